@@ -1,0 +1,67 @@
+// SPDX-License-Identifier: Apache-2.0
+/// @file BuildSurface.h
+/// @brief The one-call front door: particles in, relaxed surface mesh (and density grid) out.
+///
+/// @code
+/// nonbloppy::SurfaceParameters params;        // everything derived from the spacing
+/// params.iterations = 2;
+/// nonbloppy::SurfaceResult result = nonbloppy::buildSurface(myParticles, params);
+/// nonbloppy::writeMesh(result.mesh, "fluid.obj");
+/// @endcode
+/// The stages it chains are callable one by one: estimateSpacing/resolveParameters →
+/// buildParticleIndex → rasterizeDensity → extractSurface → relaxVertices → computeNormals.
+
+#ifndef NONBLOPPY_BUILD_SURFACE_H
+#define NONBLOPPY_BUILD_SURFACE_H
+
+#include <nonbloppy/EstimateParameters.h>
+#include <nonbloppy/Mesh.h>
+#include <nonbloppy/Timing.h>
+
+#include <openvdb/openvdb.h>
+#include <openvdb/util/NullInterrupter.h>
+#include <tbb/parallel_for.h>
+
+#include <vector>
+
+namespace nonbloppy {
+
+/// Everything buildSurface() produces.
+struct SurfaceResult
+{
+    SurfaceMesh mesh;                   ///< relaxed, counter-clockwise, with vertex normals
+    openvdb::FloatGrid::Ptr density;    ///< the "density" grid, metadata holds the parameters
+    ResolvedParameters parameters;      ///< every value used, and which were given
+    size_t particleCount = 0;
+    StageTimings timings;               ///< seconds per stage
+};
+
+/// Run the whole pipeline on @a positions (world units), which it takes over.
+/// @throw ParameterError for bad parameters or non-finite positions, CancelledError when
+///        @a interrupter asks to stop.
+SurfaceResult buildSurface(std::vector<openvdb::Vec3f> positions,
+                           const SurfaceParameters& params = SurfaceParameters(),
+                           openvdb::util::NullInterrupter* interrupter = nullptr);
+
+/// Run the whole pipeline on any ParticleList (see Particles.h); the caller's particles are
+/// read once through getPos() into the index's own float array, never modified.
+template<typename ParticleListT>
+SurfaceResult buildSurface(const ParticleListT& particles,
+                           const SurfaceParameters& params = SurfaceParameters(),
+                           openvdb::util::NullInterrupter* interrupter = nullptr)
+{
+    std::vector<openvdb::Vec3f> positions(particles.size());
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, positions.size()),
+        [&](const tbb::blocked_range<size_t>& range) {
+            openvdb::Vec3R xyz;
+            for (size_t n = range.begin(); n < range.end(); ++n) {
+                particles.getPos(n, xyz);
+                positions[n] = openvdb::Vec3f(xyz);
+            }
+        });
+    return buildSurface(std::move(positions), params, interrupter);
+}
+
+} // namespace nonbloppy
+
+#endif // NONBLOPPY_BUILD_SURFACE_H

@@ -1,0 +1,71 @@
+// SPDX-License-Identifier: Apache-2.0
+/// @file EstimateParameters.h
+/// @brief Stage "estimate parameters": particle spacing, and the method's parameters the
+///        user did not give, derived from it.
+
+#ifndef NONBLOPPY_ESTIMATE_PARAMETERS_H
+#define NONBLOPPY_ESTIMATE_PARAMETERS_H
+
+#include <openvdb/openvdb.h>
+
+#include <optional>
+#include <vector>
+
+namespace nonbloppy {
+
+/// Median distance from a particle to its nearest neighbour, in world units, over a fixed
+/// deterministic sample of at most @a maxSamples particles (all of them when fewer).
+/// Cost: O(N) to bucket the particles plus O(samples) neighbour searches.
+/// @throw ParameterError with fewer than two particles, or when the median is 0
+///        (half the particles sit on top of another one).
+double estimateSpacing(const std::vector<openvdb::Vec3f>& positions, size_t maxSamples = 20000);
+
+/// The iso-value r_0 for which a flat, uniform half-space of particles on a cubic lattice of
+/// spacing s has its unrelaxed (t = 0) surface s/2 outside the outer particle layer, so the
+/// fluid's volume is about N·s³. The density there is averaged over the lattice cell.
+/// The result depends only on the ratio r_e/s. Cost: a few thousand kernel evaluations.
+/// @throw ParameterError if @a effectiveRadiusOverSpacing ≤ 0.5 (the density at s/2 outside
+///        would be 0 and no threshold could place the surface there).
+double calibrateThreshold(double effectiveRadiusOverSpacing);
+
+/// Defaults of the method relative to the particle spacing s.
+constexpr double kDefaultRadiusOverSpacing = 2.0;  ///< r_e = 2 s
+constexpr double kDefaultVoxelOverSpacing = 0.5;   ///< h = s / 2
+constexpr double kDefaultBlend = 0.3;              ///< c
+constexpr int kDefaultIterations = 2;              ///< t
+constexpr double kDefaultAdaptivity = 0.0;         ///< volumeToMesh adaptivity, in [0,1]
+
+/// What the user asks for; every unset optional is derived from the particle spacing.
+/// All lengths are absolute, in world units (not multiples of the spacing).
+struct SurfaceParameters
+{
+    std::optional<double> spacing;          ///< s; default: estimateSpacing()
+    std::optional<double> effectiveRadius;  ///< r_e; default: 2 s
+    std::optional<double> threshold;        ///< r_0 (dimensionless); default: calibrateThreshold(r_e/s)
+    std::optional<double> voxelSize;        ///< h; default: s / 2
+    double blend = kDefaultBlend;           ///< c in [0,1]
+    int iterations = kDefaultIterations;    ///< t ≥ 0
+    double adaptivity = kDefaultAdaptivity; ///< in [0,1]
+};
+
+/// Every parameter's value as used, and whether the user gave it.
+struct ResolvedParameters
+{
+    double spacing = 0, effectiveRadius = 0, threshold = 0, voxelSize = 0;
+    double blend = kDefaultBlend;
+    int iterations = kDefaultIterations;
+    double adaptivity = kDefaultAdaptivity;
+    bool spacingGiven = false, effectiveRadiusGiven = false, thresholdGiven = false,
+         voxelSizeGiven = false;
+};
+
+/// Check @a params and fill in what is missing. @a positions is only read when the spacing
+/// must be estimated (spacing unset and effectiveRadius, threshold or voxelSize unset).
+/// @throw ParameterError naming the parameter, e.g. "--blend must lie in [0,1], got 1.5"
+///        (parameters are named by their command-line spelling).
+ResolvedParameters resolveParameters(const SurfaceParameters& params,
+                                     const std::vector<openvdb::Vec3f>& positions);
+
+} // namespace nonbloppy
+
+#endif // NONBLOPPY_ESTIMATE_PARAMETERS_H

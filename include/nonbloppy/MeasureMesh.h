@@ -1,0 +1,36 @@
+// SPDX-License-Identifier: Apache-2.0
+/// @file MeasureMesh.h
+/// @brief Topology and geometry measures of a SurfaceMesh: closed, manifold, area, volume.
+
+#ifndef NONBLOPPY_MEASURE_MESH_H
+#define NONBLOPPY_MEASURE_MESH_H
+
+#include <nonbloppy/Mesh.h>
+
+#include <cstddef>
+
+namespace nonbloppy {
+
+/// What measureMesh() finds.
+struct MeshMeasures
+{
+    size_t vertices = 0;
+    size_t polygons = 0;          ///< triangles + quads
+    size_t unusedVertices = 0;    ///< vertices no polygon references
+    size_t boundaryEdges = 0;     ///< edges with one adjacent polygon
+    size_t nonManifoldEdges = 0;  ///< edges with three or more adjacent polygons
+    size_t inconsistentEdges = 0; ///< edges used twice in the same direction (flipped faces)
+    bool closed = false;          ///< no boundary edges
+    bool manifold = false;        ///< every edge has exactly two polygons, oriented consistently
+    double area = 0.0;            ///< world units²
+    double volume = 0.0;          ///< signed enclosed volume (divergence theorem), world units³;
+                                  ///< positive when polygons face outwards
+};
+
+/// Measure @a mesh (quads split into two triangles for area and volume).
+/// Cost: O(P log P) for P polygons (edge sort), memory O(P).
+MeshMeasures measureMesh(const SurfaceMesh& mesh);
+
+} // namespace nonbloppy
+
+#endif // NONBLOPPY_MEASURE_MESH_H

@@ -1,0 +1,32 @@
+// SPDX-License-Identifier: Apache-2.0
+/// @file Mesh.h
+/// @brief SurfaceMesh, the polygon mesh every stage after extraction reads and writes.
+
+#ifndef NONBLOPPY_MESH_H
+#define NONBLOPPY_MESH_H
+
+#include <openvdb/openvdb.h>
+
+#include <vector>
+
+namespace nonbloppy {
+
+/// A polygon mesh of triangles and quads sharing one vertex array, in world units.
+/// Polygons run counter-clockwise seen from outside the fluid, so the right-hand-rule
+/// face normal points out of the fluid. Quads are kept as volumeToMesh made them;
+/// writers split them into triangles where asked or where the format needs it.
+struct SurfaceMesh
+{
+    std::vector<openvdb::Vec3s> points;     ///< vertex positions, world units
+    std::vector<openvdb::Vec3s> normals;    ///< unit vertex normals; empty until computeNormals()
+    std::vector<openvdb::Vec3I> triangles;  ///< vertex indices, counter-clockwise from outside
+    std::vector<openvdb::Vec4I> quads;      ///< vertex indices, counter-clockwise from outside
+
+    size_t polygonCount() const { return triangles.size() + quads.size(); }
+    /// Number of triangles after splitting every quad in two.
+    size_t triangleCount() const { return triangles.size() + 2 * quads.size(); }
+};
+
+} // namespace nonbloppy
+
+#endif // NONBLOPPY_MESH_H

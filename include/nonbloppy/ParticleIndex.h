@@ -1,0 +1,88 @@
+// SPDX-License-Identifier: Apache-2.0
+/// @file ParticleIndex.h
+/// @brief Stage "index particles": one openvdb::tools::PointIndexGrid per frame, shared by
+///        density rasterization and vertex relaxation.
+///
+/// The index keeps its own copy of the positions as float, reordered so that the particles
+/// of each index cell are contiguous. Inner loops then stream through memory instead of
+/// jumping through an index array, and the PointIndexGrid's index lists (rewritten to refer
+/// to the sorted order) always hold runs of consecutive numbers.
+
+#ifndef NONBLOPPY_PARTICLE_INDEX_H
+#define NONBLOPPY_PARTICLE_INDEX_H
+
+#include <nonbloppy/Error.h>
+#include <nonbloppy/Particles.h>
+
+#include <openvdb/openvdb.h>
+#include <tbb/parallel_for.h>
+
+#include <cmath>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace nonbloppy {
+
+/// Particles bucketed into cubic cells of a PointIndexGrid.
+/// Memory: 16 bytes per particle (float position + uint32 original index) plus the grid.
+/// Thread-safe for concurrent reading once built.
+class ParticleIndex
+{
+public:
+    using PosType = openvdb::Vec3R;
+
+    ParticleIndex();
+    ~ParticleIndex();
+    ParticleIndex(ParticleIndex&&) noexcept;
+    ParticleIndex& operator=(ParticleIndex&&) noexcept;
+
+    /// Bucket @a positions (world units, taken over and reordered) into cells of
+    /// @a cellSize world units. Cost: O(N) time (parallel radix partitioning by OpenVDB).
+    /// @throw ParameterError if cellSize ≤ 0 or a position is not finite.
+    static ParticleIndex build(std::vector<openvdb::Vec3f> positions, double cellSize);
+
+    /// Number of particles.
+    size_t size() const;
+    /// Position of the particle at sorted slot @a k (PointArray concept, for OpenVDB tools).
+    void getPos(size_t k, openvdb::Vec3R& xyz) const { xyz = sortedPositions()[k]; }
+    /// Positions in cell order (world units).
+    const std::vector<openvdb::Vec3f>& sortedPositions() const;
+    /// originalIndex()[k] is the index, in the caller's particle list, of sorted slot k.
+    const std::vector<uint32_t>& originalIndex() const;
+    /// Cell edge length in world units.
+    double cellSize() const;
+    /// The tools::PointIndexGrid (as GridBase, so this header stays light; cast it with
+    /// openvdb::gridPtrCast<openvdb::tools::PointIndexGrid>). Its indices refer to sorted slots.
+    openvdb::GridBase::ConstPtr indexGrid() const;
+
+    /// Internal representation (src/ParticleIndexImpl.h); the stages iterate it directly.
+    struct Impl;
+    const Impl& impl() const { return *mImpl; }
+
+private:
+    std::unique_ptr<Impl> mImpl;
+};
+
+/// Build a ParticleIndex from any ParticleList (see Particles.h). The caller's array is
+/// only read, through getPos(), in parallel.
+/// @throw ParameterError if a position is NaN or infinite (naming the particle).
+template<typename ParticleListT>
+ParticleIndex buildParticleIndex(const ParticleListT& particles, double cellSize)
+{
+    std::vector<openvdb::Vec3f> positions(particles.size());
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, positions.size()),
+        [&](const tbb::blocked_range<size_t>& range) {
+            openvdb::Vec3R xyz;
+            for (size_t n = range.begin(); n < range.end(); ++n) {
+                particles.getPos(n, xyz);
+                positions[n] = openvdb::Vec3f(xyz);
+            }
+        });
+    return ParticleIndex::build(std::move(positions), cellSize);
+}
+
+} // namespace nonbloppy
+
+#endif // NONBLOPPY_PARTICLE_INDEX_H

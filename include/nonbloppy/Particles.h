@@ -1,0 +1,100 @@
+// SPDX-License-Identifier: Apache-2.0
+/// @file Particles.h
+/// @brief Particle inputs: the ParticleList concept every stage accepts, a view over a
+///        caller's raw coordinate array, and ParticleSet, the container the readers fill.
+///
+/// ## The ParticleList concept
+/// Stages that take particles are templates over a type modelling OpenVDB's ParticleList /
+/// PointArray convention, so callers pass their own arrays and nothing is converted:
+/// @code
+/// struct MyParticles {
+///     using PosType = openvdb::Vec3R;              // optional, for OpenVDB's own tools
+///     size_t size() const;                         // number of particles
+///     void getPos(size_t n, openvdb::Vec3R& xyz) const; // world-space position of particle n
+/// };
+/// @endcode
+/// Positions are in world units (the simulation's length unit). getPos() is called
+/// concurrently from several threads and must therefore be thread-safe for reading.
+
+#ifndef NONBLOPPY_PARTICLES_H
+#define NONBLOPPY_PARTICLES_H
+
+#include <openvdb/openvdb.h>
+
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace nonbloppy {
+
+/// A non-owning ParticleList over xyz coordinates stored in a caller's array:
+/// particle n is at (data[n*stride], data[n*stride+1], data[n*stride+2]).
+/// Cost: nothing is copied; the caller keeps the array alive while the view is used.
+template<typename ScalarT>
+class PositionArrayView
+{
+public:
+    using PosType = openvdb::Vec3R;
+
+    /// @param data    first coordinate of particle 0
+    /// @param count   number of particles
+    /// @param stride  distance, in ScalarT elements, between two particles (3 for packed xyz)
+    PositionArrayView(const ScalarT* data, size_t count, size_t stride = 3)
+        : mData(data), mCount(count), mStride(stride) {}
+
+    size_t size() const { return mCount; }
+    void getPos(size_t n, openvdb::Vec3R& xyz) const
+    {
+        const ScalarT* p = mData + n * mStride;
+        xyz = openvdb::Vec3R(double(p[0]), double(p[1]), double(p[2]));
+    }
+
+private:
+    const ScalarT* mData;
+    size_t mCount;
+    size_t mStride;
+};
+
+/// The type of each component of a particle attribute, as it was stored in the file.
+enum class ScalarType { Int8, UInt8, Int16, UInt16, Int32, UInt32, Int64, UInt64, Float32, Float64 };
+
+/// Size in bytes of one component of @a type.
+size_t scalarSize(ScalarType type);
+/// Lower-case name of @a type ("float32", "int64", ...), as used by `nonbloppy inspect`.
+const char* scalarTypeName(ScalarType type);
+
+/// One named per-particle attribute (e.g. "velocity", 3 × Float32), stored in its own
+/// type so nothing is lost on the way from reader to writer.
+struct ParticleAttribute
+{
+    std::string name;
+    ScalarType type = ScalarType::Float32;
+    int components = 1;                  ///< 1 for scalars, 3 for vectors, ...
+    std::vector<unsigned char> bytes;    ///< native-endian values, particle-major
+
+    /// Number of particles the attribute holds values for.
+    size_t size() const;
+    /// Component @a c of particle @a n, converted to double.
+    double asDouble(size_t n, int c = 0) const;
+};
+
+/// Particles read from a file: positions plus every named per-particle attribute.
+/// Models the ParticleList concept, so it can be passed to every stage directly.
+struct ParticleSet
+{
+    using PosType = openvdb::Vec3R;
+
+    std::vector<openvdb::Vec3f> positions;      ///< world units
+    std::vector<ParticleAttribute> attributes;  ///< each holds positions.size() values
+
+    size_t size() const { return positions.size(); }
+    void getPos(size_t n, openvdb::Vec3R& xyz) const { xyz = positions[n]; }
+
+    /// The attribute called @a name, or nullptr.
+    const ParticleAttribute* findAttribute(const std::string& name) const;
+};
+
+} // namespace nonbloppy
+
+#endif // NONBLOPPY_PARTICLES_H

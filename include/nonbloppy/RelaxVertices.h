@@ -1,0 +1,37 @@
+// SPDX-License-Identifier: Apache-2.0
+/// @file RelaxVertices.h
+/// @brief Stage "relax vertices": pull mesh vertices towards the kernel-weighted mean of
+///        nearby particles, which flattens faces, sharpens edges and keeps sheets thin.
+
+#ifndef NONBLOPPY_RELAX_VERTICES_H
+#define NONBLOPPY_RELAX_VERTICES_H
+
+#include <nonbloppy/Mesh.h>
+#include <nonbloppy/ParticleIndex.h>
+
+#include <openvdb/util/NullInterrupter.h>
+
+namespace nonbloppy {
+
+/// Relaxation parameters.
+struct RelaxSettings
+{
+    double effectiveRadius = 0.0;  ///< r_e, world units, > 0 (the kernel's support)
+    double blend = 0.3;            ///< c in [0,1]: 0 leaves vertices alone, 1 jumps to the mean
+    int iterations = 2;            ///< t ≥ 0
+};
+
+/// Apply t times, to every vertex v_i of @a mesh:
+///   t_i = Σ_j w(|v_i − r_j|) r_j / Σ_j w(|v_i − r_j|),   v_i ← (1 − c) v_i + c t_i.
+/// Each iteration reads only the previous iteration's positions, so the result does not
+/// depend on thread count or order. A vertex with no particle within r_e stays put.
+/// Normals are not updated (call computeNormals() afterwards).
+/// Cost: t · V · (particles within r_e) kernel evaluations, parallel over vertices.
+/// @throw ParameterError for r_e ≤ 0, c outside [0,1] or t < 0; CancelledError on interrupt.
+void relaxVertices(SurfaceMesh& mesh, const ParticleIndex& particles,
+                   const RelaxSettings& settings,
+                   openvdb::util::NullInterrupter* interrupter = nullptr);
+
+} // namespace nonbloppy
+
+#endif // NONBLOPPY_RELAX_VERTICES_H

@@ -1,0 +1,37 @@
+// SPDX-License-Identifier: Apache-2.0
+/// @file WriteMesh.h
+/// @brief Stage "write mesh": save a SurfaceMesh as OBJ, binary PLY or legacy VTK polydata.
+
+#ifndef NONBLOPPY_WRITE_MESH_H
+#define NONBLOPPY_WRITE_MESH_H
+
+#include <nonbloppy/Mesh.h>
+
+#include <string>
+
+namespace nonbloppy {
+
+/// How a mesh is written.
+struct MeshWriteSettings
+{
+    /// Keep quads as quads (OBJ, PLY and VTK all allow them); false splits every quad
+    /// (q0,q1,q2,q3) into triangles (q0,q1,q2) and (q0,q2,q3).
+    bool keepQuads = false;
+};
+
+/// Write @a mesh to @a path; the format follows the extension: `.obj` (v, vn, f; 1-based),
+/// `.ply` (binary little-endian: float x y z, float nx ny nz when normals exist, uchar-count
+/// int faces), `.vtk` (legacy binary POLYDATA, POINTS float, POLYGONS, POINT_DATA NORMALS).
+/// The file is written to a temporary file beside @a path and renamed into place, so a
+/// failed or interrupted write never leaves a partial file.
+/// Output is byte-identical for identical meshes (fixed float formatting, no timestamps).
+/// @throw FileError for an unknown extension or a file that cannot be written (names @a path).
+void writeMesh(const SurfaceMesh& mesh, const std::string& path,
+               const MeshWriteSettings& settings = MeshWriteSettings());
+
+/// True if @a path has an extension writeMesh() understands.
+bool isMeshFile(const std::string& path);
+
+} // namespace nonbloppy
+
+#endif // NONBLOPPY_WRITE_MESH_H

@@ -1,0 +1,24 @@
+// SPDX-License-Identifier: Apache-2.0
+/// @file WriteVdb.h
+/// @brief Stage "write vdb": save intermediate grids (the density) as a `.vdb` cache that
+///        OpenVDB tools such as `vdb_print` read.
+
+#ifndef NONBLOPPY_WRITE_VDB_H
+#define NONBLOPPY_WRITE_VDB_H
+
+#include <openvdb/openvdb.h>
+
+#include <string>
+
+namespace nonbloppy {
+
+/// Write @a grids to @a path (temporary file, then rename), with @a fileMetadata as the
+/// file's metadata. Grids keep their own metadata (names, class, nonbloppy parameters).
+/// Written without compression timestamps, so the same grids give the same bytes.
+/// @throw FileError naming @a path when it cannot be written.
+void writeVdb(const openvdb::GridCPtrVec& grids, const std::string& path,
+              const openvdb::MetaMap& fileMetadata = openvdb::MetaMap());
+
+} // namespace nonbloppy
+
+#endif // NONBLOPPY_WRITE_VDB_H
