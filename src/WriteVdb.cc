@@ -1,23 +1,23 @@
 // SPDX-License-Identifier: Apache-2.0
 /// @file WriteVdb.cc
 /// @brief Stage "write vdb": openvdb::io::File into a temporary file, a deterministic file
-///        UUID patched into its header, then a rename into place.
+///        UUID patched into its header, then a rename into place
+///        (AtomicFile).
 
 #include <nonbloppy/WriteVdb.h>
 
 #include <nonbloppy/Error.h>
 
+#include "AtomicFile.h"
+
 #include <openvdb/io/File.h>
 
 #include <array>
-#include <atomic>
 #include <cerrno>
 #include <cstdint>
-#include <cstdio>
 #include <cstring>
 #include <fstream>
 #include <string>
-#include <unistd.h>
 
 namespace nonbloppy {
 
@@ -112,40 +112,6 @@ void makeUuidDeterministic(const std::string& path, const std::string& finalPath
     }
 }
 
-/// A temporary file beside the final path, removed unless commit() renamed it into place.
-/// (A local equivalent of src/AtomicFile.h, which did not exist when this was written.)
-class TempFile
-{
-public:
-    explicit TempFile(const std::string& finalPath) : mFinalPath(finalPath)
-    {
-        static std::atomic<unsigned> counter{0};
-        // Same directory as the final path, so that rename() is atomic.
-        mTempPath = finalPath + ".tmp." + std::to_string(::getpid()) + "."
-                    + std::to_string(counter++);
-    }
-    ~TempFile()
-    {
-        if (!mCommitted) std::remove(mTempPath.c_str());
-    }
-    TempFile(const TempFile&) = delete;
-    TempFile& operator=(const TempFile&) = delete;
-
-    const std::string& tempPath() const { return mTempPath; }
-
-    void commit()
-    {
-        if (std::rename(mTempPath.c_str(), mFinalPath.c_str()) != 0) {
-            throw FileError("cannot write " + mFinalPath + ": " + std::strerror(errno));
-        }
-        mCommitted = true;
-    }
-
-private:
-    std::string mFinalPath, mTempPath;
-    bool mCommitted = false;
-};
-
 } // namespace write_vdb_internal
 
 void writeVdb(const openvdb::GridCPtrVec& grids, const std::string& path,
@@ -158,14 +124,9 @@ void writeVdb(const openvdb::GridCPtrVec& grids, const std::string& path,
         if (!grid) throw FileError("cannot write " + path + ": null grid");
     }
 
-    TempFile temp(path);
-    {
-        // Create the file ourselves first: errno then tells why it cannot be written
-        // (io::File only says "could not open file for writing").
-        std::FILE* probe = std::fopen(temp.tempPath().c_str(), "wb");
-        if (!probe) throw FileError("cannot write " + path + ": " + std::strerror(errno));
-        std::fclose(probe);
-    }
+    // AtomicFile creates the temporary file itself, so a missing directory is reported
+    // with errno's reason (io::File would only say "could not open file for writing").
+    AtomicFile temp(path);
 
     try {
         openvdb::io::File file(temp.tempPath());
