@@ -17,9 +17,9 @@ struct DensitySettings
 {
     double effectiveRadius = 0.0;  ///< r_e, world units, > 0
     double voxelSize = 0.0;        ///< h, world units, > 0; ignored when transform is set
-    /// Optional caller-provided linear transform (voxel centres are sampled); it must be a
-    /// uniform-scale transform. When null, a transform of voxelSize with voxel centres at
-    /// integer multiples of h is used.
+    /// Optional caller-provided transform (voxel centres are sampled). It must be a
+    /// uniform scale (Transform::createLinearTransform(h)): voxel centres at integer
+    /// multiples of h. When null, such a transform of voxelSize is made.
     openvdb::math::Transform::Ptr transform;
 };
 

@@ -1,0 +1,182 @@
+// SPDX-License-Identifier: Apache-2.0
+#include "ParticleIndexImpl.h"
+
+#include <nonbloppy/Error.h>
+#include <nonbloppy/EstimateParameters.h>
+#include <nonbloppy/Kernel.h>
+
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+namespace nonbloppy {
+
+namespace {
+
+std::string formatNumber(double value)
+{
+    std::ostringstream out;
+    out << value;
+    return out.str();
+}
+
+/// Nearest-neighbour distance of each sampled slot, searched within @a searchRadius;
+/// +inf where no other particle lies that close.
+std::vector<double> nearestWithin(const ParticleIndex& index, const std::vector<size_t>& samples,
+                                  double searchRadius)
+{
+    using namespace particle_index_internal;
+    const auto& positions = index.sortedPositions();
+    const auto& grid = *index.impl().grid;
+    std::vector<double> nearest(samples.size());
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, samples.size()),
+        [&](const tbb::blocked_range<size_t>& range) {
+            auto accessor = grid.getConstAccessor();
+            for (size_t i = range.begin(); i < range.end(); ++i) {
+                const size_t self = samples[i];
+                const openvdb::Vec3d x = positions[self];
+                double best = searchRadius * searchRadius;
+                bool found = false;
+                forEachRunInBox(accessor, index.cellSize(), x - openvdb::Vec3d(searchRadius),
+                    x + openvdb::Vec3d(searchRadius), [&](uint32_t first, uint32_t end) {
+                        for (uint32_t k = first; k < end; ++k) {
+                            if (k == self) continue;
+                            const double d2 = (openvdb::Vec3d(positions[k]) - x).lengthSqr();
+                            if (d2 <= best) { best = d2; found = true; }
+                        }
+                    });
+                nearest[i] = found ? std::sqrt(best) : std::numeric_limits<double>::infinity();
+            }
+        });
+    return nearest;
+}
+
+} // namespace
+
+double estimateSpacing(const std::vector<openvdb::Vec3f>& positions, size_t maxSamples)
+{
+    if (positions.size() < 2) {
+        throw ParameterError("cannot estimate the particle spacing from " +
+                             std::to_string(positions.size()) +
+                             " particle(s); give --spacing or --radius, --threshold and --voxel-size");
+    }
+    openvdb::BBoxd bounds;
+    for (const openvdb::Vec3f& p : positions) bounds.expand(openvdb::Vec3d(p));
+    const openvdb::Vec3d extent = bounds.extents();
+    const double count = double(positions.size());
+    // First guess: the spacing of the particles spread evenly over their bounding box (or
+    // along its longest side when they are flat). Fluids rarely fill their box, so this
+    // tends to be too large, which only costs a wider first search.
+    double guess = std::cbrt(extent[0] * extent[1] * extent[2] / count);
+    guess = std::max(guess, std::max({extent[0], extent[1], extent[2]}) / count);
+    if (!(guess > 0.0)) {
+        throw ParameterError("cannot estimate the particle spacing: all particles are at the same position");
+    }
+
+    ParticleIndex index = ParticleIndex::build(positions, guess);
+    const size_t sampleCount = std::min(std::max<size_t>(maxSamples, 1), positions.size());
+    std::vector<size_t> samples(sampleCount);
+    for (size_t i = 0; i < sampleCount; ++i) samples[i] = i * positions.size() / sampleCount;
+
+    // A neighbour found within the search radius is the true nearest one, so the median is
+    // exact once more than half the samples found one; otherwise widen the search.
+    double radius = guess;
+    for (int attempt = 0; attempt < 40; ++attempt, radius *= 2.0) {
+        std::vector<double> nearest = nearestWithin(index, samples, radius);
+        const size_t middle = nearest.size() / 2;
+        std::nth_element(nearest.begin(), nearest.begin() + middle, nearest.end());
+        const double median = nearest[middle];
+        if (std::isfinite(median)) {
+            if (!(median > 0.0)) {
+                throw ParameterError("cannot estimate the particle spacing: most particles sit on top of "
+                                     "another one; give --spacing");
+            }
+            return median;
+        }
+    }
+    throw ParameterError("cannot estimate the particle spacing; give --spacing");
+}
+
+double calibrateThreshold(double effectiveRadiusOverSpacing)
+{
+    const double ratio = effectiveRadiusOverSpacing;
+    if (!(ratio > 0.5) || !std::isfinite(ratio)) {
+        throw ParameterError("--radius must exceed half the particle spacing to calibrate --threshold, got " +
+                             formatNumber(ratio) + " spacings");
+    }
+    // Lattice of unit spacing filling z ≤ 0; average φ over the plane z = 1/2 by sampling one
+    // lattice cell on a regular grid.
+    constexpr int kSamples = 16;
+    const int reach = int(std::ceil(ratio)) + 1;
+    double sum = 0.0;
+    for (int sx = 0; sx < kSamples; ++sx) {
+        for (int sy = 0; sy < kSamples; ++sy) {
+            const double x = (sx + 0.5) / kSamples, y = (sy + 0.5) / kSamples, z = 0.5;
+            for (int i = -reach; i <= reach + 1; ++i) {
+                for (int j = -reach; j <= reach + 1; ++j) {
+                    for (int k = -reach; k <= 0; ++k) {
+                        const double d = std::sqrt((x - i) * (x - i) + (y - j) * (y - j) + (z - k) * (z - k));
+                        if (d < ratio) sum += ratio / d - 1.0;
+                    }
+                }
+            }
+        }
+    }
+    return sum / (kSamples * kSamples);
+}
+
+ResolvedParameters resolveParameters(const SurfaceParameters& params,
+                                     const std::vector<openvdb::Vec3f>& positions)
+{
+    auto requirePositive = [](const std::optional<double>& value, const char* name) {
+        if (value && (!(*value > 0.0) || !std::isfinite(*value))) {
+            throw ParameterError(std::string(name) + " must be > 0, got " + formatNumber(*value));
+        }
+    };
+    requirePositive(params.spacing, "--spacing");
+    requirePositive(params.effectiveRadius, "--radius");
+    requirePositive(params.threshold, "--threshold");
+    requirePositive(params.voxelSize, "--voxel-size");
+    if (!(params.blend >= 0.0 && params.blend <= 1.0)) {
+        throw ParameterError("--blend must lie in [0,1], got " + formatNumber(params.blend));
+    }
+    if (params.iterations < 0) {
+        throw ParameterError("--iterations must be >= 0, got " + std::to_string(params.iterations));
+    }
+    if (!(params.adaptivity >= 0.0 && params.adaptivity <= 1.0)) {
+        throw ParameterError("--adaptivity must lie in [0,1], got " + formatNumber(params.adaptivity));
+    }
+    if (positions.empty()) throw ParameterError("no particles to mesh");
+
+    ResolvedParameters out;
+    out.blend = params.blend;
+    out.iterations = params.iterations;
+    out.adaptivity = params.adaptivity;
+    out.spacingGiven = bool(params.spacing);
+    out.effectiveRadiusGiven = bool(params.effectiveRadius);
+    out.thresholdGiven = bool(params.threshold);
+    out.voxelSizeGiven = bool(params.voxelSize);
+
+    const bool needSpacing = !params.effectiveRadius || !params.threshold || !params.voxelSize;
+    if (params.spacing) out.spacing = *params.spacing;
+    else if (needSpacing) out.spacing = estimateSpacing(positions);
+
+    out.effectiveRadius = params.effectiveRadius ? *params.effectiveRadius
+                                                 : kDefaultRadiusOverSpacing * out.spacing;
+    out.voxelSize = params.voxelSize ? *params.voxelSize : kDefaultVoxelOverSpacing * out.spacing;
+    out.threshold = params.threshold ? *params.threshold
+                                     : calibrateThreshold(out.effectiveRadius / out.spacing);
+
+    // The grid holds (2 r_e / h)³ voxels per particle: refuse sizes that would exhaust memory.
+    constexpr double kMaxVoxelsPerRadius = 32.0;
+    if (out.effectiveRadius / out.voxelSize > kMaxVoxelsPerRadius) {
+        throw ParameterError("--voxel-size " + formatNumber(out.voxelSize) + " is too small for --radius " +
+                             formatNumber(out.effectiveRadius) + ": at most 32 voxels per radius");
+    }
+    return out;
+}
+
+} // namespace nonbloppy

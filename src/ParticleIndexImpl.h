@@ -1,0 +1,76 @@
+// SPDX-License-Identifier: Apache-2.0
+/// @file ParticleIndexImpl.h
+/// @brief Private: the representation behind nonbloppy::ParticleIndex and the cell walk the
+///        stages share. Only src/ includes it (it pulls in tools/PointIndexGrid.h).
+
+#ifndef NONBLOPPY_PARTICLE_INDEX_IMPL_H
+#define NONBLOPPY_PARTICLE_INDEX_IMPL_H
+
+#include <nonbloppy/ParticleIndex.h>
+
+#include <openvdb/tools/PointIndexGrid.h>
+
+#include <algorithm>
+#include <cmath>
+
+namespace nonbloppy {
+
+struct ParticleIndex::Impl
+{
+    std::vector<openvdb::Vec3f> sortedPositions;
+    std::vector<uint32_t> originalIndex;
+    double cellSize = 0.0;
+    openvdb::tools::PointIndexGrid::Ptr grid;  ///< indices refer to sorted slots
+};
+
+namespace particle_index_internal {
+
+using IndexTree = openvdb::tools::PointIndexTree;
+using IndexLeaf = IndexTree::LeafNodeType;
+
+/// Index-space cell holding world position @a x (cells are centred on integer coordinates,
+/// as OpenVDB's PointPartitioner buckets them).
+inline openvdb::Coord cellOf(const openvdb::Vec3d& x, double cellSize)
+{
+    return openvdb::Coord(int(std::floor(x[0] / cellSize + 0.5)),
+                          int(std::floor(x[1] / cellSize + 0.5)),
+                          int(std::floor(x[2] / cellSize + 0.5)));
+}
+
+/// Call visit(firstSlot, endSlot) for every non-empty run of sorted slots whose cells overlap
+/// the world box [minCorner, maxCorner]. Cells along z inside one leaf hold consecutive
+/// slots, so each (x, y) column of a leaf is one run. Visiting order is fixed (x, y, z
+/// ascending), which keeps every sum built from the runs independent of threading.
+template<typename AccessorT, typename VisitorT>
+inline void forEachRunInBox(AccessorT& accessor, double cellSize,
+                            const openvdb::Vec3d& minCorner, const openvdb::Vec3d& maxCorner,
+                            VisitorT&& visit)
+{
+    const openvdb::Coord lo = cellOf(minCorner, cellSize), hi = cellOf(maxCorner, cellSize);
+    constexpr int kLeafMask = int(IndexLeaf::DIM) - 1;
+    openvdb::Coord ijk;
+    for (ijk[0] = lo[0]; ijk[0] <= hi[0]; ++ijk[0]) {
+        for (ijk[1] = lo[1]; ijk[1] <= hi[1]; ++ijk[1]) {
+            for (int z = lo[2]; z <= hi[2];) {
+                const int zEnd = std::min(hi[2], (z & ~kLeafMask) + kLeafMask);
+                ijk[2] = z;
+                if (const IndexLeaf* leaf = accessor.probeConstLeaf(ijk)) {
+                    const openvdb::Index first = IndexLeaf::coordToOffset(ijk);
+                    const openvdb::Index last = first + openvdb::Index(zEnd - z);
+                    const uint32_t begin = first == 0 ? 0u : uint32_t(leaf->getValue(first - 1));
+                    const uint32_t end = uint32_t(leaf->getValue(last));
+                    if (end > begin) {
+                        const uint32_t slot = uint32_t(leaf->indices()[begin]);
+                        visit(slot, slot + (end - begin));
+                    }
+                }
+                z = zEnd + 1;
+            }
+        }
+    }
+}
+
+} // namespace particle_index_internal
+} // namespace nonbloppy
+
+#endif // NONBLOPPY_PARTICLE_INDEX_IMPL_H

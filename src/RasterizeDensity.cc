@@ -1,0 +1,191 @@
+// SPDX-License-Identifier: Apache-2.0
+#include "ParticleIndexImpl.h"
+
+#include <nonbloppy/Error.h>
+#include <nonbloppy/Kernel.h>
+#include <nonbloppy/RasterizeDensity.h>
+
+#include <openvdb/tree/LeafManager.h>
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+
+#include <atomic>
+#include <cmath>
+#include <sstream>
+
+namespace nonbloppy {
+
+namespace {
+
+using FloatLeaf = openvdb::FloatTree::LeafNodeType;
+using particle_index_internal::IndexLeaf;
+using particle_index_internal::IndexTree;
+
+/// Origins of the density leaves that may hold a voxel within r_e of a particle: for each
+/// leaf of the particle index, the density leaves overlapping its active cells' bounding box
+/// grown by r_e. Sorted, so the leaf order (and thus everything after) is deterministic.
+std::vector<openvdb::Coord> candidateLeafOrigins(const ParticleIndex& particles,
+                                                 const openvdb::math::Transform& transform,
+                                                 double effectiveRadius)
+{
+    const IndexTree& indexTree = particles.impl().grid->tree();
+    const double cellSize = particles.cellSize();
+    openvdb::tree::LeafManager<const IndexTree> leaves(indexTree);
+    tbb::enumerable_thread_specific<std::vector<openvdb::Coord>> perThread;
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, leaves.leafCount()),
+        [&](const tbb::blocked_range<size_t>& range) {
+            std::vector<openvdb::Coord>& origins = perThread.local();
+            for (size_t n = range.begin(); n < range.end(); ++n) {
+                openvdb::CoordBBox cells;
+                leaves.leaf(n).evalActiveBoundingBox(cells, /*visitVoxels=*/true);
+                const openvdb::Vec3d worldMin = (cells.min().asVec3d() - 0.5) * cellSize - effectiveRadius;
+                const openvdb::Vec3d worldMax = (cells.max().asVec3d() + 0.5) * cellSize + effectiveRadius;
+                const openvdb::Vec3d indexMin = transform.worldToIndex(worldMin);
+                const openvdb::Vec3d indexMax = transform.worldToIndex(worldMax);
+                const openvdb::Coord lo(openvdb::Coord::ceil(indexMin) & ~int(FloatLeaf::DIM - 1));
+                const openvdb::Coord hi(openvdb::Coord::floor(indexMax) & ~int(FloatLeaf::DIM - 1));
+                openvdb::Coord origin;
+                for (origin[0] = lo[0]; origin[0] <= hi[0]; origin[0] += FloatLeaf::DIM)
+                    for (origin[1] = lo[1]; origin[1] <= hi[1]; origin[1] += FloatLeaf::DIM)
+                        for (origin[2] = lo[2]; origin[2] <= hi[2]; origin[2] += FloatLeaf::DIM)
+                            origins.push_back(origin);
+            }
+        });
+    std::vector<openvdb::Coord> all;
+    for (auto& origins : perThread) all.insert(all.end(), origins.begin(), origins.end());
+    std::sort(all.begin(), all.end());
+    all.erase(std::unique(all.begin(), all.end()), all.end());
+    return all;
+}
+
+/// Fills one density leaf from the particles whose support overlaps it (a gather over
+/// leaves, a scatter over each particle's clipped sphere inside the leaf): no two tasks
+/// write the same memory, and each voxel sums its particles in the index's fixed order.
+struct RasterizeLeafOp
+{
+    const ParticleIndex& particles;
+    const std::vector<openvdb::Coord>& origins;
+    std::vector<FloatLeaf*>& results;
+    double voxelSize;
+    double effectiveRadius;
+    openvdb::util::NullInterrupter* interrupter;
+    std::atomic<bool>& cancelled;
+    std::atomic<size_t>& done;
+
+    void operator()(const tbb::blocked_range<size_t>& range) const
+    {
+        if (cancelled) return;
+        const auto& positions = particles.sortedPositions();
+        auto accessor = particles.impl().grid->getConstAccessor();
+        const float h = float(voxelSize);
+        const float invH = 1.0f / h;
+        const float radius = float(effectiveRadius);
+        const float radius2 = radius * radius;
+        const float minDistance2 = (kMinDistanceFraction * radius) * (kMinDistanceFraction * radius);
+        constexpr int kDim = int(FloatLeaf::DIM);
+        float values[FloatLeaf::SIZE];
+
+        for (size_t n = range.begin(); n < range.end(); ++n) {
+            const openvdb::Coord origin = origins[n];
+            std::fill(values, values + FloatLeaf::SIZE, 0.0f);
+            const openvdb::Vec3d leafMin = origin.asVec3d() * voxelSize;
+            const openvdb::Vec3d leafMax = (origin.asVec3d() + double(kDim - 1)) * voxelSize;
+            bool any = false;
+            particle_index_internal::forEachRunInBox(accessor, particles.cellSize(),
+                leafMin - openvdb::Vec3d(effectiveRadius), leafMax + openvdb::Vec3d(effectiveRadius),
+                [&](uint32_t first, uint32_t end) {
+                    for (uint32_t k = first; k < end; ++k) {
+                        const openvdb::Vec3f& p = positions[k];
+                        // Voxel range of the particle's support, relative to the leaf origin.
+                        int lo[3], hi[3];
+                        bool empty = false;
+                        for (int a = 0; a < 3; ++a) {
+                            lo[a] = std::max(0, int(std::ceil((p[a] - radius) * invH)) - origin[a]);
+                            hi[a] = std::min(kDim - 1, int(std::floor((p[a] + radius) * invH)) - origin[a]);
+                            empty |= lo[a] > hi[a];
+                        }
+                        if (empty) continue;
+                        for (int i = lo[0]; i <= hi[0]; ++i) {
+                            const float dx = float(origin[0] + i) * h - p[0];
+                            for (int j = lo[1]; j <= hi[1]; ++j) {
+                                const float dy = float(origin[1] + j) * h - p[1];
+                                const float dxy2 = dx * dx + dy * dy;
+                                if (!(dxy2 < radius2)) continue;
+                                float* row = values + (i << 6) + (j << 3);
+                                const float pz = p[2] - float(origin[2]) * h;
+                                for (int l = lo[2]; l <= hi[2]; ++l) {
+                                    const float dz = float(l) * h - pz;
+                                    const float d2 = dxy2 + dz * dz;
+                                    const float w = radius / std::sqrt(std::max(d2, minDistance2)) - 1.0f;
+                                    row[l] += d2 < radius2 ? w : 0.0f;
+                                }
+                            }
+                        }
+                        any = true;
+                    }
+                });
+            if (!any) { results[n] = nullptr; continue; }
+            auto* leaf = new FloatLeaf(origin, 0.0f, false);
+            bool active = false;
+            for (openvdb::Index i = 0; i < FloatLeaf::SIZE; ++i) {
+                if (values[i] > 0.0f) { leaf->setValueOn(i, values[i]); active = true; }
+            }
+            if (!active) { delete leaf; leaf = nullptr; }
+            results[n] = leaf;
+        }
+        const size_t finished = done.fetch_add(range.size()) + range.size();
+        if (interrupter && interrupter->wasInterrupted(int(100.0 * double(finished) / double(origins.size())))) {
+            cancelled = true;
+        }
+    }
+};
+
+} // namespace
+
+openvdb::FloatGrid::Ptr rasterizeDensity(const ParticleIndex& particles, const DensitySettings& settings,
+                                         openvdb::util::NullInterrupter* interrupter)
+{
+    openvdb::initialize();
+    if (!(settings.effectiveRadius > 0.0) || !std::isfinite(settings.effectiveRadius)) {
+        std::ostringstream msg;
+        msg << "--radius must be > 0, got " << settings.effectiveRadius;
+        throw ParameterError(msg.str());
+    }
+    openvdb::math::Transform::Ptr transform = settings.transform;
+    if (!transform) {
+        if (!(settings.voxelSize > 0.0) || !std::isfinite(settings.voxelSize)) {
+            std::ostringstream msg;
+            msg << "--voxel-size must be > 0, got " << settings.voxelSize;
+            throw ParameterError(msg.str());
+        }
+        transform = openvdb::math::Transform::createLinearTransform(settings.voxelSize);
+    } else if (transform->baseMap()->type() != openvdb::math::UniformScaleMap::mapType()) {
+        throw ParameterError("rasterizeDensity needs a uniform-scale transform without translation or rotation");
+    }
+    const double voxelSize = transform->voxelSize()[0];
+
+    if (interrupter) interrupter->start("rasterize density");
+    const std::vector<openvdb::Coord> origins = candidateLeafOrigins(particles, *transform, settings.effectiveRadius);
+    std::vector<FloatLeaf*> results(origins.size(), nullptr);
+    std::atomic<bool> cancelled{false};
+    std::atomic<size_t> done{0};
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, origins.size(), 16),
+        RasterizeLeafOp{particles, origins, results, voxelSize, settings.effectiveRadius, interrupter,
+                        cancelled, done});
+
+    openvdb::FloatGrid::Ptr grid = openvdb::FloatGrid::create(0.0f);
+    grid->setTransform(transform);
+    grid->setName("density");
+    grid->setGridClass(openvdb::GRID_FOG_VOLUME);
+    openvdb::FloatTree& tree = grid->tree();
+    for (FloatLeaf* leaf : results) {
+        if (!leaf) continue;
+        if (cancelled) delete leaf;
+        else tree.addLeaf(leaf);
+    }
+    if (interrupter) interrupter->end();
+    if (cancelled) throw CancelledError("interrupted during rasterize density");
+    return grid;
+}
+
+} // namespace nonbloppy
