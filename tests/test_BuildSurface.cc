@@ -1,0 +1,87 @@
+// SPDX-License-Identifier: Apache-2.0
+#include "TestUtil.h"
+
+#include <nonbloppy/BuildSurface.h>
+#include <nonbloppy/MeasureMesh.h>
+#include <nonbloppy/ReadParticles.h>
+
+#include <gtest/gtest.h>
+#include <tbb/global_control.h>
+
+using namespace nonbloppy;
+using nonbloppy_test::dataPath;
+using nonbloppy_test::latticeParticles;
+
+TEST(BuildSurface, NormalsPointOutOfABallOfParticles)
+{
+    const auto ball = latticeParticles(0.1, 1.1, [](const openvdb::Vec3d& x) { return x.length() < 1.0; }, 0.1);
+    const SurfaceResult result = buildSurface(ball);
+    const SurfaceMesh& mesh = result.mesh;
+    ASSERT_EQ(mesh.normals.size(), mesh.points.size());
+    ASSERT_GT(mesh.points.size(), 1000u);
+    for (size_t i = 0; i < mesh.points.size(); ++i) {
+        EXPECT_NEAR(mesh.normals[i].length(), 1.0f, 1e-5f);
+        ASSERT_GT(mesh.normals[i].dot(mesh.points[i]), 0.0f) << "vertex " << i;
+    }
+    const MeshMeasures measures = measureMesh(mesh);
+    EXPECT_TRUE(measures.closed);
+    EXPECT_TRUE(measures.manifold);
+    EXPECT_GT(measures.volume, 0.0);
+}
+
+TEST(BuildSurface, CallerArraysModelTheParticleListConcept)
+{
+    // A caller's own packed double array, viewed without copying.
+    const std::vector<double> xyz{0.0, 0.0, 0.0};
+    SurfaceParameters params;
+    params.effectiveRadius = 1.0;
+    params.threshold = 1.0;
+    params.voxelSize = 0.05;
+    params.blend = 0.5;
+    params.iterations = 1;
+    const SurfaceResult result = buildSurface(PositionArrayView<double>(xyz.data(), 1), params);
+    EXPECT_EQ(result.particleCount, 1u);
+    EXPECT_FALSE(result.parameters.spacingGiven);
+    EXPECT_EQ(result.parameters.spacing, 0.0);  // not needed: every length was given
+    for (const openvdb::Vec3s& p : result.mesh.points) {
+        ASSERT_NEAR(p.length(), 0.5 * 0.5, 0.05 / 4 * 0.5 + 1e-6);
+    }
+    // The grid carries the parameters.
+    EXPECT_EQ(result.density->metaValue<double>("effective_radius"), 1.0);
+    EXPECT_EQ(result.density->metaValue<int32_t>("iterations"), 1);
+    EXPECT_EQ(result.density->metaValue<int64_t>("particle_count"), 1);
+}
+
+TEST(BuildSurface, DamBreakFrameIsClosedManifoldAndOutward)
+{
+    const ParticleSet particles = readParticles(dataPath("dam_break_frame_23_24389_particles.vtk"));
+    ASSERT_EQ(particles.size(), 24389u);
+    const SurfaceResult result = buildSurface(particles);
+    EXPECT_NEAR(result.parameters.spacing, 0.05, 0.005);  // SPlisHSPlasH radius 0.025
+    const MeshMeasures measures = measureMesh(result.mesh);
+    EXPECT_GT(measures.polygons, 10000u);
+    EXPECT_TRUE(measures.closed);
+    EXPECT_TRUE(measures.manifold);
+    EXPECT_EQ(measures.unusedVertices, 0u);
+    EXPECT_GT(measures.volume, 0.0);
+}
+
+TEST(BuildSurface, IdenticalWithOneAndTwoThreads)
+{
+    const ParticleSet particles = readParticles(dataPath("double_dam_break_frame_26_4732_particles.vtk"));
+    SurfaceResult serial, parallel;
+    {
+        tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 1);
+        serial = buildSurface(particles);
+    }
+    {
+        tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 2);
+        parallel = buildSurface(particles);
+    }
+    ASSERT_GT(serial.mesh.points.size(), 0u);
+    EXPECT_EQ(serial.mesh.points, parallel.mesh.points);
+    EXPECT_EQ(serial.mesh.normals, parallel.mesh.normals);
+    EXPECT_EQ(serial.mesh.quads, parallel.mesh.quads);
+    EXPECT_EQ(serial.mesh.triangles, parallel.mesh.triangles);
+    EXPECT_EQ(serial.density->activeVoxelCount(), parallel.density->activeVoxelCount());
+}

@@ -1,0 +1,118 @@
+// SPDX-License-Identifier: Apache-2.0
+#include "TestUtil.h"
+
+#include <nonbloppy/BuildSurface.h>
+#include <nonbloppy/Error.h>
+#include <nonbloppy/EstimateParameters.h>
+
+#include <gtest/gtest.h>
+
+using namespace nonbloppy;
+using nonbloppy_test::latticeParticles;
+
+TEST(EstimateParameters, SpacingOfALatticeIsItsStep)
+{
+    const auto ball = latticeParticles(0.05, 0.6, [](const openvdb::Vec3d& x) { return x.length() < 0.5; });
+    EXPECT_NEAR(estimateSpacing(ball), 0.05, 1e-6);
+    // Median over a sample, so a few far-away strays do not matter.
+    auto withStrays = ball;
+    for (int i = 0; i < 20; ++i) withStrays.emplace_back(10.0f + float(i), 0.0f, 0.0f);
+    EXPECT_NEAR(estimateSpacing(withStrays), 0.05, 1e-6);
+}
+
+TEST(EstimateParameters, SpacingOfAJitteredLatticeIsCloseToItsStep)
+{
+    const auto box = latticeParticles(0.1, 1.0, [](const openvdb::Vec3d&) { return true; }, 0.1);
+    const double spacing = estimateSpacing(box);
+    EXPECT_GT(spacing, 0.08);
+    EXPECT_LT(spacing, 0.1);  // jitter only brings nearest neighbours closer
+}
+
+TEST(EstimateParameters, SpacingNeedsTwoDistinctParticles)
+{
+    try {
+        estimateSpacing({openvdb::Vec3f(1.0f)});
+        FAIL() << "one particle accepted";
+    } catch (const ParameterError& e) {
+        EXPECT_STREQ(e.what(), "cannot estimate the particle spacing from 1 particle(s); give --spacing or "
+                               "--radius, --threshold and --voxel-size");
+    }
+    EXPECT_THROW(estimateSpacing(std::vector<openvdb::Vec3f>(5, openvdb::Vec3f(1.0f))), ParameterError);
+}
+
+TEST(EstimateParameters, CalibratedThresholdPutsAFlatSurfaceHalfASpacingOutside)
+{
+    // A slab 8 layers thick, wide enough that its middle is flat; top layer at z = 0.
+    const double spacing = 0.1;
+    auto slab = latticeParticles(spacing, 1.6, [](const openvdb::Vec3d& x) {
+        return std::abs(x[0]) <= 1.5 && std::abs(x[1]) <= 1.5 && x[2] <= 1e-9 && x[2] >= -0.75;
+    });
+    SurfaceParameters params;
+    params.iterations = 0;
+    const SurfaceResult result = buildSurface(slab, params);
+    EXPECT_NEAR(result.parameters.spacing, spacing, 1e-6);
+    EXPECT_DOUBLE_EQ(result.parameters.effectiveRadius, 2 * result.parameters.spacing);
+    EXPECT_DOUBLE_EQ(result.parameters.voxelSize, result.parameters.spacing / 2);
+    EXPECT_DOUBLE_EQ(result.parameters.threshold, calibrateThreshold(2.0));
+    double heightSum = 0.0;
+    int count = 0;
+    for (const openvdb::Vec3s& p : result.mesh.points) {
+        if (std::abs(p[0]) < 0.5 && std::abs(p[1]) < 0.5 && p[2] > 0.0f) {
+            heightSum += p[2];
+            ++count;
+        }
+    }
+    ASSERT_GT(count, 50);
+    EXPECT_NEAR(heightSum / count, spacing / 2, 0.1 * spacing);
+}
+
+TEST(EstimateParameters, ThresholdGrowsWithTheRadius)
+{
+    EXPECT_GT(calibrateThreshold(3.0), calibrateThreshold(2.0));
+    EXPECT_GT(calibrateThreshold(2.0), 0.0);
+    EXPECT_THROW(calibrateThreshold(0.5), ParameterError);
+}
+
+TEST(EstimateParameters, ResolveReportsWhatWasGivenAndChecksRanges)
+{
+    const auto ball = latticeParticles(0.05, 0.3, [](const openvdb::Vec3d& x) { return x.length() < 0.25; });
+    SurfaceParameters params;
+    params.effectiveRadius = 0.2;
+    const ResolvedParameters resolved = resolveParameters(params, ball);
+    EXPECT_TRUE(resolved.effectiveRadiusGiven);
+    EXPECT_FALSE(resolved.spacingGiven);
+    EXPECT_FALSE(resolved.thresholdGiven);
+    EXPECT_DOUBLE_EQ(resolved.effectiveRadius, 0.2);
+    EXPECT_NEAR(resolved.voxelSize, 0.025, 1e-7);
+    EXPECT_DOUBLE_EQ(resolved.threshold, calibrateThreshold(0.2 / resolved.spacing));
+
+    const auto expectMessage = [&](SurfaceParameters bad, const char* message) {
+        try {
+            resolveParameters(bad, ball);
+            ADD_FAILURE() << "accepted: " << message;
+        } catch (const ParameterError& e) {
+            EXPECT_STREQ(e.what(), message);
+        }
+    };
+    SurfaceParameters bad;
+    bad.effectiveRadius = 0.0;
+    expectMessage(bad, "--radius must be > 0, got 0");
+    bad = SurfaceParameters();
+    bad.voxelSize = -1.0;
+    expectMessage(bad, "--voxel-size must be > 0, got -1");
+    bad = SurfaceParameters();
+    bad.blend = 1.5;
+    expectMessage(bad, "--blend must lie in [0,1], got 1.5");
+    bad = SurfaceParameters();
+    bad.iterations = -1;
+    expectMessage(bad, "--iterations must be >= 0, got -1");
+    bad = SurfaceParameters();
+    bad.voxelSize = 0.0001;
+    expectMessage(bad, "--voxel-size 0.0001 is too small for --radius 0.1: at most 32 voxels per radius");
+    try {
+        resolveParameters(SurfaceParameters(), {});
+        ADD_FAILURE() << "no particles accepted";
+    } catch (const ParameterError& e) {
+        EXPECT_STREQ(e.what(), "no particles to mesh");
+    }
+}

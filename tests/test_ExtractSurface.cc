@@ -1,0 +1,72 @@
+// SPDX-License-Identifier: Apache-2.0
+#include <nonbloppy/Error.h>
+#include <nonbloppy/ExtractSurface.h>
+#include <nonbloppy/ParticleIndex.h>
+#include <nonbloppy/RasterizeDensity.h>
+
+#include <gtest/gtest.h>
+
+using namespace nonbloppy;
+
+namespace {
+
+const openvdb::Vec3f kCentre(0.31f, -0.17f, 0.05f);
+
+SurfaceMesh singleParticleSurface(double radius, double threshold, double voxelSize)
+{
+    const ParticleIndex index = ParticleIndex::build({kCentre}, radius / 2);
+    DensitySettings settings;
+    settings.effectiveRadius = radius;
+    settings.voxelSize = voxelSize;
+    return extractSurface(*rasterizeDensity(index, settings), threshold);
+}
+
+} // namespace
+
+TEST(ExtractSurface, OneParticleGivesASphereOfRadiusReOverOnePlusR0)
+{
+    for (const double threshold : {0.5, 1.0, 3.0}) {
+        const double radius = 1.0, voxelSize = 0.04;
+        const SurfaceMesh mesh = singleParticleSurface(radius, threshold, voxelSize);
+        ASSERT_GT(mesh.points.size(), 100u);
+        const double expected = radius / (1.0 + threshold);
+        for (const openvdb::Vec3s& p : mesh.points) {
+            ASSERT_NEAR((p - kCentre).length(), expected, voxelSize / 4) << "r_0 = " << threshold;
+        }
+    }
+}
+
+TEST(ExtractSurface, PolygonsFaceOutOfTheFluid)
+{
+    const SurfaceMesh mesh = singleParticleSurface(1.0, 1.0, 0.05);
+    ASSERT_FALSE(mesh.quads.empty());
+    // Right-hand-rule normal of every polygon points away from the particle.
+    for (const openvdb::Vec4I& q : mesh.quads) {
+        const openvdb::Vec3d a(mesh.points[q[0]]), b(mesh.points[q[1]]), c(mesh.points[q[2]]), d(mesh.points[q[3]]);
+        const openvdb::Vec3d normal = (c - a).cross(d - b);
+        const openvdb::Vec3d outward = (a + b + c + d) / 4.0 - openvdb::Vec3d(kCentre);
+        ASSERT_GT(normal.dot(outward), 0.0);
+    }
+    for (const openvdb::Vec3I& t : mesh.triangles) {
+        const openvdb::Vec3d a(mesh.points[t[0]]), b(mesh.points[t[1]]), c(mesh.points[t[2]]);
+        ASSERT_GT((b - a).cross(c - a).dot((a + b + c) / 3.0 - openvdb::Vec3d(kCentre)), 0.0);
+    }
+}
+
+TEST(ExtractSurface, AdaptivityMergesPolygonsAndIsChecked)
+{
+    const ParticleIndex index = ParticleIndex::build({kCentre}, 0.5);
+    DensitySettings settings;
+    settings.effectiveRadius = 1.0;
+    settings.voxelSize = 0.04;
+    const openvdb::FloatGrid::Ptr grid = rasterizeDensity(index, settings);
+    const SurfaceMesh full = extractSurface(*grid, 1.0, 0.0);
+    const SurfaceMesh adaptive = extractSurface(*grid, 1.0, 0.5);
+    EXPECT_LT(adaptive.polygonCount(), full.polygonCount());
+    try {
+        extractSurface(*grid, 1.0, 1.5);
+        FAIL() << "adaptivity 1.5 accepted";
+    } catch (const ParameterError& e) {
+        EXPECT_STREQ(e.what(), "--adaptivity must lie in [0,1], got 1.5");
+    }
+}

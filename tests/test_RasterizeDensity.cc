@@ -1,0 +1,152 @@
+// SPDX-License-Identifier: Apache-2.0
+#include "TestUtil.h"
+
+#include <nonbloppy/Error.h>
+#include <nonbloppy/Kernel.h>
+#include <nonbloppy/ParticleIndex.h>
+#include <nonbloppy/RasterizeDensity.h>
+
+#include <gtest/gtest.h>
+#include <tbb/global_control.h>
+
+#include <random>
+
+using namespace nonbloppy;
+
+namespace {
+
+std::vector<openvdb::Vec3f> randomParticles(size_t count, unsigned seed)
+{
+    std::mt19937 random(seed);
+    std::uniform_real_distribution<float> coordinate(-0.4f, 0.6f);
+    std::vector<openvdb::Vec3f> positions(count);
+    for (auto& p : positions) p = openvdb::Vec3f(coordinate(random), coordinate(random), coordinate(random));
+    return positions;
+}
+
+double bruteForceDensity(const std::vector<openvdb::Vec3f>& positions, const openvdb::Vec3d& x, double radius)
+{
+    double sum = 0.0;
+    for (const auto& p : positions) sum += mpsWeight(float((openvdb::Vec3d(p) - x).length()), float(radius));
+    return sum;
+}
+
+openvdb::FloatGrid::Ptr rasterize(const std::vector<openvdb::Vec3f>& positions, double radius, double voxelSize)
+{
+    const ParticleIndex index = ParticleIndex::build(positions, radius / 2);
+    DensitySettings settings;
+    settings.effectiveRadius = radius;
+    settings.voxelSize = voxelSize;
+    return rasterizeDensity(index, settings);
+}
+
+} // namespace
+
+TEST(RasterizeDensity, MatchesBruteForceSumAndActivatesExactlyTheSupport)
+{
+    const double radius = 0.15, voxelSize = 0.04;
+    const std::vector<openvdb::Vec3f> positions = randomParticles(300, 1);
+    const openvdb::FloatGrid::Ptr grid = rasterize(positions, radius, voxelSize);
+    EXPECT_EQ(grid->getName(), "density");
+    EXPECT_EQ(grid->getGridClass(), openvdb::GRID_FOG_VOLUME);
+    EXPECT_EQ(grid->background(), 0.0f);
+
+    // Every voxel of a box around the particles: active exactly where some particle is
+    // closer than r_e, with the brute-force value.
+    auto accessor = grid->getConstAccessor();
+    size_t activeSeen = 0;
+    const openvdb::CoordBBox box(openvdb::Coord(-15), openvdb::Coord(20));
+    for (auto ijk = box.begin(); ijk; ++ijk) {
+        const openvdb::Vec3d x = grid->indexToWorld(*ijk);
+        const double expected = bruteForceDensity(positions, x, radius);
+        float value = 0.0f;
+        const bool active = accessor.probeValue(*ijk, value);
+        ASSERT_EQ(active, expected > 0.0) << *ijk;
+        if (active) {
+            ++activeSeen;
+            ASSERT_NEAR(value, expected, 1e-4 * (1.0 + expected)) << *ijk;
+        }
+    }
+    EXPECT_EQ(activeSeen, grid->activeVoxelCount());  // nothing active outside the box
+}
+
+TEST(RasterizeDensity, VoxelOnTopOfAParticleStaysFinite)
+{
+    const std::vector<openvdb::Vec3f> one{openvdb::Vec3f(0.2f, 0.0f, -0.4f)};
+    const openvdb::FloatGrid::Ptr grid = rasterize(one, 1.0, 0.1);
+    const float value = grid->tree().getValue(openvdb::Coord(2, 0, -4));
+    EXPECT_TRUE(std::isfinite(value));
+    EXPECT_NEAR(value, 1.0 / kMinDistanceFraction - 1.0, 1e-2);
+}
+
+TEST(RasterizeDensity, BitIdenticalForOneAndTwoThreads)
+{
+    const std::vector<openvdb::Vec3f> positions = randomParticles(5000, 2);
+    openvdb::FloatGrid::Ptr serial, parallel;
+    {
+        tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 1);
+        serial = rasterize(positions, 0.08, 0.02);
+    }
+    {
+        tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 2);
+        parallel = rasterize(positions, 0.08, 0.02);
+    }
+    ASSERT_EQ(serial->activeVoxelCount(), parallel->activeVoxelCount());
+    auto accessor = parallel->getConstAccessor();
+    for (auto it = serial->cbeginValueOn(); it; ++it) {
+        float other = 0.0f;
+        ASSERT_TRUE(accessor.probeValue(it.getCoord(), other));
+        ASSERT_EQ(*it, other) << it.getCoord();  // bitwise, not approximately
+    }
+}
+
+TEST(RasterizeDensity, RejectsBadSettings)
+{
+    const ParticleIndex index = ParticleIndex::build({openvdb::Vec3f(0.0f)}, 0.5);
+    DensitySettings settings;
+    settings.effectiveRadius = 0.0;
+    settings.voxelSize = 0.1;
+    try {
+        rasterizeDensity(index, settings);
+        FAIL() << "r_e = 0 accepted";
+    } catch (const ParameterError& e) {
+        EXPECT_STREQ(e.what(), "--radius must be > 0, got 0");
+    }
+    settings.effectiveRadius = 1.0;
+    settings.voxelSize = -0.5;
+    try {
+        rasterizeDensity(index, settings);
+        FAIL() << "h < 0 accepted";
+    } catch (const ParameterError& e) {
+        EXPECT_STREQ(e.what(), "--voxel-size must be > 0, got -0.5");
+    }
+}
+
+TEST(ParticleIndex, KeepsEveryParticleOnceAndMapsBackToTheOriginal)
+{
+    const std::vector<openvdb::Vec3f> positions = randomParticles(2000, 3);
+    const ParticleIndex index = ParticleIndex::build(positions, 0.05);
+    ASSERT_EQ(index.size(), positions.size());
+    std::vector<bool> seen(positions.size(), false);
+    for (size_t k = 0; k < index.size(); ++k) {
+        const uint32_t original = index.originalIndex()[k];
+        ASSERT_LT(original, positions.size());
+        EXPECT_FALSE(seen[original]);
+        seen[original] = true;
+        EXPECT_EQ(index.sortedPositions()[k], positions[original]);
+    }
+    EXPECT_EQ(index.cellSize(), 0.05);
+    EXPECT_TRUE(index.indexGrid());
+}
+
+TEST(ParticleIndex, RejectsNonFinitePositions)
+{
+    std::vector<openvdb::Vec3f> positions(10, openvdb::Vec3f(0.0f));
+    positions[7][1] = std::nanf("");
+    try {
+        ParticleIndex::build(positions, 0.1);
+        FAIL() << "NaN accepted";
+    } catch (const ParameterError& e) {
+        EXPECT_STREQ(e.what(), "non-finite position of particle 7");
+    }
+}

@@ -1,0 +1,110 @@
+// SPDX-License-Identifier: Apache-2.0
+#include "TestUtil.h"
+
+#include <nonbloppy/Error.h>
+#include <nonbloppy/ExtractSurface.h>
+#include <nonbloppy/ParticleIndex.h>
+#include <nonbloppy/RasterizeDensity.h>
+#include <nonbloppy/RelaxVertices.h>
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+using namespace nonbloppy;
+
+namespace {
+
+const openvdb::Vec3f kCentre(12.31f, -4.17f, 0.05f);  // away from the origin on purpose
+
+struct OneParticle
+{
+    ParticleIndex index = ParticleIndex::build({kCentre}, 0.5);
+    SurfaceMesh mesh;
+    OneParticle()
+    {
+        DensitySettings settings;
+        settings.effectiveRadius = 1.0;
+        settings.voxelSize = 0.05;
+        mesh = extractSurface(*rasterizeDensity(index, settings), 1.0);
+    }
+};
+
+RelaxSettings relaxSettings(double blend, int iterations)
+{
+    RelaxSettings settings;
+    settings.effectiveRadius = 1.0;
+    settings.blend = blend;
+    settings.iterations = iterations;
+    return settings;
+}
+
+} // namespace
+
+TEST(RelaxVertices, OneParticleShrinksEveryVertexByOneMinusCToTheT)
+{
+    for (const double blend : {0.3, 0.5, 1.0}) {
+        for (const int iterations : {1, 2, 4}) {
+            OneParticle one;
+            const std::vector<openvdb::Vec3s> before = one.mesh.points;
+            relaxVertices(one.mesh, one.index, relaxSettings(blend, iterations));
+            const double factor = std::pow(1.0 - blend, iterations);
+            for (size_t i = 0; i < before.size(); ++i) {
+                const double d0 = (before[i] - kCentre).length();
+                const double d = (one.mesh.points[i] - kCentre).length();
+                ASSERT_NEAR(d, factor * d0, 1e-4 * d0 + (factor == 0.0 ? 1e-6 : 0.0))
+                    << "c = " << blend << ", t = " << iterations << ", vertex " << i;
+            }
+        }
+    }
+}
+
+TEST(RelaxVertices, ZeroBlendOrZeroIterationsLeaveVerticesUnchanged)
+{
+    OneParticle one;
+    const std::vector<openvdb::Vec3s> before = one.mesh.points;
+    relaxVertices(one.mesh, one.index, relaxSettings(0.0, 5));
+    EXPECT_EQ(one.mesh.points, before);
+    relaxVertices(one.mesh, one.index, relaxSettings(0.7, 0));
+    EXPECT_EQ(one.mesh.points, before);
+}
+
+TEST(RelaxVertices, VertexWithNoParticleInReachStaysPut)
+{
+    OneParticle one;
+    one.mesh.points.push_back(kCentre + openvdb::Vec3s(3.0f, 0.0f, 0.0f));
+    relaxVertices(one.mesh, one.index, relaxSettings(0.5, 3));
+    EXPECT_EQ(one.mesh.points.back(), kCentre + openvdb::Vec3s(3.0f, 0.0f, 0.0f));
+}
+
+TEST(RelaxVertices, MovesTowardsTheWeightedMeanOfTwoParticles)
+{
+    // Vertex at the origin, particles at distances 0.25 (w = 3) and 0.5 (w = 1) on the x axis:
+    // mean = (3·0.25 + 1·(−0.5)) / 4 = 0.0625; with c = 0.5 the vertex lands at 0.03125.
+    const ParticleIndex index = ParticleIndex::build({openvdb::Vec3f(0.25f, 0, 0), openvdb::Vec3f(-0.5f, 0, 0)}, 0.5);
+    SurfaceMesh mesh;
+    mesh.points.push_back(openvdb::Vec3s(0.0f));
+    relaxVertices(mesh, index, relaxSettings(0.5, 1));
+    EXPECT_NEAR(mesh.points[0][0], 0.03125f, 1e-6f);
+    EXPECT_EQ(mesh.points[0][1], 0.0f);
+    EXPECT_EQ(mesh.points[0][2], 0.0f);
+}
+
+TEST(RelaxVertices, RejectsBadSettings)
+{
+    OneParticle one;
+    const auto expectMessage = [&](const RelaxSettings& settings, const char* message) {
+        try {
+            relaxVertices(one.mesh, one.index, settings);
+            ADD_FAILURE() << "accepted: " << message;
+        } catch (const ParameterError& e) {
+            EXPECT_STREQ(e.what(), message);
+        }
+    };
+    expectMessage(relaxSettings(1.5, 2), "--blend must lie in [0,1], got 1.5");
+    expectMessage(relaxSettings(-0.1, 2), "--blend must lie in [0,1], got -0.1");
+    expectMessage(relaxSettings(0.3, -1), "--iterations must be >= 0, got -1");
+    RelaxSettings noRadius = relaxSettings(0.3, 2);
+    noRadius.effectiveRadius = 0.0;
+    expectMessage(noRadius, "--radius must be > 0, got 0");
+}
