@@ -1,0 +1,79 @@
+// SPDX-License-Identifier: Apache-2.0
+/// @file Commands.h
+/// @brief The subcommands of the `nonbloppy` tool (in the manner of pbrt's imgtool: one
+///        set-up function that declares a command's options, one function that runs it).
+///
+/// Every run function returns the process exit code and reports failures by throwing:
+/// main() prints what() as the single line "nonbloppy: <message>" and exits with 1.
+
+#ifndef NONBLOPPY_TOOL_COMMANDS_H
+#define NONBLOPPY_TOOL_COMMANDS_H
+
+#include <CLI/CLI.hpp>
+
+#include <cstdint>
+#include <cstdio>
+#include <functional>
+#include <sstream>
+#include <string>
+
+namespace nonbloppy_tool {
+
+/// Help headings, shared by every command, in the order splashsurf uses.
+constexpr const char* kGroupInputOutput = "Input/output";
+constexpr const char* kGroupNumerical = "Numerical parameters";
+constexpr const char* kGroupAdvanced = "Advanced";
+constexpr const char* kGroupDebug = "Debug";
+
+/// Exit status after SIGINT/SIGTERM (128 + SIGINT, as shells report it).
+constexpr int kExitInterrupted = 130;
+
+/// One subcommand: its CLI11 sub-app (options, help) and what runs it after parsing.
+struct Command
+{
+    CLI::App* app = nullptr;
+    std::function<int()> run;
+};
+
+/// Declare `nonbloppy mesh` on @a parent.
+Command setupMeshCommand(CLI::App& parent);
+/// Declare `nonbloppy inspect` on @a parent.
+Command setupInspectCommand(CLI::App& parent);
+
+/// "nonbloppy 0.1.0 (OpenVDB 10.0.1)".
+std::string versionLine();
+
+/// A number as a person reads it: shortest of %g with 6 significant digits ("0.05", "1.5").
+/// This is also how the library spells numbers in its parameter errors.
+inline std::string formatNumber(double value)
+{
+    std::ostringstream out;
+    out << value;
+    return out.str();
+}
+
+/// A count with a K/M/G suffix, as vdb_print prints voxel counts ("24.4K", "1.21M").
+inline std::string formatCount(uint64_t n)
+{
+    char buffer[32];
+    if (n < 1000) std::snprintf(buffer, sizeof(buffer), "%llu", static_cast<unsigned long long>(n));
+    else if (n < 1000000) std::snprintf(buffer, sizeof(buffer), "%.3gK", double(n) / 1e3);
+    else if (n < 1000000000) std::snprintf(buffer, sizeof(buffer), "%.3gM", double(n) / 1e6);
+    else std::snprintf(buffer, sizeof(buffer), "%.3gG", double(n) / 1e9);
+    return buffer;
+}
+
+/// A byte count in KB/MB/GB (powers of 1024, as vdb_print).
+inline std::string formatBytes(uint64_t n)
+{
+    char buffer[32];
+    if (n < 1024) std::snprintf(buffer, sizeof(buffer), "%llu B", static_cast<unsigned long long>(n));
+    else if (n < (1u << 20)) std::snprintf(buffer, sizeof(buffer), "%.3g KB", double(n) / 1024.0);
+    else if (n < (1u << 30)) std::snprintf(buffer, sizeof(buffer), "%.3g MB", double(n) / 1048576.0);
+    else std::snprintf(buffer, sizeof(buffer), "%.3g GB", double(n) / 1073741824.0);
+    return buffer;
+}
+
+} // namespace nonbloppy_tool
+
+#endif // NONBLOPPY_TOOL_COMMANDS_H

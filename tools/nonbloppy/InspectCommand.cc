@@ -1,0 +1,532 @@
+// SPDX-License-Identifier: Apache-2.0
+/// @file InspectCommand.cc
+/// @brief `nonbloppy inspect FILE [--json]`: what a .vdb, mesh or particle file holds, in the
+///        manner of vdb_print (one line per grid) and pbrt's `plytool info`.
+
+#include "Commands.h"
+
+#include <nonbloppy/Error.h>
+#include <nonbloppy/EstimateParameters.h>
+#include <nonbloppy/MeasureMesh.h>
+#include <nonbloppy/Mesh.h>
+#include <nonbloppy/Particles.h>
+#include <nonbloppy/ReadMesh.h>
+#include <nonbloppy/ReadParticles.h>
+
+#include <openvdb/Exceptions.h>
+#include <openvdb/io/File.h>
+#include <openvdb/openvdb.h>
+#include <openvdb/tools/Count.h>
+
+#include <algorithm>
+#include <cctype>
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <iostream>
+#include <limits>
+#include <memory>
+#include <optional>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <sys/stat.h>
+
+namespace nonbloppy_tool {
+
+namespace {
+
+// ---------------------------------------------------------------------------------------
+// A small JSON writer: objects and arrays, indented two spaces, strings escaped.
+
+/// A double in the fewest digits that read back to the same value; null when not finite
+/// (JSON has no NaN or infinity).
+std::string jsonNumber(double value)
+{
+    if (!std::isfinite(value)) return "null";
+    char buffer[40];
+    for (int precision = 6; precision <= 17; ++precision) {
+        std::snprintf(buffer, sizeof(buffer), "%.*g", precision, value);
+        if (std::strtod(buffer, nullptr) == value) break;
+    }
+    return buffer;
+}
+
+std::string jsonString(const std::string& text)
+{
+    std::string out = "\"";
+    for (const char ch : text) {
+        const unsigned char c = static_cast<unsigned char>(ch);
+        switch (c) {
+        case '"': out += "\\\""; break;
+        case '\\': out += "\\\\"; break;
+        case '\n': out += "\\n"; break;
+        case '\r': out += "\\r"; break;
+        case '\t': out += "\\t"; break;
+        case '\b': out += "\\b"; break;
+        case '\f': out += "\\f"; break;
+        default:
+            if (c < 0x20 || c == 0x7f) {
+                char buffer[8];
+                std::snprintf(buffer, sizeof(buffer), "\\u%04x", c);
+                out += buffer;
+            } else {
+                out += ch; // UTF-8 bytes pass through unchanged
+            }
+        }
+    }
+    return out + "\"";
+}
+
+class JsonWriter
+{
+public:
+    void beginObject(const char* key = nullptr) { open(key, '{'); }
+    void endObject() { close('}'); }
+    void beginArray(const char* key = nullptr) { open(key, '['); }
+    void endArray() { close(']'); }
+
+    /// A value already in JSON syntax.
+    void raw(const char* key, const std::string& json)
+    {
+        item(key);
+        mOut << json;
+    }
+    void string(const char* key, const std::string& value) { raw(key, jsonString(value)); }
+    void number(const char* key, double value) { raw(key, jsonNumber(value)); }
+    void integer(const char* key, long long value) { raw(key, std::to_string(value)); }
+    void boolean(const char* key, bool value) { raw(key, value ? "true" : "false"); }
+    void vec3(const char* key, double x, double y, double z)
+    {
+        raw(key, "[" + jsonNumber(x) + ", " + jsonNumber(y) + ", " + jsonNumber(z) + "]");
+    }
+
+    std::string str() const { return mOut.str() + "\n"; }
+
+private:
+    void item(const char* key)
+    {
+        if (!mFirst.empty()) {
+            if (!mFirst.back()) mOut << ",";
+            mFirst.back() = false;
+            mOut << "\n" << std::string(2 * mFirst.size(), ' ');
+        }
+        if (key) mOut << jsonString(key) << ": ";
+    }
+    void open(const char* key, char bracket)
+    {
+        item(key);
+        mOut << bracket;
+        mFirst.push_back(true);
+    }
+    void close(char bracket)
+    {
+        const bool empty = mFirst.back();
+        mFirst.pop_back();
+        if (!empty) mOut << "\n" << std::string(2 * mFirst.size(), ' ');
+        mOut << bracket;
+    }
+
+    std::ostringstream mOut;
+    std::vector<bool> mFirst; ///< per open container: no item written yet
+};
+
+// ---------------------------------------------------------------------------------------
+// Helpers
+
+std::string lowerExtension(const std::string& path)
+{
+    std::string ext = std::filesystem::path(path).extension().string();
+    for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    return ext;
+}
+
+std::string formatVec3(double x, double y, double z)
+{
+    return "(" + formatNumber(x) + ", " + formatNumber(y) + ", " + formatNumber(z) + ")";
+}
+
+std::string formatCoord(const openvdb::Coord& c)
+{
+    return "(" + std::to_string(c.x()) + "," + std::to_string(c.y()) + "," + std::to_string(c.z())
+           + ")";
+}
+
+/// Bounding box of @a points (min, max); nullopt for none.
+template<typename Vec3T>
+std::optional<std::pair<openvdb::Vec3d, openvdb::Vec3d>> boundingBox(const std::vector<Vec3T>& points)
+{
+    if (points.empty()) return std::nullopt;
+    openvdb::Vec3d lo(std::numeric_limits<double>::infinity()), hi(-lo);
+    for (const Vec3T& p : points) {
+        for (int a = 0; a < 3; ++a) {
+            lo[a] = std::min(lo[a], double(p[a]));
+            hi[a] = std::max(hi[a], double(p[a]));
+        }
+    }
+    return std::make_pair(lo, hi);
+}
+
+void printRow(const std::string& label, const std::string& value)
+{
+    char line[64];
+    std::snprintf(line, sizeof(line), "  %-16s ", label.c_str());
+    std::cout << line << value << "\n";
+}
+
+// ---------------------------------------------------------------------------------------
+// Particle files
+
+int inspectParticles(const std::string& path, const nonbloppy::ParticleSet& particles, bool json)
+{
+    const auto bbox = boundingBox(particles.positions);
+    std::optional<double> spacing;
+    std::string spacingNote;
+    if (particles.size() < 2) {
+        spacingNote = "needs two particles";
+    } else {
+        try {
+            spacing = nonbloppy::estimateSpacing(particles.positions);
+        } catch (const nonbloppy::Error& e) {
+            spacingNote = e.what();
+        }
+    }
+
+    if (json) {
+        JsonWriter w;
+        w.beginObject();
+        w.string("file", path);
+        w.string("type", "particles");
+        w.integer("particles", static_cast<long long>(particles.size()));
+        if (bbox) {
+            w.beginObject("bbox");
+            w.vec3("min", bbox->first.x(), bbox->first.y(), bbox->first.z());
+            w.vec3("max", bbox->second.x(), bbox->second.y(), bbox->second.z());
+            w.endObject();
+        } else {
+            w.raw("bbox", "null");
+        }
+        if (spacing) w.number("spacing", *spacing);
+        else w.raw("spacing", "null");
+        w.beginArray("attributes");
+        for (const nonbloppy::ParticleAttribute& a : particles.attributes) {
+            w.beginObject();
+            w.string("name", a.name);
+            w.string("type", nonbloppy::scalarTypeName(a.type));
+            w.integer("components", a.components);
+            w.endObject();
+        }
+        w.endArray();
+        w.endObject();
+        std::cout << w.str();
+        return 0;
+    }
+
+    std::cout << path << ": particle file\n";
+    printRow("particles", std::to_string(particles.size()));
+    if (bbox) {
+        printRow("bounding box", formatVec3(bbox->first.x(), bbox->first.y(), bbox->first.z())
+                                     + " -> "
+                                     + formatVec3(bbox->second.x(), bbox->second.y(), bbox->second.z()));
+    }
+    printRow("spacing", spacing ? formatNumber(*spacing) + " (median nearest-neighbour distance)"
+                                : "- (" + spacingNote + ")");
+    if (particles.attributes.empty()) {
+        printRow("attributes", "none");
+    } else {
+        bool first = true;
+        for (const nonbloppy::ParticleAttribute& a : particles.attributes) {
+            std::string text = a.name + "  " + nonbloppy::scalarTypeName(a.type);
+            if (a.components != 1) text += " x" + std::to_string(a.components);
+            printRow(first ? "attributes" : "", text);
+            first = false;
+        }
+    }
+    std::cout.flush();
+    return 0;
+}
+
+// ---------------------------------------------------------------------------------------
+// Meshes
+
+int inspectMesh(const std::string& path, const nonbloppy::SurfaceMesh& mesh, bool json)
+{
+    const nonbloppy::MeshMeasures m = nonbloppy::measureMesh(mesh);
+    const auto bbox = boundingBox(mesh.points);
+
+    if (json) {
+        JsonWriter w;
+        w.beginObject();
+        w.string("file", path);
+        w.string("type", "mesh");
+        w.integer("vertices", static_cast<long long>(m.vertices));
+        w.integer("faces", static_cast<long long>(m.polygons));
+        w.integer("triangles", static_cast<long long>(mesh.triangles.size()));
+        w.integer("quads", static_cast<long long>(mesh.quads.size()));
+        w.boolean("normals", !mesh.normals.empty());
+        w.boolean("closed", m.closed);
+        w.boolean("manifold", m.manifold);
+        w.integer("boundary_edges", static_cast<long long>(m.boundaryEdges));
+        w.integer("non_manifold_edges", static_cast<long long>(m.nonManifoldEdges));
+        w.integer("inconsistent_edges", static_cast<long long>(m.inconsistentEdges));
+        w.integer("unused_vertices", static_cast<long long>(m.unusedVertices));
+        w.number("area", m.area);
+        w.number("volume", m.volume);
+        if (bbox) {
+            w.beginObject("bbox");
+            w.vec3("min", bbox->first.x(), bbox->first.y(), bbox->first.z());
+            w.vec3("max", bbox->second.x(), bbox->second.y(), bbox->second.z());
+            w.endObject();
+        } else {
+            w.raw("bbox", "null");
+        }
+        w.endObject();
+        std::cout << w.str();
+        return 0;
+    }
+
+    std::cout << path << ": mesh\n";
+    printRow("vertices", std::to_string(m.vertices)
+                             + (mesh.normals.empty() ? "" : " (with normals)")
+                             + (m.unusedVertices ? ", " + std::to_string(m.unusedVertices) + " unused"
+                                                 : ""));
+    printRow("faces", std::to_string(m.polygons) + " (" + std::to_string(mesh.triangles.size())
+                          + " triangles, " + std::to_string(mesh.quads.size()) + " quads)");
+    printRow("closed", std::string(m.closed ? "yes" : "no") + " ("
+                           + std::to_string(m.boundaryEdges) + " boundary edges)");
+    printRow("manifold", std::string(m.manifold ? "yes" : "no") + " ("
+                             + std::to_string(m.nonManifoldEdges) + " non-manifold, "
+                             + std::to_string(m.inconsistentEdges)
+                             + " inconsistently oriented edges)");
+    printRow("area", formatNumber(m.area));
+    printRow("volume", formatNumber(m.volume) + (m.closed ? "" : " (not closed: not meaningful)"));
+    if (bbox) {
+        printRow("bounding box", formatVec3(bbox->first.x(), bbox->first.y(), bbox->first.z())
+                                     + " -> "
+                                     + formatVec3(bbox->second.x(), bbox->second.y(), bbox->second.z()));
+    }
+    std::cout.flush();
+    return 0;
+}
+
+// ---------------------------------------------------------------------------------------
+// .vdb files
+
+/// Min and max of the active values of scalar grids; nullopt for other value types and
+/// for grids without active values.
+std::optional<std::pair<double, double>> activeRange(const openvdb::GridBase& grid)
+{
+    if (grid.activeVoxelCount() == 0) return std::nullopt;
+    auto range = [](const auto& typed) {
+        const auto mm = openvdb::tools::minMax(typed.tree());
+        return std::make_pair(double(mm.min()), double(mm.max()));
+    };
+    if (const auto* g = dynamic_cast<const openvdb::FloatGrid*>(&grid)) return range(*g);
+    if (const auto* g = dynamic_cast<const openvdb::DoubleGrid*>(&grid)) return range(*g);
+    if (const auto* g = dynamic_cast<const openvdb::Int32Grid*>(&grid)) return range(*g);
+    if (const auto* g = dynamic_cast<const openvdb::Int64Grid*>(&grid)) return range(*g);
+    return std::nullopt;
+}
+
+/// A metadata value in JSON syntax: numbers, booleans and vectors as such, the rest as
+/// strings.
+std::string metadataJson(const openvdb::Metadata& meta)
+{
+    using namespace openvdb;
+    if (auto* m = dynamic_cast<const FloatMetadata*>(&meta)) return jsonNumber(m->value());
+    if (auto* m = dynamic_cast<const DoubleMetadata*>(&meta)) return jsonNumber(m->value());
+    if (auto* m = dynamic_cast<const Int32Metadata*>(&meta)) return std::to_string(m->value());
+    if (auto* m = dynamic_cast<const Int64Metadata*>(&meta)) return std::to_string(m->value());
+    if (auto* m = dynamic_cast<const BoolMetadata*>(&meta)) return m->value() ? "true" : "false";
+    auto vec = [](const auto& v) {
+        return "[" + jsonNumber(double(v[0])) + ", " + jsonNumber(double(v[1])) + ", "
+               + jsonNumber(double(v[2])) + "]";
+    };
+    if (auto* m = dynamic_cast<const Vec3IMetadata*>(&meta)) return vec(m->value());
+    if (auto* m = dynamic_cast<const Vec3SMetadata*>(&meta)) return vec(m->value());
+    if (auto* m = dynamic_cast<const Vec3DMetadata*>(&meta)) return vec(m->value());
+    if (auto* m = dynamic_cast<const StringMetadata*>(&meta)) return jsonString(m->value());
+    return jsonString(meta.str());
+}
+
+/// The text form: full precision for doubles (Metadata::str() keeps 6 digits).
+std::string metadataText(const openvdb::Metadata& meta)
+{
+    if (auto* m = dynamic_cast<const openvdb::DoubleMetadata*>(&meta)) return jsonNumber(m->value());
+    if (auto* m = dynamic_cast<const openvdb::FloatMetadata*>(&meta)) return jsonNumber(m->value());
+    return meta.str();
+}
+
+void writeMetadataJson(JsonWriter& w, const char* key, const openvdb::MetaMap& metadata)
+{
+    w.beginObject(key);
+    for (auto it = metadata.beginMeta(); it != metadata.endMeta(); ++it) {
+        if (it->second) w.raw(it->first.c_str(), metadataJson(*it->second));
+    }
+    w.endObject();
+}
+
+void printMetadata(const openvdb::MetaMap& metadata, const char* indent)
+{
+    for (auto it = metadata.beginMeta(); it != metadata.endMeta(); ++it) {
+        if (it->second) std::cout << indent << it->first << ": " << metadataText(*it->second) << "\n";
+    }
+}
+
+int inspectVdb(const std::string& path, bool json)
+{
+    openvdb::initialize();
+    openvdb::GridPtrVecPtr grids;
+    openvdb::MetaMap::Ptr fileMetadata;
+    std::string fileVersion;
+    try {
+        openvdb::io::File file(path);
+        file.open(/*delayLoad=*/false);
+        fileVersion = file.version();
+        fileMetadata = file.getMetadata();
+        // Names, classes and metadata first, then the trees (this is where a truncated
+        // file fails).
+        file.readAllGridMetadata();
+        grids = file.getGrids();
+        file.close();
+    } catch (const openvdb::Exception& e) {
+        throw nonbloppy::FileError("cannot read " + path + ": " + e.what());
+    } catch (const std::exception& e) {
+        throw nonbloppy::FileError("cannot read " + path + ": " + e.what());
+    }
+    if (!grids) grids = std::make_shared<openvdb::GridPtrVec>();
+    if (!fileMetadata) fileMetadata = std::make_shared<openvdb::MetaMap>();
+
+    if (json) {
+        JsonWriter w;
+        w.beginObject();
+        w.string("file", path);
+        w.string("type", "vdb");
+        w.string("format_version", fileVersion);
+        writeMetadataJson(w, "metadata", *fileMetadata);
+        w.beginArray("grids");
+        for (const openvdb::GridBase::Ptr& grid : *grids) {
+            if (!grid) continue;
+            w.beginObject();
+            w.string("name", grid->getName());
+            w.string("value_type", grid->valueType());
+            w.string("class", openvdb::GridBase::gridClassToString(grid->getGridClass()));
+            const openvdb::Vec3d voxel = grid->voxelSize();
+            w.vec3("voxel_size", voxel.x(), voxel.y(), voxel.z());
+            const openvdb::CoordBBox bbox = grid->evalActiveVoxelBoundingBox();
+            if (bbox.empty()) {
+                w.raw("index_bbox", "null");
+            } else {
+                w.beginObject("index_bbox");
+                w.vec3("min", bbox.min().x(), bbox.min().y(), bbox.min().z());
+                w.vec3("max", bbox.max().x(), bbox.max().y(), bbox.max().z());
+                w.endObject();
+            }
+            w.integer("active_voxels", static_cast<long long>(grid->activeVoxelCount()));
+            w.integer("leaf_nodes", static_cast<long long>(grid->baseTree().leafCount()));
+            w.integer("memory_bytes", static_cast<long long>(grid->memUsage()));
+            if (const auto range = activeRange(*grid)) {
+                w.number("min", range->first);
+                w.number("max", range->second);
+            } else {
+                w.raw("min", "null");
+                w.raw("max", "null");
+            }
+            writeMetadataJson(w, "metadata", *grid);
+            w.endObject();
+        }
+        w.endArray();
+        w.endObject();
+        std::cout << w.str();
+        return 0;
+    }
+
+    std::cout << path << ": OpenVDB file version " << fileVersion << ", " << grids->size()
+              << (grids->size() == 1 ? " grid" : " grids") << "\n";
+    printMetadata(*fileMetadata, "  ");
+    for (const openvdb::GridBase::Ptr& grid : *grids) {
+        if (!grid) continue;
+        // One line per grid, as vdb_print: name, type, class, voxel size, index bbox,
+        // active voxels, leaves, memory, value range.
+        std::ostringstream line;
+        line << grid->getName() << "  " << grid->valueType() << "  "
+             << openvdb::GridBase::gridClassToString(grid->getGridClass());
+        const openvdb::Vec3d voxel = grid->voxelSize();
+        if (voxel.x() == voxel.y() && voxel.y() == voxel.z()) {
+            line << "  voxel " << formatNumber(voxel.x());
+        } else {
+            line << "  voxel " << formatVec3(voxel.x(), voxel.y(), voxel.z());
+        }
+        const openvdb::CoordBBox bbox = grid->evalActiveVoxelBoundingBox();
+        if (bbox.empty()) {
+            line << "  empty";
+        } else {
+            const openvdb::Coord dim = bbox.dim();
+            line << "  " << formatCoord(bbox.min()) << "->" << formatCoord(bbox.max()) << "  "
+                 << dim.x() << "x" << dim.y() << "x" << dim.z();
+        }
+        line << "  " << formatCount(grid->activeVoxelCount()) << " active voxels  "
+             << grid->baseTree().leafCount() << " leaves  " << formatBytes(grid->memUsage());
+        if (const auto range = activeRange(*grid)) {
+            line << "  values [" << formatNumber(range->first) << ", "
+                 << formatNumber(range->second) << "]";
+        }
+        std::cout << line.str() << "\n";
+        printMetadata(*grid, "    ");
+    }
+    std::cout.flush();
+    return 0;
+}
+
+// ---------------------------------------------------------------------------------------
+
+int runInspect(const std::string& path, bool json)
+{
+    struct stat info;
+    if (::stat(path.c_str(), &info) != 0) {
+        throw nonbloppy::FileError("cannot open " + path + ": " + std::strerror(errno));
+    }
+    if (S_ISDIR(info.st_mode)) {
+        throw nonbloppy::FileError("cannot open " + path + ": " + std::strerror(EISDIR));
+    }
+
+    const std::string ext = lowerExtension(path);
+    if (ext == ".vdb") return inspectVdb(path, json);
+    if (ext == ".obj") return inspectMesh(path, nonbloppy::readMesh(path), json);
+    if (ext == ".ply" || ext == ".vtk") {
+        // Both formats hold either particles or polygons: a file with faces is a mesh.
+        try {
+            nonbloppy::SurfaceMesh mesh = nonbloppy::readMesh(path);
+            if (mesh.polygonCount() > 0) return inspectMesh(path, mesh, json);
+        } catch (const nonbloppy::FileError&) {
+            // Not a mesh (e.g. UNSTRUCTURED_GRID): read it as particles, whose error counts.
+        }
+    }
+    if (nonbloppy::isParticleFile(path)) {
+        return inspectParticles(path, nonbloppy::readParticles(path), json);
+    }
+    throw nonbloppy::FileError("cannot inspect " + path + ": unknown file extension \"" + ext
+                               + "\" (expected .vdb, a mesh or a particle file)");
+}
+
+} // namespace
+
+Command setupInspectCommand(CLI::App& parent)
+{
+    struct Options { std::string path; bool json = false; };
+    auto options = std::make_shared<Options>();
+
+    CLI::App* cmd = parent.add_subcommand(
+        "inspect", "Describe a .vdb grid file, a mesh (.obj, .ply, .vtk) or a particle file");
+    cmd->add_option("FILE", options->path, "File to describe")
+        ->required()->group(kGroupInputOutput);
+    cmd->add_flag("--json", options->json, "Print one JSON object instead of text")
+        ->group(kGroupInputOutput);
+
+    return {cmd, [options]() { return runInspect(options->path, options->json); }};
+}
+
+} // namespace nonbloppy_tool

@@ -1,0 +1,494 @@
+// SPDX-License-Identifier: Apache-2.0
+/// @file MeshCommand.cc
+/// @brief `nonbloppy mesh IN -o OUT`: read particles, build the surface, write the mesh and,
+///        on request, the density grid; print a one-screen summary.
+
+#include "Commands.h"
+
+#include <nonbloppy/BuildSurface.h>
+#include <nonbloppy/Error.h>
+#include <nonbloppy/ReadParticles.h>
+#include <nonbloppy/Timing.h>
+#include <nonbloppy/WriteMesh.h>
+#include <nonbloppy/WriteVdb.h>
+
+#include <openvdb/util/NullInterrupter.h>
+#include <tbb/global_control.h>
+
+#include <atomic>
+#include <cctype>
+#include <cerrno>
+#include <chrono>
+#include <cmath>
+#include <csignal>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <iostream>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <sys/stat.h>
+#include <unistd.h>
+
+namespace nonbloppy_tool {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+// ---------------------------------------------------------------------------------------
+// Cancellation and progress
+
+/// Set by SIGINT/SIGTERM; the interrupter reports it to the library, which then throws
+/// CancelledError at its next check.
+std::atomic<bool> gInterruptRequested{false};
+static_assert(std::atomic<bool>::is_always_lock_free, "the signal handler needs a lock-free flag");
+
+extern "C" void onInterruptSignal(int signalNumber)
+{
+    // A second signal means "stop now": fall back to the default action.
+    if (gInterruptRequested.exchange(true)) {
+        std::signal(signalNumber, SIG_DFL);
+        std::raise(signalNumber);
+    }
+}
+
+/// Restores the previous SIGINT/SIGTERM handlers when the command ends.
+class SignalHandlerScope
+{
+public:
+    SignalHandlerScope()
+    {
+        gInterruptRequested = false;
+        mOldInt = std::signal(SIGINT, onInterruptSignal);
+        mOldTerm = std::signal(SIGTERM, onInterruptSignal);
+    }
+    ~SignalHandlerScope()
+    {
+        std::signal(SIGINT, mOldInt == SIG_ERR ? SIG_DFL : mOldInt);
+        std::signal(SIGTERM, mOldTerm == SIG_ERR ? SIG_DFL : mOldTerm);
+    }
+    SignalHandlerScope(const SignalHandlerScope&) = delete;
+    SignalHandlerScope& operator=(const SignalHandlerScope&) = delete;
+
+private:
+    void (*mOldInt)(int) = SIG_DFL;
+    void (*mOldTerm)(int) = SIG_DFL;
+};
+
+/// The library's interrupter: says "stop" after SIGINT/SIGTERM and, with -v, prints each
+/// stage's name, its progress in quarters and its duration on stderr.
+/// wasInterrupted() is called from worker threads, so printing is serialized.
+class ProgressInterrupter : public openvdb::util::NullInterrupter
+{
+public:
+    explicit ProgressInterrupter(bool verbose) : mVerbose(verbose) {}
+
+    void start(const char* name = nullptr) override
+    {
+        std::lock_guard<std::mutex> lock(mMutex);
+        mStages.push_back({name ? name : "working", std::chrono::steady_clock::now()});
+        mNextQuarter = 1;
+        if (mVerbose) std::cerr << "[progress] " << mStages.back().name << " ..." << std::endl;
+    }
+
+    void end() override
+    {
+        std::lock_guard<std::mutex> lock(mMutex);
+        if (mStages.empty()) return;
+        if (mVerbose) {
+            const std::chrono::duration<double> elapsed =
+                std::chrono::steady_clock::now() - mStages.back().start;
+            std::cerr << "[progress] " << mStages.back().name << " done ("
+                      << formatNumber(elapsed.count()) << " s)" << std::endl;
+        }
+        mStages.pop_back();
+    }
+
+    bool wasInterrupted(int percent = -1) override
+    {
+        if (mVerbose && percent >= 0 && percent >= 25 * mNextQuarter.load() && percent < 100) {
+            std::lock_guard<std::mutex> lock(mMutex);
+            const int quarter = percent / 25;
+            if (quarter >= mNextQuarter && !mStages.empty()) {
+                mNextQuarter = quarter + 1;
+                std::cerr << "[progress] " << mStages.back().name << " " << 25 * quarter << "%"
+                          << std::endl;
+            }
+        }
+        return gInterruptRequested.load(std::memory_order_relaxed);
+    }
+
+private:
+    struct Stage { std::string name; std::chrono::steady_clock::time_point start; };
+    bool mVerbose;
+    std::mutex mMutex;
+    std::vector<Stage> mStages;
+    std::atomic<int> mNextQuarter{1};
+};
+
+/// Runs the tool's own stages (reading, writing) under the same names in the interrupter
+/// and the timing table.
+class StageScope
+{
+public:
+    StageScope(ProgressInterrupter& interrupter, nonbloppy::StageTimings& timings,
+               const char* stage)
+        : mInterrupter(interrupter), mTimer(timings, stage)
+    {
+        mInterrupter.start(stage);
+    }
+    ~StageScope() { mInterrupter.end(); }
+    StageScope(const StageScope&) = delete;
+    StageScope& operator=(const StageScope&) = delete;
+
+private:
+    ProgressInterrupter& mInterrupter;
+    nonbloppy::ScopedStageTimer mTimer;
+};
+
+void throwIfInterrupted()
+{
+    if (gInterruptRequested) throw nonbloppy::CancelledError("interrupted");
+}
+
+// ---------------------------------------------------------------------------------------
+// Options and their validation
+
+struct MeshOptions
+{
+    std::string input, output, vdbPath;
+    double spacing = 0, radius = 0, threshold = 0, voxelSize = 0;
+    double blend = nonbloppy::kDefaultBlend;
+    int iterations = nonbloppy::kDefaultIterations;
+    double adaptivity = nonbloppy::kDefaultAdaptivity;
+    int threads = 0;
+    bool quads = false, quiet = false, verbose = false;
+
+    // Set after declaration, to tell "given" from "default".
+    CLI::Option *spacingOpt = nullptr, *radiusOpt = nullptr, *thresholdOpt = nullptr,
+                *voxelSizeOpt = nullptr, *blendOpt = nullptr, *iterationsOpt = nullptr,
+                *adaptivityOpt = nullptr, *threadsOpt = nullptr, *vdbOpt = nullptr;
+};
+
+std::optional<double> ifGiven(const CLI::Option* option, double value)
+{
+    if (option->count() > 0) return value;
+    return std::nullopt;
+}
+
+void requirePositive(const CLI::Option* option, double value, const char* name)
+{
+    if (option->count() > 0 && !(value > 0.0 && std::isfinite(value))) {
+        throw nonbloppy::ParameterError(std::string(name) + " must be > 0, got "
+                                        + formatNumber(value));
+    }
+}
+
+void requireUnitInterval(double value, const char* name)
+{
+    if (!(value >= 0.0 && value <= 1.0)) {
+        throw nonbloppy::ParameterError(std::string(name) + " must lie in [0,1], got "
+                                        + formatNumber(value));
+    }
+}
+
+/// The extension of @a path's last component with its dot, lower-cased ("" if none).
+std::string lowerExtension(const std::string& path)
+{
+    std::string ext = fs::path(path).extension().string();
+    for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    return ext;
+}
+
+/// Fail now, before any work, if @a path's directory does not exist or cannot be written.
+void requireWritableDirectory(const std::string& path)
+{
+    fs::path dir = fs::path(path).parent_path();
+    if (dir.empty()) dir = ".";
+    std::error_code ec;
+    const fs::file_status status = fs::status(dir, ec);
+    int error = 0;
+    if (!fs::exists(status)) error = ENOENT;
+    else if (!fs::is_directory(status)) error = ENOTDIR;
+    else if (::access(dir.c_str(), W_OK | X_OK) != 0) error = errno;
+    if (error != 0) {
+        throw nonbloppy::FileError("cannot write " + path + ": " + std::strerror(error));
+    }
+}
+
+/// Check everything that can be checked without reading the input, so a mistake costs
+/// nothing and leaves no file behind. The library checks the same ranges again.
+void validate(const MeshOptions& o)
+{
+    requirePositive(o.spacingOpt, o.spacing, "--spacing");
+    requirePositive(o.radiusOpt, o.radius, "--radius");
+    requirePositive(o.thresholdOpt, o.threshold, "--threshold");
+    requirePositive(o.voxelSizeOpt, o.voxelSize, "--voxel-size");
+    requireUnitInterval(o.blend, "--blend");
+    if (o.iterations < 0) {
+        throw nonbloppy::ParameterError("--iterations must be >= 0, got "
+                                        + std::to_string(o.iterations));
+    }
+    requireUnitInterval(o.adaptivity, "--adaptivity");
+    if (o.threadsOpt->count() > 0 && o.threads < 1) {
+        throw nonbloppy::ParameterError("--threads must be >= 1, got " + std::to_string(o.threads));
+    }
+
+    if (!nonbloppy::isMeshFile(o.output)) {
+        throw nonbloppy::FileError("cannot write " + o.output + ": unknown mesh extension \""
+                                   + lowerExtension(o.output) + "\" (use .obj, .ply or .vtk)");
+    }
+    if (!o.vdbPath.empty() && lowerExtension(o.vdbPath) != ".vdb") {
+        throw nonbloppy::FileError("cannot write " + o.vdbPath
+                                   + ": --vdb needs a file name ending in .vdb");
+    }
+
+    struct stat info;
+    if (::stat(o.input.c_str(), &info) != 0) {
+        throw nonbloppy::FileError("cannot open " + o.input + ": " + std::strerror(errno));
+    }
+    if (!nonbloppy::isParticleFile(o.input)) {
+        throw nonbloppy::FileError("cannot read " + o.input + ": unknown particle file extension \""
+                                   + lowerExtension(o.input) + "\"");
+    }
+
+    std::vector<std::string> outputs{o.output};
+    if (!o.vdbPath.empty()) outputs.push_back(o.vdbPath);
+    for (const std::string& out : outputs) {
+        requireWritableDirectory(out);
+        std::error_code ec;
+        if (fs::equivalent(o.input, out, ec)) {
+            throw nonbloppy::FileError("cannot write " + out + ": it is the input file");
+        }
+    }
+    if (!o.vdbPath.empty()) {
+        std::error_code ec;
+        if (o.vdbPath == o.output || fs::equivalent(o.vdbPath, o.output, ec)) {
+            throw nonbloppy::FileError("cannot write " + o.vdbPath
+                                       + ": --vdb and --output name the same file");
+        }
+    }
+}
+
+// ---------------------------------------------------------------------------------------
+// Summary
+
+std::string origin(bool given, const char* otherwise) { return given ? "(given)" : otherwise; }
+
+void printSummary(const MeshOptions& o, const nonbloppy::SurfaceResult& result,
+                  const nonbloppy::StageTimings& timings, int threads)
+{
+    const nonbloppy::ResolvedParameters& p = result.parameters;
+    const nonbloppy::SurfaceMesh& mesh = result.mesh;
+    char line[512];
+    std::ostream& out = std::cout;
+
+    auto row = [&](const char* label, const std::string& value, const std::string& note) {
+        std::snprintf(line, sizeof(line), "  %-18s %-14s %s", label, value.c_str(), note.c_str());
+        std::string text = line;
+        while (!text.empty() && text.back() == ' ') text.pop_back();
+        out << text << "\n";
+    };
+
+    out << "input\n";
+    row("file", o.input, "");
+    row("particles", std::to_string(result.particleCount), "");
+    out << "parameters\n";
+    // The spacing is only estimated when something was derived from it.
+    const bool spacingUsed = p.spacingGiven || !p.effectiveRadiusGiven || !p.thresholdGiven
+                             || !p.voxelSizeGiven;
+    row("spacing s", spacingUsed ? formatNumber(p.spacing) : "-",
+        spacingUsed ? origin(p.spacingGiven, "(derived)") : "(not needed)");
+    row("radius r_e", formatNumber(p.effectiveRadius), origin(p.effectiveRadiusGiven, "(derived)"));
+    row("threshold r_0", formatNumber(p.threshold), origin(p.thresholdGiven, "(derived)"));
+    row("voxel size h", formatNumber(p.voxelSize), origin(p.voxelSizeGiven, "(derived)"));
+    row("blend c", formatNumber(p.blend), origin(o.blendOpt->count() > 0, "(default)"));
+    row("iterations t", std::to_string(p.iterations),
+        origin(o.iterationsOpt->count() > 0, "(default)"));
+    row("adaptivity", formatNumber(p.adaptivity), origin(o.adaptivityOpt->count() > 0, "(default)"));
+    row("threads", std::to_string(threads), origin(o.threadsOpt->count() > 0, "(default)"));
+
+    out << "result\n";
+    const uint64_t activeVoxels = result.density ? result.density->activeVoxelCount() : 0;
+    row("active voxels", std::to_string(activeVoxels), "(" + formatCount(activeVoxels) + ", density grid)");
+    row("vertices", std::to_string(mesh.points.size()), "");
+    if (o.quads) {
+        row("polygons", std::to_string(mesh.polygonCount()),
+            "(" + std::to_string(mesh.quads.size()) + " quads, "
+                + std::to_string(mesh.triangles.size()) + " triangles)");
+    } else {
+        row("triangles", std::to_string(mesh.triangleCount()), "");
+    }
+    row("mesh", o.output, "");
+    if (!o.vdbPath.empty()) row("density grid", o.vdbPath, "");
+
+    out << "timings\n";
+    const double total = timings.total();
+    for (const auto& entry : timings.entries) {
+        std::snprintf(line, sizeof(line), "  %-18s %8.3f s  (%4.1f%%)", entry.stage.c_str(),
+                      entry.seconds, total > 0 ? 100.0 * entry.seconds / total : 0.0);
+        out << line << "\n";
+    }
+    std::snprintf(line, sizeof(line), "  %-18s %8.3f s", "total", total);
+    out << line << "\n";
+    out.flush();
+}
+
+// ---------------------------------------------------------------------------------------
+// The command
+
+/// Files this run has written; removed again unless the run succeeds, so a failed or
+/// interrupted run leaves no half-set of outputs.
+class OutputCleanup
+{
+public:
+    void add(const std::string& path) { mPaths.push_back(path); }
+    void keep() { mPaths.clear(); }
+    ~OutputCleanup()
+    {
+        for (const std::string& path : mPaths) std::remove(path.c_str());
+    }
+
+private:
+    std::vector<std::string> mPaths;
+};
+
+int runMesh(const MeshOptions& o)
+{
+    validate(o);
+
+    std::unique_ptr<tbb::global_control> threadLimit;
+    if (o.threadsOpt->count() > 0) {
+        threadLimit = std::make_unique<tbb::global_control>(
+            tbb::global_control::max_allowed_parallelism, static_cast<size_t>(o.threads));
+    }
+    const int threads = static_cast<int>(
+        tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
+
+    SignalHandlerScope signals;
+    ProgressInterrupter interrupter(o.verbose);
+    OutputCleanup cleanup;
+
+    try {
+        nonbloppy::StageTimings before, after;
+
+        nonbloppy::ParticleSet particles;
+        {
+            StageScope stage(interrupter, before, "read particles");
+            particles = nonbloppy::readParticles(o.input);
+        }
+        if (particles.size() == 0) {
+            throw nonbloppy::FileError("no particles in " + o.input);
+        }
+        throwIfInterrupted();
+
+        nonbloppy::SurfaceParameters params;
+        params.spacing = ifGiven(o.spacingOpt, o.spacing);
+        params.effectiveRadius = ifGiven(o.radiusOpt, o.radius);
+        params.threshold = ifGiven(o.thresholdOpt, o.threshold);
+        params.voxelSize = ifGiven(o.voxelSizeOpt, o.voxelSize);
+        params.blend = o.blend;
+        params.iterations = o.iterations;
+        params.adaptivity = o.adaptivity;
+
+        // The particles are handed over; their attributes are not needed for meshing.
+        nonbloppy::SurfaceResult result =
+            nonbloppy::buildSurface(std::move(particles.positions), params, &interrupter);
+        particles = nonbloppy::ParticleSet();
+        throwIfInterrupted();
+
+        {
+            StageScope stage(interrupter, after, "write mesh");
+            nonbloppy::MeshWriteSettings settings;
+            settings.keepQuads = o.quads;
+            nonbloppy::writeMesh(result.mesh, o.output, settings);
+            cleanup.add(o.output);
+        }
+        throwIfInterrupted();
+
+        if (!o.vdbPath.empty()) {
+            if (!result.density) throw nonbloppy::Error("no density grid to write");
+            StageScope stage(interrupter, after, "write vdb");
+            result.density->insertMeta("source_file", openvdb::StringMetadata(o.input));
+            openvdb::MetaMap fileMetadata;
+            fileMetadata.insertMeta("creator", openvdb::StringMetadata(versionLine()));
+            nonbloppy::writeVdb({result.density}, o.vdbPath, fileMetadata);
+            cleanup.add(o.vdbPath);
+        }
+        throwIfInterrupted();
+        cleanup.keep();
+
+        if (!o.quiet) {
+            nonbloppy::StageTimings timings = before;
+            for (const auto& entry : result.timings.entries) timings.add(entry.stage, entry.seconds);
+            for (const auto& entry : after.entries) timings.add(entry.stage, entry.seconds);
+            printSummary(o, result, timings, threads);
+        }
+        return 0;
+    } catch (const nonbloppy::CancelledError&) {
+        // OutputCleanup has removed what was written; the library leaves nothing behind.
+        std::cerr << "nonbloppy: interrupted" << std::endl;
+        return kExitInterrupted;
+    }
+}
+
+} // namespace
+
+Command setupMeshCommand(CLI::App& parent)
+{
+    auto options = std::make_shared<MeshOptions>();
+    MeshOptions& o = *options;
+
+    CLI::App* cmd = parent.add_subcommand(
+        "mesh", "Build a surface mesh from a particle file");
+    cmd->footer(
+        "Lengths are absolute, in the particle file's units (not multiples of the spacing).\n"
+        "Unset parameters are derived from the particle spacing s: r_e = 2 s, h = s/2, and r_0\n"
+        "so that a flat block of fluid gets its surface s/2 outside the outer particles.");
+
+    cmd->add_option("IN", o.input, "Particle file (.vtk, .ply, .xyz, ...)")
+        ->required()->group(kGroupInputOutput);
+    cmd->add_option("-o,--output", o.output, "Mesh to write (.obj, .ply or .vtk)")
+        ->required()->group(kGroupInputOutput);
+    cmd->add_flag("--quads", o.quads, "Keep quads instead of splitting them into triangles")
+        ->group(kGroupInputOutput);
+
+    o.spacingOpt = cmd->add_option("--spacing", o.spacing,
+        "Particle spacing s (default: median nearest-neighbour distance)")
+        ->group(kGroupNumerical);
+    o.radiusOpt = cmd->add_option("--radius", o.radius,
+        "Effective (kernel) radius r_e (default: 2 s)")->group(kGroupNumerical);
+    o.thresholdOpt = cmd->add_option("--threshold", o.threshold,
+        "Density iso-value r_0 (default: calibrated from r_e/s)")->group(kGroupNumerical);
+    o.voxelSizeOpt = cmd->add_option("--voxel-size", o.voxelSize,
+        "Voxel size h of the density grid (default: s/2)")->group(kGroupNumerical);
+    o.blendOpt = cmd->add_option("-c,--blend", o.blend,
+        "Relaxation blend c in [0,1] (default: 0.3)")->group(kGroupNumerical);
+    o.iterationsOpt = cmd->add_option("-t,--iterations", o.iterations,
+        "Relaxation iterations t >= 0 (default: 2)")->group(kGroupNumerical);
+
+    o.adaptivityOpt = cmd->add_option("--adaptivity", o.adaptivity,
+        "Polygon merging in flat regions, in [0,1] (default: 0)")->group(kGroupAdvanced);
+    o.threadsOpt = cmd->add_option("--threads", o.threads,
+        "Worker threads (default: all cores); results do not depend on it")
+        ->group(kGroupAdvanced);
+
+    o.vdbPath.clear();
+    o.vdbOpt = cmd->add_option("--vdb", o.vdbPath,
+        "Also write the density grid to this .vdb file (vdb_print reads it)")
+        ->group(kGroupDebug);
+    CLI::Option* quiet = cmd->add_flag("-q,--quiet", o.quiet, "Print nothing but errors")
+        ->group(kGroupDebug);
+    CLI::Option* verbose = cmd->add_flag("-v,--verbose", o.verbose,
+        "Print each stage and its progress on stderr")->group(kGroupDebug);
+    quiet->excludes(verbose);
+
+    return {cmd, [options]() { return runMesh(*options); }};
+}
+
+} // namespace nonbloppy_tool

@@ -1,0 +1,122 @@
+// SPDX-License-Identifier: Apache-2.0
+/// @file main.cc
+/// @brief `nonbloppy`: particles to surface meshes from the command line.
+///
+///     nonbloppy mesh IN -o OUT [options]   particles → mesh (and density .vdb)
+///     nonbloppy inspect FILE [--json]      what a particle, mesh or .vdb file holds
+///     nonbloppy help [COMMAND]             the options of a command
+///
+/// Every error is one line "nonbloppy: <message>" on stderr; exit codes are 0 (success),
+/// 1 (error), 2 (bad command line) and 130 (interrupted).
+
+#include "Commands.h"
+
+#include <nonbloppy/Error.h>
+#include <nonbloppy/Version.h>
+
+#include <openvdb/Exceptions.h>
+#include <openvdb/version.h>
+
+#include <exception>
+#include <iostream>
+#include <new>
+#include <vector>
+
+namespace nonbloppy_tool {
+
+std::string versionLine()
+{
+    return std::string("nonbloppy ") + nonbloppy::version() + " (OpenVDB "
+           + openvdb::getLibraryVersionString() + ")";
+}
+
+} // namespace nonbloppy_tool
+
+namespace {
+
+constexpr int kExitError = 1;
+constexpr int kExitUsage = 2;
+
+/// CLI11 and OpenVDB messages can span lines; the tool promises one line per error.
+std::string oneLine(std::string message)
+{
+    for (char& c : message) {
+        if (c == '\n' || c == '\r' || c == '\t') c = ' ';
+    }
+    while (!message.empty() && message.back() == ' ') message.pop_back();
+    return message;
+}
+
+int fail(const std::string& message, int exitCode)
+{
+    std::cerr << "nonbloppy: " << oneLine(message) << std::endl;
+    return exitCode;
+}
+
+int run(int argc, char** argv)
+{
+    using namespace nonbloppy_tool;
+
+    CLI::App app("nonbloppy: surface meshes from fluid-simulation particles", "nonbloppy");
+    app.set_version_flag("--version", versionLine(), "Print the version and exit");
+    app.require_subcommand(1, 1);
+    app.footer("Run 'nonbloppy help COMMAND' or 'nonbloppy COMMAND --help' for a command's "
+               "options.");
+
+    // The subcommand table.
+    std::vector<Command> commands;
+    commands.push_back(setupMeshCommand(app));
+    commands.push_back(setupInspectCommand(app));
+
+    std::string helpTopic;
+    CLI::App* help = app.add_subcommand("help", "Print the options of COMMAND, or this list");
+    help->add_option("COMMAND", helpTopic, "mesh or inspect");
+    commands.push_back({help, [&]() {
+        if (helpTopic.empty()) {
+            std::cout << app.help();
+            return 0;
+        }
+        for (const Command& command : commands) {
+            if (command.app->get_name() == helpTopic) {
+                std::cout << command.app->help();
+                return 0;
+            }
+        }
+        return fail("unknown command '" + helpTopic + "'; commands are mesh, inspect, help",
+                    kExitUsage);
+    }});
+
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::Success& e) {
+        return app.exit(e); // --help or --version: printed on stdout, exit 0
+    } catch (const CLI::ParseError& e) {
+        return fail(e.what(), kExitUsage);
+    }
+
+    for (const Command& command : commands) {
+        if (command.app->parsed()) return command.run();
+    }
+    return fail("no command given; run 'nonbloppy --help'", kExitUsage);
+}
+
+} // namespace
+
+int main(int argc, char** argv)
+{
+    try {
+        return run(argc, argv);
+    } catch (const nonbloppy::CancelledError&) {
+        return fail("interrupted", nonbloppy_tool::kExitInterrupted);
+    } catch (const nonbloppy::Error& e) {
+        return fail(e.what(), kExitError);
+    } catch (const openvdb::Exception& e) {
+        return fail(e.what(), kExitError);
+    } catch (const std::bad_alloc&) {
+        return fail("out of memory", kExitError);
+    } catch (const std::exception& e) {
+        return fail(e.what(), kExitError);
+    } catch (...) {
+        return fail("unknown error", kExitError);
+    }
+}
