@@ -1,0 +1,1168 @@
+// SPDX-License-Identifier: Apache-2.0
+/// @file FileFormats.cc
+/// @brief Legacy VTK and PLY decoding shared by readParticles() and readMesh().
+
+#include "FileFormats.h"
+
+#include <nonbloppy/Error.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <charconv>
+#include <cstdlib>
+#include <cstring>
+#include <limits>
+#include <memory>
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+namespace nonbloppy {
+namespace io_internal {
+
+// ------------------------------------------------------------------------------------------
+// Files, messages, text
+
+std::vector<char>
+loadFile(const std::string& path)
+{
+    const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+    if (fd < 0) throw FileError("cannot open " + path + ": " + std::strerror(errno));
+
+    struct FdCloser { int fd; ~FdCloser() { ::close(fd); } } closer{fd};
+    auto readError = [&path](int errorNumber) {
+        return FileError("cannot read " + path + ": " + std::strerror(errorNumber));
+    };
+
+    struct stat info;
+    if (::fstat(fd, &info) != 0) throw readError(errno);
+    if (S_ISDIR(info.st_mode)) throw readError(EISDIR);
+
+    // st_size is only a hint (pipes and /proc files report 0); read until end of file.
+    std::vector<char> data(S_ISREG(info.st_mode) ? size_t(info.st_size) + 1 : 65536);
+    size_t used = 0;
+    for (;;) {
+        if (used == data.size()) data.resize(data.size() * 2);
+        const ssize_t n = ::read(fd, data.data() + used, data.size() - used);
+        if (n < 0) {
+            if (errno == EINTR) continue;
+            throw readError(errno);
+        }
+        if (n == 0) break;
+        used += size_t(n);
+    }
+    data.resize(used);
+    return data;
+}
+
+std::string
+lowerExtension(const std::string& path)
+{
+    const size_t slash = path.find_last_of('/');
+    const size_t nameStart = (slash == std::string::npos) ? 0 : slash + 1;
+    const size_t dot = path.find_last_of('.');
+    if (dot == std::string::npos || dot <= nameStart) return std::string();
+    std::string ext = path.substr(dot);
+    for (char& ch : ext) {
+        if (ch >= 'A' && ch <= 'Z') ch = char(ch - 'A' + 'a');
+    }
+    return ext;
+}
+
+void
+fail(const std::string& path, const std::string& what)
+{
+    throw FileError(what + " (" + path + ")");
+}
+
+std::string
+printable(std::string_view text)
+{
+    std::string result;
+    for (char ch : text.substr(0, 40)) {
+        result += (ch >= 32 && ch < 127) ? ch : '?';
+    }
+    if (text.size() > 40) result += "...";
+    return result;
+}
+
+namespace {
+
+constexpr bool kHostIsBigEndian = (__BYTE_ORDER__ == __ORDER_BIG_ENDIAN__);
+
+bool
+isSpace(char ch)
+{
+    return ch == ' ' || ch == '\t' || ch == '\n' || ch == '\r' || ch == '\v' || ch == '\f';
+}
+
+char
+toLower(char ch)
+{
+    return (ch >= 'A' && ch <= 'Z') ? char(ch - 'A' + 'a') : ch;
+}
+
+bool
+iequals(std::string_view a, std::string_view b)
+{
+    if (a.size() != b.size()) return false;
+    for (size_t i = 0; i < a.size(); ++i) {
+        if (toLower(a[i]) != toLower(b[i])) return false;
+    }
+    return true;
+}
+
+std::string_view
+trim(std::string_view text)
+{
+    while (!text.empty() && isSpace(text.front())) text.remove_prefix(1);
+    while (!text.empty() && isSpace(text.back())) text.remove_suffix(1);
+    return text;
+}
+
+std::vector<std::string_view>
+splitWords(std::string_view text)
+{
+    std::vector<std::string_view> words;
+    size_t i = 0;
+    while (i < text.size()) {
+        while (i < text.size() && isSpace(text[i])) ++i;
+        const size_t begin = i;
+        while (i < text.size() && !isSpace(text[i])) ++i;
+        if (i > begin) words.push_back(text.substr(begin, i - begin));
+    }
+    return words;
+}
+
+/// A read position in a buffer; every access is bounds-checked by the caller via remaining().
+class Cursor
+{
+public:
+    Cursor(const char* data, size_t size) : mData(data), mSize(size) {}
+
+    size_t pos() const { return mPos; }
+    void setPos(size_t pos) { mPos = std::min(pos, mSize); }
+    size_t remaining() const { return mSize - mPos; }
+    bool atEnd() const { return mPos >= mSize; }
+    const char* here() const { return mData + mPos; }
+    void advance(size_t n) { mPos += std::min(n, remaining()); }
+
+    void skipSpace()
+    {
+        while (mPos < mSize && isSpace(mData[mPos])) ++mPos;
+    }
+
+    /// The next run of non-space characters (empty at the end of the buffer).
+    std::string_view token()
+    {
+        skipSpace();
+        const size_t begin = mPos;
+        while (mPos < mSize && !isSpace(mData[mPos])) ++mPos;
+        return std::string_view(mData + begin, mPos - begin);
+    }
+
+    /// The rest of the current line without its line break; moves past the '\n'.
+    std::string_view line()
+    {
+        const size_t begin = mPos;
+        const void* newline = std::memchr(mData + mPos, '\n', mSize - mPos);
+        size_t end = newline ? size_t(static_cast<const char*>(newline) - mData) : mSize;
+        mPos = newline ? end + 1 : mSize;
+        if (end > begin && mData[end - 1] == '\r') --end;
+        return std::string_view(mData + begin, end - begin);
+    }
+
+    /// True if the next non-space text starts with the word @a word (case-insensitive).
+    /// Moves nothing.
+    bool peekWord(std::string_view word)
+    {
+        const size_t saved = mPos;
+        const std::string_view next = token();
+        mPos = saved;
+        return iequals(next, word);
+    }
+
+private:
+    const char* mData;
+    size_t mSize;
+    size_t mPos = 0;
+};
+
+bool
+parseCount(std::string_view text, uint64_t& value)
+{
+    const char* end = text.data() + text.size();
+    const auto result = std::from_chars(text.data(), end, value);
+    return !text.empty() && result.ec == std::errc() && result.ptr == end;
+}
+
+bool
+parseDouble(std::string_view text, double& value)
+{
+    if (!text.empty() && text.front() == '+') text.remove_prefix(1);
+    if (text.empty()) return false;
+    const char* end = text.data() + text.size();
+    const auto result = std::from_chars(text.data(), end, value);
+    if (result.ec == std::errc() && result.ptr == end) return true;
+    if (result.ec == std::errc::result_out_of_range && text.size() < 64) {
+        // from_chars leaves the value unset for 1e-400 or 1e400; strtod gives 0 or inf.
+        const std::string copy(text);
+        char* parsedEnd = nullptr;
+        value = std::strtod(copy.c_str(), &parsedEnd);
+        return parsedEnd == copy.c_str() + copy.size();
+    }
+    return false;
+}
+
+template<typename IntT>
+bool
+parseInteger(std::string_view text, IntT& value)
+{
+    if (!text.empty() && text.front() == '+') text.remove_prefix(1);
+    const char* end = text.data() + text.size();
+    const auto result = std::from_chars(text.data(), end, value);
+    return !text.empty() && result.ec == std::errc() && result.ptr == end;
+}
+
+template<typename IntT, typename WideT>
+bool
+parseNarrow(std::string_view text, unsigned char* out)
+{
+    WideT wide;
+    if (!parseInteger(text, wide)) return false;
+    if (wide < WideT(std::numeric_limits<IntT>::min()) ||
+        wide > WideT(std::numeric_limits<IntT>::max())) return false;
+    const IntT value = IntT(wide);
+    std::memcpy(out, &value, sizeof(IntT));
+    return true;
+}
+
+/// Parse one text value of @a type into native bytes at @a out.
+bool
+parseTextValue(std::string_view text, ScalarType type, unsigned char* out)
+{
+    switch (type) {
+        case ScalarType::Int8: return parseNarrow<int8_t, int64_t>(text, out);
+        case ScalarType::UInt8: return parseNarrow<uint8_t, uint64_t>(text, out);
+        case ScalarType::Int16: return parseNarrow<int16_t, int64_t>(text, out);
+        case ScalarType::UInt16: return parseNarrow<uint16_t, uint64_t>(text, out);
+        case ScalarType::Int32: return parseNarrow<int32_t, int64_t>(text, out);
+        case ScalarType::UInt32: return parseNarrow<uint32_t, uint64_t>(text, out);
+        case ScalarType::Int64: return parseNarrow<int64_t, int64_t>(text, out);
+        case ScalarType::UInt64: return parseNarrow<uint64_t, uint64_t>(text, out);
+        case ScalarType::Float32: {
+            double value;
+            if (!parseDouble(text, value)) return false;
+            const float narrow = float(value);
+            std::memcpy(out, &narrow, sizeof(float));
+            return true;
+        }
+        case ScalarType::Float64: {
+            double value;
+            if (!parseDouble(text, value)) return false;
+            std::memcpy(out, &value, sizeof(double));
+            return true;
+        }
+    }
+    return false;
+}
+
+/// Copy @a count values of @a width bytes, reversing the bytes of each if @a swap.
+void
+copyValues(const char* src, size_t count, size_t width, bool swap, unsigned char* dst)
+{
+    if (!swap || width == 1) {
+        if (count > 0) std::memcpy(dst, src, count * width);
+        return;
+    }
+    switch (width) {
+        case 2:
+            for (size_t i = 0; i < count; ++i) {
+                uint16_t v;
+                std::memcpy(&v, src + 2 * i, 2);
+                v = __builtin_bswap16(v);
+                std::memcpy(dst + 2 * i, &v, 2);
+            }
+            break;
+        case 4:
+            for (size_t i = 0; i < count; ++i) {
+                uint32_t v;
+                std::memcpy(&v, src + 4 * i, 4);
+                v = __builtin_bswap32(v);
+                std::memcpy(dst + 4 * i, &v, 4);
+            }
+            break;
+        case 8:
+            for (size_t i = 0; i < count; ++i) {
+                uint64_t v;
+                std::memcpy(&v, src + 8 * i, 8);
+                v = __builtin_bswap64(v);
+                std::memcpy(dst + 8 * i, &v, 8);
+            }
+            break;
+        default: break;
+    }
+}
+
+bool integerValue(const unsigned char* p, ScalarType type, int64_t& value);
+
+double
+valueAsDouble(const unsigned char* p, ScalarType type)
+{
+    switch (type) {
+        case ScalarType::Float32: { float v; std::memcpy(&v, p, 4); return v; }
+        case ScalarType::Float64: { double v; std::memcpy(&v, p, 8); return v; }
+        case ScalarType::UInt64: { uint64_t v; std::memcpy(&v, p, 8); return double(v); }
+        default: {
+            int64_t v = 0;
+            integerValue(p, type, v);
+            return double(v);
+        }
+    }
+}
+
+bool
+isIntegerType(ScalarType type)
+{
+    return type != ScalarType::Float32 && type != ScalarType::Float64;
+}
+
+/// Integer value of @a p (native bytes of integer @a type); false if it does not fit int64.
+bool
+integerValue(const unsigned char* p, ScalarType type, int64_t& value)
+{
+    switch (type) {
+        case ScalarType::Int8: { int8_t v; std::memcpy(&v, p, 1); value = v; return true; }
+        case ScalarType::UInt8: { uint8_t v; std::memcpy(&v, p, 1); value = v; return true; }
+        case ScalarType::Int16: { int16_t v; std::memcpy(&v, p, 2); value = v; return true; }
+        case ScalarType::UInt16: { uint16_t v; std::memcpy(&v, p, 2); value = v; return true; }
+        case ScalarType::Int32: { int32_t v; std::memcpy(&v, p, 4); value = v; return true; }
+        case ScalarType::UInt32: { uint32_t v; std::memcpy(&v, p, 4); value = v; return true; }
+        case ScalarType::Int64: { std::memcpy(&value, p, 8); return true; }
+        case ScalarType::UInt64: {
+            uint64_t v;
+            std::memcpy(&v, p, 8);
+            value = int64_t(v);
+            return v <= uint64_t(std::numeric_limits<int64_t>::max());
+        }
+        default: return false;
+    }
+}
+
+/// Reads typed value arrays from a Cursor, text or binary, never past the buffer's end.
+class ValueReader
+{
+public:
+    ValueReader(Cursor& cursor, bool binary, bool bigEndian, const std::string& path)
+        : mCursor(cursor), mBinary(binary), mSwap(binary && bigEndian != kHostIsBigEndian)
+        , mPath(path) {}
+
+    bool binary() const { return mBinary; }
+
+    /// Fail with "truncated <section> (path)" unless @a count values of @a type can still
+    /// be in the buffer: checked before allocating, so a corrupt count cannot exhaust memory.
+    void requireRoom(uint64_t count, ScalarType type, const std::string& section) const
+    {
+        const size_t left = mCursor.remaining();
+        // A text value takes at least one character plus a separator.
+        const uint64_t capacity = mBinary ? left / scalarSize(type) : (uint64_t(left) + 1) / 2;
+        if (count > capacity) fail(mPath, "truncated " + section);
+    }
+
+    /// @a count values of @a type, in native byte order, appended to @a out.
+    void read(uint64_t count, ScalarType type, const std::string& section,
+              std::vector<unsigned char>& out)
+    {
+        requireRoom(count, type, section);
+        const size_t width = scalarSize(type);
+        const size_t start = out.size();
+        out.resize(start + size_t(count) * width);
+        readInto(size_t(count), type, section, out.data() + start);
+    }
+
+    /// @a count values into @a dst (room for count × scalarSize(type) bytes).
+    void readInto(size_t count, ScalarType type, const std::string& section,
+                  unsigned char* dst)
+    {
+        requireRoom(count, type, section);
+        const size_t width = scalarSize(type);
+        if (mBinary) {
+            copyValues(mCursor.here(), count, width, mSwap, dst);
+            mCursor.advance(count * width);
+            return;
+        }
+        for (size_t i = 0; i < count; ++i) {
+            const std::string_view text = mCursor.token();
+            if (text.empty()) fail(mPath, "truncated " + section);
+            if (!parseTextValue(text, type, dst + i * width)) {
+                fail(mPath, "bad " + std::string(scalarTypeName(type)) + " value '" +
+                    printable(text) + "' in " + section);
+            }
+        }
+    }
+
+    /// Move past @a count values of @a type without keeping them.
+    void skip(uint64_t count, ScalarType type, const std::string& section)
+    {
+        requireRoom(count, type, section);
+        if (mBinary) {
+            mCursor.advance(size_t(count) * scalarSize(type));
+            return;
+        }
+        for (uint64_t i = 0; i < count; ++i) {
+            if (mCursor.token().empty()) fail(mPath, "truncated " + section);
+        }
+    }
+
+    /// One value of integer @a type (e.g. a PLY list length).
+    int64_t readInteger(ScalarType type, const std::string& section)
+    {
+        unsigned char bytes[8];
+        readInto(1, type, section, bytes);
+        int64_t value = 0;
+        if (!integerValue(bytes, type, value)) fail(mPath, "integer out of range in " + section);
+        return value;
+    }
+
+private:
+    Cursor& mCursor;
+    bool mBinary;
+    bool mSwap;
+    const std::string& mPath;
+};
+
+std::vector<int64_t>
+toIntegers(const std::vector<unsigned char>& bytes, ScalarType type, const std::string& path,
+           const std::string& section)
+{
+    const size_t width = scalarSize(type);
+    std::vector<int64_t> values(bytes.size() / width);
+    for (size_t i = 0; i < values.size(); ++i) {
+        if (!integerValue(bytes.data() + i * width, type, values[i])) {
+            fail(path, "integer out of range in " + section);
+        }
+    }
+    return values;
+}
+
+uint32_t
+checkedIndex(int64_t value, const std::string& path, const std::string& section)
+{
+    if (value < 0 || value > int64_t(std::numeric_limits<uint32_t>::max())) {
+        fail(path, "bad vertex index " + std::to_string(value) + " in " + section);
+    }
+    return uint32_t(value);
+}
+
+} // namespace
+
+std::vector<float>
+toFloats(const NumericArray& array)
+{
+    const size_t width = scalarSize(array.type);
+    const size_t count = array.bytes.size() / width;
+    std::vector<float> values(count);
+    if (array.type == ScalarType::Float32) {
+        if (count > 0) std::memcpy(values.data(), array.bytes.data(), count * sizeof(float));
+    } else {
+        for (size_t i = 0; i < count; ++i) {
+            values[i] = float(valueAsDouble(array.bytes.data() + i * width, array.type));
+        }
+    }
+    return values;
+}
+
+// ------------------------------------------------------------------------------------------
+// Legacy VTK
+
+namespace {
+
+bool
+vtkScalarType(std::string_view name, ScalarType& type)
+{
+    struct Entry { const char* name; ScalarType type; };
+    // "long" is 8 bytes as VTK writes it on Linux/macOS; VTK's legacy writer stores
+    // vtkIdType arrays as 32-bit int for backward compatibility.
+    static const Entry kTable[] = {
+        {"char", ScalarType::Int8}, {"signed_char", ScalarType::Int8},
+        {"vtktypeint8", ScalarType::Int8},
+        {"unsigned_char", ScalarType::UInt8}, {"vtktypeuint8", ScalarType::UInt8},
+        {"short", ScalarType::Int16}, {"vtktypeint16", ScalarType::Int16},
+        {"unsigned_short", ScalarType::UInt16}, {"vtktypeuint16", ScalarType::UInt16},
+        {"int", ScalarType::Int32}, {"vtktypeint32", ScalarType::Int32},
+        {"vtkidtype", ScalarType::Int32},
+        {"unsigned_int", ScalarType::UInt32}, {"vtktypeuint32", ScalarType::UInt32},
+        {"long", ScalarType::Int64}, {"long_long", ScalarType::Int64},
+        {"vtktypeint64", ScalarType::Int64}, {"__int64", ScalarType::Int64},
+        {"unsigned_long", ScalarType::UInt64}, {"unsigned_long_long", ScalarType::UInt64},
+        {"vtktypeuint64", ScalarType::UInt64}, {"unsigned___int64", ScalarType::UInt64},
+        {"float", ScalarType::Float32}, {"vtktypefloat32", ScalarType::Float32},
+        {"double", ScalarType::Float64}, {"vtktypefloat64", ScalarType::Float64},
+    };
+    for (const Entry& entry : kTable) {
+        if (iequals(name, entry.name)) {
+            type = entry.type;
+            return true;
+        }
+    }
+    return false;
+}
+
+std::string
+upper(std::string_view text)
+{
+    std::string result(text);
+    for (char& ch : result) {
+        if (ch >= 'a' && ch <= 'z') ch = char(ch - 'a' + 'A');
+    }
+    return result;
+}
+
+/// VTK 5 writes names with spaces and other special characters as %XX.
+std::string
+decodeVtkName(std::string_view name)
+{
+    std::string result;
+    for (size_t i = 0; i < name.size(); ++i) {
+        if (name[i] == '%' && i + 2 < name.size()) {
+            unsigned value = 0;
+            const auto r = std::from_chars(name.data() + i + 1, name.data() + i + 3, value, 16);
+            if (r.ec == std::errc() && r.ptr == name.data() + i + 3) {
+                result += char(value);
+                i += 2;
+                continue;
+            }
+        }
+        result += name[i];
+    }
+    return result;
+}
+
+class VtkParser
+{
+public:
+    VtkParser(const char* data, size_t size, const std::string& path, bool wantPolygons)
+        : mCursor(data, size), mPath(path), mWantPolygons(wantPolygons) {}
+
+    VtkData parse()
+    {
+        readHeader();
+        bool havePoints = false;
+        for (;;) {
+            mCursor.skipSpace();
+            if (mCursor.atEnd()) break;
+            const std::string_view headerLine = mCursor.line();
+            mLine = headerLine;
+            const std::vector<std::string_view> words = splitWords(headerLine);
+            const std::string key = upper(words.at(0));  // skipSpace() made words non-empty
+
+            if (key == "POINTS") {
+                if (havePoints) fail(mPath, "second POINTS section in VTK file");
+                readPoints(words);
+                havePoints = true;
+            } else if (key == "CELLS" || key == "VERTICES" || key == "LINES" ||
+                       key == "POLYGONS" || key == "TRIANGLE_STRIPS") {
+                readCells(key, words);
+            } else if (key == "CELL_TYPES") {
+                requireWords(words, 2);
+                mReader->skip(count(words[1]), ScalarType::Int32, "CELL_TYPES section");
+            } else if (key == "POINT_DATA" || key == "CELL_DATA") {
+                requireWords(words, 2);
+                mTupleCount = count(words[1]);
+                mInPointData = (key == "POINT_DATA");
+                mInCellData = !mInPointData;
+                if (mInPointData && havePoints && mTupleCount != mData.points.size()) {
+                    fail(mPath, "POINT_DATA count " + std::to_string(mTupleCount) +
+                        " differs from POINTS count " + std::to_string(mData.points.size()));
+                }
+            } else if (key == "SCALARS") {
+                requireAttributeSection(key);
+                if (words.size() < 3 || words.size() > 4) badHeader();
+                uint64_t components = 1;
+                if (words.size() == 4) components = count(words[3]);
+                if (components < 1 || components > 4096) badHeader();
+                const ScalarType type = dataType(words[2]);
+                // The LOOKUP_TABLE line is optional from VTK 5; binary data never starts
+                // with that word, so peeking is safe.
+                const size_t saved = mCursor.pos();
+                if (!mReader->binary()) mCursor.skipSpace();
+                if (mCursor.remaining() >= 12 &&
+                    iequals(std::string_view(mCursor.here(), 12), "LOOKUP_TABLE")) {
+                    mCursor.line();
+                } else {
+                    mCursor.setPos(saved);
+                }
+                readAttribute(key, words[1], type, int(components));
+            } else if (key == "VECTORS" || key == "NORMALS") {
+                requireAttributeSection(key);
+                requireWords(words, 3);
+                readAttribute(key, words[1], dataType(words[2]), 3);
+            } else if (key == "TENSORS" || key == "TENSORS6") {
+                requireAttributeSection(key);
+                requireWords(words, 3);
+                readAttribute(key, words[1], dataType(words[2]), key == "TENSORS" ? 9 : 6);
+            } else if (key == "TEXTURE_COORDINATES") {
+                requireAttributeSection(key);
+                requireWords(words, 4);
+                const uint64_t dim = count(words[2]);
+                if (dim < 1 || dim > 3) badHeader();
+                readAttribute(key, words[1], dataType(words[3]), int(dim));
+            } else if (key == "COLOR_SCALARS") {
+                requireAttributeSection(key);
+                requireWords(words, 3);
+                const uint64_t components = count(words[2]);
+                if (components < 1 || components > 4096) badHeader();
+                // Binary color scalars are bytes, ASCII ones floats in [0,1].
+                readAttribute(key, words[1],
+                    mReader->binary() ? ScalarType::UInt8 : ScalarType::Float32,
+                    int(components));
+            } else if (key == "LOOKUP_TABLE") {
+                requireWords(words, 3);
+                const uint64_t entries = count(words[2]);
+                if (entries > std::numeric_limits<uint64_t>::max() / 4) badHeader();
+                mReader->skip(entries * 4,
+                    mReader->binary() ? ScalarType::UInt8 : ScalarType::Float32,
+                    "LOOKUP_TABLE section");
+            } else if (key == "FIELD") {
+                requireWords(words, 3);
+                readField(count(words[2]));
+            } else if (key == "METADATA") {
+                skipMetadata();
+            } else {
+                fail(mPath, "unexpected '" + printable(words[0]) + "' in VTK file");
+            }
+        }
+        if (!havePoints) fail(mPath, "missing POINTS section in VTK file");
+        return std::move(mData);
+    }
+
+private:
+    void readHeader()
+    {
+        const std::string_view first = mCursor.line();
+        if (first.substr(0, 14) != "# vtk DataFile") {
+            fail(mPath, "not a legacy VTK file: the first line must start with '# vtk DataFile'");
+        }
+        mCursor.line();  // title, free text
+        if (mCursor.atEnd()) fail(mPath, "truncated VTK header");
+        const std::string_view format = trim(mCursor.line());
+        bool binary = false;
+        if (iequals(format, "BINARY")) {
+            binary = true;
+        } else if (!iequals(format, "ASCII")) {
+            fail(mPath, "bad VTK file type '" + printable(format) + "'; expected ASCII or BINARY");
+        }
+        mReader.reset(new ValueReader(mCursor, binary, /*bigEndian=*/true, mPath));
+
+        mCursor.skipSpace();
+        if (mCursor.atEnd()) fail(mPath, "truncated VTK header");
+        mLine = mCursor.line();
+        const std::vector<std::string_view> words = splitWords(mLine);
+        if (words.size() != 2 || !iequals(words[0], "DATASET")) {
+            fail(mPath, "expected 'DATASET <type>' in VTK file, got '" + printable(mLine) + "'");
+        }
+        if (!iequals(words[1], "UNSTRUCTURED_GRID") && !iequals(words[1], "POLYDATA")) {
+            fail(mPath, "unsupported VTK dataset '" + printable(words[1]) +
+                "'; expected UNSTRUCTURED_GRID or POLYDATA");
+        }
+    }
+
+    [[noreturn]] void badHeader() const
+    {
+        fail(mPath, "bad header '" + printable(mLine) + "' in VTK file");
+    }
+
+    void requireWords(const std::vector<std::string_view>& words, size_t n) const
+    {
+        if (words.size() != n) badHeader();
+    }
+
+    uint64_t count(std::string_view text) const
+    {
+        uint64_t value = 0;
+        if (!parseCount(text, value)) badHeader();
+        return value;
+    }
+
+    ScalarType dataType(std::string_view name) const
+    {
+        ScalarType type;
+        if (!vtkScalarType(name, type)) {
+            fail(mPath, "unsupported VTK data type '" + printable(name) + "'");
+        }
+        return type;
+    }
+
+    void requireAttributeSection(const std::string& key) const
+    {
+        if (!mInPointData && !mInCellData) {
+            fail(mPath, key + " before POINT_DATA or CELL_DATA in VTK file");
+        }
+    }
+
+    void readPoints(const std::vector<std::string_view>& words)
+    {
+        requireWords(words, 3);
+        const uint64_t n = count(words[1]);
+        const ScalarType type = dataType(words[2]);
+        if (type != ScalarType::Float32 && type != ScalarType::Float64) {
+            fail(mPath, "unsupported POINTS type '" + printable(words[2]) +
+                "'; expected float or double");
+        }
+        if (n > std::numeric_limits<uint64_t>::max() / 3) fail(mPath, "truncated POINTS section");
+        mReader->requireRoom(3 * n, type, "POINTS section");
+        mData.points.resize(size_t(n));
+        if (type == ScalarType::Float32) {
+            mReader->readInto(size_t(3 * n), type, "POINTS section",
+                reinterpret_cast<unsigned char*>(mData.points.data()));
+        } else {
+            std::vector<double> values(size_t(3 * n));
+            mReader->readInto(values.size(), type, "POINTS section",
+                reinterpret_cast<unsigned char*>(values.data()));
+            for (size_t i = 0; i < size_t(n); ++i) {
+                mData.points[i] = openvdb::Vec3f(
+                    float(values[3 * i]), float(values[3 * i + 1]), float(values[3 * i + 2]));
+            }
+        }
+    }
+
+    /// Cell sections: VTK ≤ 4.2 stores "n size" then size ints (count, indices...);
+    /// VTK 5 stores "nOffsets nConnectivity" then OFFSETS and CONNECTIVITY arrays.
+    void readCells(const std::string& key, const std::vector<std::string_view>& words)
+    {
+        requireWords(words, 3);
+        const uint64_t n = count(words[1]);
+        const uint64_t size = count(words[2]);
+        const bool keep = mWantPolygons && key == "POLYGONS";
+        const std::string section = key + " section";
+
+        const size_t saved = mCursor.pos();
+        if (mCursor.peekWord("OFFSETS")) {
+            mCursor.skipSpace();
+            mLine = mCursor.line();
+            const std::vector<std::string_view> offsetWords = splitWords(mLine);
+            requireWords(offsetWords, 2);
+            const ScalarType offsetType = dataType(offsetWords[1]);
+            std::vector<unsigned char> offsetBytes;
+            if (keep) mReader->read(n, offsetType, section, offsetBytes);
+            else mReader->skip(n, offsetType, section);
+
+            mCursor.skipSpace();
+            mLine = mCursor.line();
+            const std::vector<std::string_view> connWords = splitWords(mLine);
+            if (connWords.size() != 2 || !iequals(connWords[0], "CONNECTIVITY")) badHeader();
+            const ScalarType connType = dataType(connWords[1]);
+            std::vector<unsigned char> connBytes;
+            if (keep) mReader->read(size, connType, section, connBytes);
+            else mReader->skip(size, connType, section);
+
+            if (keep) {
+                if (!isIntegerType(offsetType) || !isIntegerType(connType)) badHeader();
+                const std::vector<int64_t> offsets =
+                    toIntegers(offsetBytes, offsetType, mPath, section);
+                const std::vector<int64_t> conn = toIntegers(connBytes, connType, mPath, section);
+                for (size_t i = 0; i + 1 < offsets.size(); ++i) {
+                    if (offsets[i] < 0 || offsets[i] > offsets[i + 1] ||
+                        uint64_t(offsets[i + 1]) > conn.size()) {
+                        fail(mPath, "bad OFFSETS in " + section);
+                    }
+                    for (int64_t j = offsets[i]; j < offsets[i + 1]; ++j) {
+                        mData.polygons.indices.push_back(checkedIndex(conn[size_t(j)], mPath, section));
+                    }
+                    mData.polygons.offsets.push_back(mData.polygons.indices.size());
+                }
+            }
+            return;
+        }
+        mCursor.setPos(saved);
+
+        if (!keep) {
+            mReader->skip(size, ScalarType::Int32, section);
+            return;
+        }
+        std::vector<unsigned char> bytes;
+        mReader->read(size, ScalarType::Int32, section, bytes);
+        const std::vector<int64_t> values = toIntegers(bytes, ScalarType::Int32, mPath, section);
+        size_t p = 0;
+        for (uint64_t cell = 0; cell < n; ++cell) {
+            if (p >= values.size() || values[p] < 0 ||
+                uint64_t(values[p]) > values.size() - p - 1) {
+                fail(mPath, "truncated " + section);
+            }
+            const size_t corners = size_t(values[p++]);
+            for (size_t j = 0; j < corners; ++j) {
+                mData.polygons.indices.push_back(checkedIndex(values[p++], mPath, section));
+            }
+            mData.polygons.offsets.push_back(mData.polygons.indices.size());
+        }
+    }
+
+    void readAttribute(const std::string& kind, std::string_view name, ScalarType type,
+                       int components)
+    {
+        NumericArray array;
+        array.name = decodeVtkName(name);
+        array.kind = kind;
+        array.type = type;
+        array.components = components;
+        const std::string section = kind + " '" + printable(array.name) + "' section";
+        if (mTupleCount > std::numeric_limits<uint64_t>::max() / uint64_t(components)) {
+            fail(mPath, "truncated " + section);
+        }
+        const uint64_t values = mTupleCount * uint64_t(components);
+        if (mInPointData) {
+            mReader->read(values, type, section, array.bytes);
+            mData.pointArrays.push_back(std::move(array));
+        } else {
+            mReader->skip(values, type, section);
+        }
+    }
+
+    void readField(uint64_t arrayCount)
+    {
+        for (uint64_t i = 0; i < arrayCount; ++i) {
+            mCursor.skipSpace();
+            if (mCursor.atEnd()) fail(mPath, "truncated FIELD section");
+            if (mCursor.peekWord("METADATA")) {
+                mCursor.line();
+                skipMetadata();
+                mCursor.skipSpace();
+            }
+            mLine = mCursor.line();
+            const std::vector<std::string_view> words = splitWords(mLine);
+            if (words.size() == 1 && iequals(words[0], "NULL_ARRAY")) continue;
+            requireWords(words, 4);
+            const uint64_t components = count(words[1]);
+            const uint64_t tuples = count(words[2]);
+            const ScalarType type = dataType(words[3]);
+            if (components < 1 || components > 4096) badHeader();
+
+            NumericArray array;
+            array.name = decodeVtkName(words[0]);
+            array.kind = "FIELD";
+            array.type = type;
+            array.components = int(components);
+            const std::string section = "FIELD array '" + printable(array.name) + "'";
+            if (tuples > std::numeric_limits<uint64_t>::max() / components) {
+                fail(mPath, "truncated " + section);
+            }
+            if (mInPointData) {
+                if (tuples != mTupleCount) {
+                    fail(mPath, section + " has " + std::to_string(tuples) +
+                        " tuples but POINT_DATA has " + std::to_string(mTupleCount));
+                }
+                mReader->read(tuples * components, type, section, array.bytes);
+                mData.pointArrays.push_back(std::move(array));
+            } else {
+                mReader->skip(tuples * components, type, section);
+            }
+        }
+    }
+
+    /// A METADATA block (VTK 5) is text lines up to the first blank line.
+    void skipMetadata()
+    {
+        while (!mCursor.atEnd()) {
+            if (trim(mCursor.line()).empty()) break;
+        }
+    }
+
+    Cursor mCursor;
+    const std::string& mPath;
+    bool mWantPolygons;
+    std::unique_ptr<ValueReader> mReader;
+    std::string_view mLine;       ///< the header line being interpreted, for messages
+    bool mInPointData = false;
+    bool mInCellData = false;
+    uint64_t mTupleCount = 0;
+    VtkData mData;
+};
+
+} // namespace
+
+VtkData
+parseVtk(const char* data, size_t size, const std::string& path, bool wantPolygons)
+{
+    return VtkParser(data, size, path, wantPolygons).parse();
+}
+
+// ------------------------------------------------------------------------------------------
+// PLY
+
+namespace {
+
+bool
+plyScalarType(std::string_view name, ScalarType& type)
+{
+    struct Entry { const char* name; ScalarType type; };
+    static const Entry kTable[] = {
+        {"char", ScalarType::Int8}, {"int8", ScalarType::Int8},
+        {"uchar", ScalarType::UInt8}, {"uint8", ScalarType::UInt8},
+        {"short", ScalarType::Int16}, {"int16", ScalarType::Int16},
+        {"ushort", ScalarType::UInt16}, {"uint16", ScalarType::UInt16},
+        {"int", ScalarType::Int32}, {"int32", ScalarType::Int32},
+        {"uint", ScalarType::UInt32}, {"uint32", ScalarType::UInt32},
+        {"int64", ScalarType::Int64}, {"uint64", ScalarType::UInt64},
+        {"float", ScalarType::Float32}, {"float32", ScalarType::Float32},
+        {"double", ScalarType::Float64}, {"float64", ScalarType::Float64},
+    };
+    for (const Entry& entry : kTable) {
+        if (name == entry.name) {
+            type = entry.type;
+            return true;
+        }
+    }
+    return false;
+}
+
+struct PlyProperty
+{
+    std::string name;
+    ScalarType type = ScalarType::Float32;   ///< value type (of the items, for lists)
+    bool isList = false;
+    ScalarType countType = ScalarType::UInt8;
+};
+
+struct PlyElement
+{
+    std::string name;
+    uint64_t count = 0;
+    std::vector<PlyProperty> properties;
+};
+
+class PlyParser
+{
+public:
+    PlyParser(const char* data, size_t size, const std::string& path, bool wantFaces)
+        : mCursor(data, size), mPath(path), mWantFaces(wantFaces) {}
+
+    PlyData parse()
+    {
+        readHeader();
+        bool haveVertices = false, haveFaces = false;
+        for (const PlyElement& element : mElements) {
+            if (haveVertices && (haveFaces || !mWantFaces)) break;  // the rest is not needed
+            if (element.name == "vertex" && !haveVertices) {
+                readVertices(element);
+                haveVertices = true;
+            } else if (element.name == "face" && mWantFaces && !haveFaces) {
+                readFaces(element);
+                haveFaces = true;
+            } else {
+                skipElement(element);
+            }
+        }
+        if (!haveVertices) fail(mPath, "PLY file has no vertex element");
+        return std::move(mData);
+    }
+
+private:
+    void readHeader()
+    {
+        if (trim(mCursor.line()) != "ply") fail(mPath, "not a PLY file: the first line must be 'ply'");
+        bool haveFormat = false;
+        for (;;) {
+            if (mCursor.atEnd()) fail(mPath, "truncated PLY header: no end_header line");
+            const std::string_view line = mCursor.line();
+            const std::vector<std::string_view> words = splitWords(line);
+            if (words.empty()) continue;
+            const std::string_view key = words[0];
+            if (key == "end_header") break;
+            if (key == "comment" || key == "obj_info") continue;
+            if (key == "format") {
+                if (words.size() != 3) badHeader(line);
+                bool binary = true, bigEndian = false;
+                if (words[1] == "ascii") binary = false;
+                else if (words[1] == "binary_big_endian") bigEndian = true;
+                else if (words[1] != "binary_little_endian") {
+                    fail(mPath, "unsupported PLY format '" + printable(words[1]) +
+                        "'; expected ascii, binary_little_endian or binary_big_endian");
+                }
+                mReader.reset(new ValueReader(mCursor, binary, bigEndian, mPath));
+                haveFormat = true;
+            } else if (key == "element") {
+                if (words.size() != 3) badHeader(line);
+                PlyElement element;
+                element.name = std::string(words[1]);
+                if (!parseCount(words[2], element.count)) badHeader(line);
+                mElements.push_back(std::move(element));
+            } else if (key == "property") {
+                if (mElements.empty()) badHeader(line);
+                PlyProperty property;
+                if (words.size() == 5 && words[1] == "list") {
+                    property.isList = true;
+                    if (!plyScalarType(words[2], property.countType) ||
+                        !plyScalarType(words[3], property.type) ||
+                        !isIntegerType(property.countType)) badHeader(line);
+                    property.name = std::string(words[4]);
+                } else if (words.size() == 3) {
+                    if (!plyScalarType(words[1], property.type)) badHeader(line);
+                    property.name = std::string(words[2]);
+                } else {
+                    badHeader(line);
+                }
+                mElements.back().properties.push_back(std::move(property));
+            } else {
+                badHeader(line);
+            }
+        }
+        if (!haveFormat) fail(mPath, "PLY header has no format line");
+    }
+
+    [[noreturn]] void badHeader(std::string_view line) const
+    {
+        fail(mPath, "bad PLY header line '" + printable(line) + "'");
+    }
+
+    /// Fail unless @a element's records can fit in the bytes left (before allocating).
+    void requireRoom(const PlyElement& element, const std::string& section) const
+    {
+        // Binary records need at least their scalars and list lengths; a text value at
+        // least one character and a separator (the last one may lack it).
+        uint64_t minRecord = 0;
+        for (const PlyProperty& property : element.properties) {
+            minRecord += mReader->binary()
+                ? scalarSize(property.isList ? property.countType : property.type) : 2;
+        }
+        const uint64_t room = uint64_t(mCursor.remaining()) + (mReader->binary() ? 0 : 1);
+        if (minRecord > 0 && element.count > room / minRecord) {
+            fail(mPath, "truncated " + section);
+        }
+    }
+
+    void skipList(const PlyProperty& property, const std::string& section)
+    {
+        const int64_t n = mReader->readInteger(property.countType, section);
+        if (n < 0) fail(mPath, "negative list length in " + section);
+        mReader->skip(uint64_t(n), property.type, section);
+    }
+
+    void readVertices(const PlyElement& element)
+    {
+        const std::string section = "PLY vertex element";
+        for (const char* axis : {"x", "y", "z"}) {
+            const auto found = std::find_if(element.properties.begin(), element.properties.end(),
+                [axis](const PlyProperty& p) { return !p.isList && p.name == axis; });
+            if (found == element.properties.end()) {
+                fail(mPath, std::string("PLY vertex element has no '") + axis + "' property");
+            }
+        }
+        requireRoom(element, section);
+        mData.vertexCount = size_t(element.count);
+        std::vector<NumericArray*> columns(element.properties.size(), nullptr);
+        for (const PlyProperty& property : element.properties) {
+            if (property.isList) continue;
+            NumericArray array;
+            array.name = property.name;
+            array.kind = "PLY";
+            array.type = property.type;
+            array.components = 1;
+            array.bytes.resize(mData.vertexCount * scalarSize(property.type));
+            mData.vertexProperties.push_back(std::move(array));
+        }
+        for (size_t p = 0, column = 0; p < element.properties.size(); ++p) {
+            if (!element.properties[p].isList) columns[p] = &mData.vertexProperties[column++];
+        }
+        for (size_t i = 0; i < mData.vertexCount; ++i) {
+            for (size_t p = 0; p < element.properties.size(); ++p) {
+                const PlyProperty& property = element.properties[p];
+                if (property.isList) {
+                    skipList(property, section);
+                } else {
+                    const size_t width = scalarSize(property.type);
+                    mReader->readInto(1, property.type, section,
+                        columns[p]->bytes.data() + i * width);
+                }
+            }
+        }
+    }
+
+    void readFaces(const PlyElement& element)
+    {
+        const std::string section = "PLY face element";
+        requireRoom(element, section);
+        size_t indexProperty = element.properties.size();
+        for (size_t p = 0; p < element.properties.size(); ++p) {
+            const PlyProperty& property = element.properties[p];
+            if (property.isList && (property.name == "vertex_indices" ||
+                                    property.name == "vertex_index")) {
+                indexProperty = p;
+                break;
+            }
+        }
+        if (indexProperty == element.properties.size()) {
+            fail(mPath, "PLY face element has no vertex_indices list");
+        }
+        if (!isIntegerType(element.properties[indexProperty].type)) {
+            fail(mPath, "PLY vertex_indices must be integers");
+        }
+        PolygonList& faces = mData.faces;
+        faces.offsets.reserve(size_t(element.count) + 1);
+        unsigned char bytes[8];
+        for (uint64_t i = 0; i < element.count; ++i) {
+            for (size_t p = 0; p < element.properties.size(); ++p) {
+                const PlyProperty& property = element.properties[p];
+                if (p != indexProperty) {
+                    if (property.isList) skipList(property, section);
+                    else mReader->skip(1, property.type, section);
+                    continue;
+                }
+                const int64_t n = mReader->readInteger(property.countType, section);
+                if (n < 0) fail(mPath, "negative list length in " + section);
+                mReader->requireRoom(uint64_t(n), property.type, section);
+                for (int64_t j = 0; j < n; ++j) {
+                    mReader->readInto(1, property.type, section, bytes);
+                    int64_t index = 0;
+                    if (!integerValue(bytes, property.type, index)) {
+                        fail(mPath, "integer out of range in " + section);
+                    }
+                    faces.indices.push_back(checkedIndex(index, mPath, section));
+                }
+                faces.offsets.push_back(faces.indices.size());
+            }
+        }
+    }
+
+    void skipElement(const PlyElement& element)
+    {
+        const std::string section = "PLY " + printable(element.name) + " element";
+        if (element.properties.empty()) return;  // nothing stored, whatever the count
+        requireRoom(element, section);
+        bool fixedSize = mReader->binary();
+        uint64_t recordSize = 0;
+        for (const PlyProperty& property : element.properties) {
+            fixedSize = fixedSize && !property.isList;
+            recordSize += scalarSize(property.type);
+        }
+        if (fixedSize) {
+            // requireRoom() checked count × recordSize against the bytes left.
+            mReader->skip(element.count * recordSize, ScalarType::UInt8, section);
+            return;
+        }
+        for (uint64_t i = 0; i < element.count; ++i) {
+            for (const PlyProperty& property : element.properties) {
+                if (property.isList) skipList(property, section);
+                else mReader->skip(1, property.type, section);
+            }
+        }
+    }
+
+    Cursor mCursor;
+    const std::string& mPath;
+    bool mWantFaces;
+    std::unique_ptr<ValueReader> mReader;
+    std::vector<PlyElement> mElements;
+    PlyData mData;
+};
+
+} // namespace
+
+PlyData
+parsePly(const char* data, size_t size, const std::string& path, bool wantFaces)
+{
+    return PlyParser(data, size, path, wantFaces).parse();
+}
+
+} // namespace io_internal
+} // namespace nonbloppy
