@@ -252,10 +252,7 @@ void validate(const MeshOptions& o)
     if (::stat(o.input.c_str(), &info) != 0) {
         throw nonbloppy::FileError("cannot open " + o.input + ": " + std::strerror(errno));
     }
-    if (!nonbloppy::isParticleFile(o.input)) {
-        throw nonbloppy::FileError("cannot read " + o.input + ": unknown particle file extension \""
-                                   + lowerExtension(o.input) + "\"");
-    }
+    // An unknown input extension is reported by readParticles(), before it reads a byte.
 
     std::vector<std::string> outputs{o.output};
     if (!o.vdbPath.empty()) outputs.push_back(o.vdbPath);

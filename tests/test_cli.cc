@@ -1,0 +1,388 @@
+// SPDX-License-Identifier: Apache-2.0
+/// @file test_cli.cc
+/// @brief Runs the built `nonbloppy` tool (NONBLOPPY_CLI_PATH) as a user would: outputs,
+///        `inspect`, one-line errors with exact messages, no files left after a failure,
+///        thread-count independence.
+
+#include <gtest/gtest.h>
+
+#include <openvdb/version.h>
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace {
+
+namespace fs = std::filesystem;
+
+const std::string kCli = NONBLOPPY_CLI_PATH;
+const std::string kData = NONBLOPPY_TEST_DATA_DIR;
+const std::string kCube = kData + "/cube_2366_particles.vtk";
+
+std::string readText(const std::string& path)
+{
+    std::ifstream in(path, std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+void writeText(const std::string& path, const std::string& text)
+{
+    std::ofstream out(path, std::ios::binary);
+    out << text;
+}
+
+std::string quote(const std::string& s)
+{
+    std::string out = "'";
+    for (char c : s) {
+        if (c == '\'') out += "'\\''";
+        else out += c;
+    }
+    return out + "'";
+}
+
+std::vector<std::string> lines(const std::string& text)
+{
+    std::vector<std::string> out;
+    std::istringstream in(text);
+    for (std::string line; std::getline(in, line);) out.push_back(line);
+    return out;
+}
+
+/// Names of the entries of @a dir, sorted.
+std::vector<std::string> listDir(const std::string& dir)
+{
+    std::vector<std::string> names;
+    for (const auto& entry : fs::directory_iterator(dir)) {
+        names.push_back(entry.path().filename().string());
+    }
+    std::sort(names.begin(), names.end());
+    return names;
+}
+
+struct RunResult
+{
+    int exitCode = -1;
+    std::string out, err;
+};
+
+/// A fresh directory per test under ::testing::TempDir(), removed afterwards.
+class CliTest : public ::testing::Test
+{
+protected:
+    void SetUp() override
+    {
+        const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+        mDir = (fs::path(::testing::TempDir()) / ("nonbloppy_cli_" + std::string(info->name())
+                                                  + "_" + std::to_string(::getpid())))
+                   .string();
+        fs::remove_all(mDir);
+        fs::create_directories(mDir + "/out");
+        fs::create_directories(mDir + "/in");
+    }
+    void TearDown() override
+    {
+        std::error_code ec;
+        fs::remove_all(mDir, ec);
+    }
+
+    /// Run `nonbloppy ARGS` (ARGS already shell-quoted) with stdout and stderr in files.
+    RunResult run(const std::string& args) const
+    {
+        const std::string outFile = mDir + "/stdout.txt", errFile = mDir + "/stderr.txt";
+        const std::string command = quote(kCli) + " " + args + " >" + quote(outFile) + " 2>"
+                                    + quote(errFile) + " </dev/null";
+        const int status = std::system(command.c_str());
+        RunResult result;
+        result.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+        result.out = readText(outFile);
+        result.err = readText(errFile);
+        return result;
+    }
+
+    std::string dir() const { return mDir; }
+    std::string out(const std::string& name) const { return mDir + "/out/" + name; }
+    std::string in(const std::string& name) const { return mDir + "/in/" + name; }
+
+    /// The failure contract: non-zero exit, exactly one stderr line, equal to @a message,
+    /// and nothing (not even a temporary file) in the output directory.
+    void expectFailure(const std::string& args, const std::string& message) const
+    {
+        SCOPED_TRACE(args);
+        const RunResult r = run(args);
+        EXPECT_NE(r.exitCode, 0);
+        EXPECT_LT(r.exitCode, 128) << "crashed";
+        const std::vector<std::string> errLines = lines(r.err);
+        ASSERT_EQ(errLines.size(), 1u) << r.err;
+        EXPECT_EQ(errLines[0], "nonbloppy: " + message);
+        EXPECT_TRUE(listDir(mDir + "/out").empty()) << "output files left behind";
+    }
+
+    /// Mesh the cube into out/NAME.obj and out/NAME.vdb; returns the run.
+    RunResult meshCube(const std::string& name, const std::string& extra = "") const
+    {
+        return run("mesh " + quote(kCube) + " -o " + quote(out(name + ".obj")) + " --vdb "
+                   + quote(out(name + ".vdb")) + " " + extra);
+    }
+
+private:
+    std::string mDir;
+};
+
+/// The number after `"key": ` in a JSON text, NaN when absent.
+double jsonNumber(const std::string& json, const std::string& key)
+{
+    const std::string needle = "\"" + key + "\": ";
+    const size_t at = json.find(needle);
+    if (at == std::string::npos) return std::nan("");
+    return std::strtod(json.c_str() + at + needle.size(), nullptr);
+}
+
+} // namespace
+
+TEST_F(CliTest, MeshWritesObjAndVdbAndSummary)
+{
+    const RunResult r = meshCube("cube");
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_TRUE(r.err.empty()) << r.err;
+    EXPECT_NE(r.out.find("particles"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("2366"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("(derived)"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("rasterize density"), std::string::npos) << r.out;
+    EXPECT_EQ(listDir(dir() + "/out"), (std::vector<std::string>{"cube.obj", "cube.vdb"}));
+    EXPECT_GT(fs::file_size(out("cube.obj")), 1000u);
+    EXPECT_GT(fs::file_size(out("cube.vdb")), 1000u);
+}
+
+TEST_F(CliTest, QuietPrintsNothing)
+{
+    const RunResult r = meshCube("cube", "--quiet");
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_TRUE(r.out.empty()) << r.out;
+    EXPECT_TRUE(r.err.empty()) << r.err;
+}
+
+TEST_F(CliTest, VerbosePrintsStagesOnStderr)
+{
+    const RunResult r = meshCube("cube", "-v");
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_NE(r.err.find("read particles"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("write mesh"), std::string::npos) << r.err;
+}
+
+TEST_F(CliTest, GivenParametersAreMarkedGiven)
+{
+    const RunResult r = meshCube("cube", "--radius 0.1 -c 0.5 -t 1");
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_NE(r.out.find("(given)"), std::string::npos) << r.out;
+}
+
+TEST_F(CliTest, InspectMeshIsClosedManifoldWithPositiveVolume)
+{
+    ASSERT_EQ(meshCube("cube", "-q").exitCode, 0);
+    const RunResult r = run("inspect --json " + quote(out("cube.obj")));
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_NE(r.out.find("\"closed\": true"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("\"manifold\": true"), std::string::npos) << r.out;
+    EXPECT_GT(jsonNumber(r.out, "vertices"), 0.0) << r.out;
+    EXPECT_GT(jsonNumber(r.out, "faces"), 0.0) << r.out;
+    EXPECT_GT(jsonNumber(r.out, "area"), 0.0) << r.out;
+    // 2366 particles at spacing about 0.05 fill about 2366 · 0.05³ = 0.3 cubic units.
+    const double volume = jsonNumber(r.out, "volume");
+    EXPECT_GT(volume, 0.15) << r.out;
+    EXPECT_LT(volume, 0.6) << r.out;
+}
+
+TEST_F(CliTest, InspectVdbListsDensityGrid)
+{
+    ASSERT_EQ(meshCube("cube", "-q").exitCode, 0);
+    const RunResult text = run("inspect " + quote(out("cube.vdb")));
+    ASSERT_EQ(text.exitCode, 0) << text.err;
+    EXPECT_NE(text.out.find("density  float"), std::string::npos) << text.out;
+    EXPECT_NE(text.out.find("source_file: " + kCube), std::string::npos) << text.out;
+
+    const RunResult json = run("inspect --json " + quote(out("cube.vdb")));
+    ASSERT_EQ(json.exitCode, 0) << json.err;
+    EXPECT_NE(json.out.find("\"grids\": ["), std::string::npos) << json.out;
+    EXPECT_NE(json.out.find("\"name\": \"density\""), std::string::npos) << json.out;
+    EXPECT_GT(jsonNumber(json.out, "active_voxels"), 0.0) << json.out;
+}
+
+TEST_F(CliTest, InspectParticleFile)
+{
+    const RunResult json = run("inspect --json " + quote(kCube));
+    ASSERT_EQ(json.exitCode, 0) << json.err;
+    EXPECT_EQ(jsonNumber(json.out, "particles"), 2366.0) << json.out;
+    EXPECT_GT(jsonNumber(json.out, "spacing"), 0.0) << json.out;
+
+    const RunResult text = run("inspect " + quote(kData + "/dam_break_frame_23_24389_particles.vtk"));
+    ASSERT_EQ(text.exitCode, 0) << text.err;
+    EXPECT_NE(text.out.find("24389"), std::string::npos) << text.out;
+    EXPECT_NE(text.out.find("velocity"), std::string::npos) << text.out;
+}
+
+TEST_F(CliTest, VdbPrintReadsTheCache)
+{
+    if (!fs::exists("/usr/bin/vdb_print")) GTEST_SKIP() << "vdb_print not installed";
+    ASSERT_EQ(meshCube("cube", "-q").exitCode, 0);
+    const std::string command = "/usr/bin/vdb_print -m " + quote(out("cube.vdb")) + " >"
+                                + quote(dir() + "/vdb_print.txt") + " 2>&1";
+    const int status = std::system(command.c_str());
+    ASSERT_TRUE(WIFEXITED(status));
+    EXPECT_EQ(WEXITSTATUS(status), 0) << readText(dir() + "/vdb_print.txt");
+    const std::string printed = readText(dir() + "/vdb_print.txt");
+    EXPECT_NE(printed.find("density"), std::string::npos) << printed;
+    EXPECT_NE(printed.find("effective_radius"), std::string::npos) << printed;
+}
+
+TEST_F(CliTest, OutputDoesNotDependOnThreadCount)
+{
+    ASSERT_EQ(meshCube("t1", "-q --threads 1").exitCode, 0);
+    ASSERT_EQ(meshCube("t2", "-q --threads 2").exitCode, 0);
+    EXPECT_TRUE(readText(out("t1.obj")) == readText(out("t2.obj"))) << "OBJ files differ";
+    EXPECT_TRUE(readText(out("t1.vdb")) == readText(out("t2.vdb"))) << ".vdb files differ";
+}
+
+TEST_F(CliTest, MissingInputFile)
+{
+    const std::string missing = in("missing.vtk");
+    expectFailure("mesh " + quote(missing) + " -o " + quote(out("x.obj")),
+                  "cannot open " + missing + ": No such file or directory");
+}
+
+TEST_F(CliTest, UnknownInputExtension)
+{
+    const std::string path = in("particles.foo");
+    writeText(path, "1 2 3\n");
+    expectFailure("mesh " + quote(path) + " -o " + quote(out("x.obj")),
+                  "unknown particle file extension '.foo' (" + path
+                      + "); expected .vtk, .ply or .xyz");
+}
+
+TEST_F(CliTest, TruncatedInput)
+{
+    const std::string path = in("truncated.vtk");
+    writeText(path, readText(kCube).substr(0, 300));
+    expectFailure("mesh " + quote(path) + " -o " + quote(out("x.obj")),
+                  "truncated POINTS section (" + path + ")");
+}
+
+TEST_F(CliTest, NanCoordinate)
+{
+    const std::string path = in("nan.vtk");
+    writeText(path, "# vtk DataFile Version 3.0\nnan test\nASCII\nDATASET POLYDATA\n"
+                    "POINTS 3 float\n0 0 0\n1 nan 0\n0 1 0\n");
+    const RunResult r = run("mesh " + quote(path) + " -o " + quote(out("x.obj")));
+    EXPECT_NE(r.exitCode, 0);
+    const std::vector<std::string> errLines = lines(r.err);
+    ASSERT_EQ(errLines.size(), 1u) << r.err;
+    // The reader either refuses the token or the value; both name the file.
+    EXPECT_TRUE(errLines[0] == "nonbloppy: non-finite position of particle 1 (" + path + ")"
+                || errLines[0] == "nonbloppy: bad float32 value 'nan' in POINTS section (" + path + ")")
+        << errLines[0];
+    EXPECT_TRUE(listDir(dir() + "/out").empty());
+}
+
+TEST_F(CliTest, ZeroParticles)
+{
+    const std::string path = in("empty.vtk");
+    writeText(path, "# vtk DataFile Version 3.0\nempty\nASCII\nDATASET POLYDATA\nPOINTS 0 float\n");
+    expectFailure("mesh " + quote(path) + " -o " + quote(out("x.obj")), "no particles in " + path);
+}
+
+TEST_F(CliTest, BadParameters)
+{
+    const std::string base = "mesh " + quote(kCube) + " -o " + quote(out("x.obj")) + " --vdb "
+                             + quote(out("x.vdb")) + " ";
+    expectFailure(base + "--radius 0", "--radius must be > 0, got 0");
+    expectFailure(base + "--radius=-1", "--radius must be > 0, got -1");
+    expectFailure(base + "--voxel-size 0", "--voxel-size must be > 0, got 0");
+    expectFailure(base + "--blend 1.5", "--blend must lie in [0,1], got 1.5");
+    expectFailure(base + "--blend=-0.1", "--blend must lie in [0,1], got -0.1");
+    expectFailure(base + "-c 2", "--blend must lie in [0,1], got 2");
+    expectFailure(base + "--iterations=-1", "--iterations must be >= 0, got -1");
+    expectFailure(base + "--adaptivity 1.5", "--adaptivity must lie in [0,1], got 1.5");
+    expectFailure(base + "--threads 0", "--threads must be >= 1, got 0");
+}
+
+TEST_F(CliTest, NegativeValuesWithSpace)
+{
+    // "--radius -1" (with a space) must read -1 as the value, not as an option.
+    expectFailure("mesh " + quote(kCube) + " -o " + quote(out("x.obj")) + " --radius -1",
+                  "--radius must be > 0, got -1");
+    expectFailure("mesh " + quote(kCube) + " -o " + quote(out("x.obj")) + " --blend -0.1",
+                  "--blend must lie in [0,1], got -0.1");
+}
+
+TEST_F(CliTest, OutputInMissingDirectory)
+{
+    const std::string target = dir() + "/no/such/dir/x.obj";
+    expectFailure("mesh " + quote(kCube) + " -o " + quote(target),
+                  "cannot write " + target + ": No such file or directory");
+    // The same for the .vdb cache, before the mesh is written.
+    const std::string vdb = dir() + "/no/such/dir/x.vdb";
+    expectFailure("mesh " + quote(kCube) + " -o " + quote(out("x.obj")) + " --vdb " + quote(vdb),
+                  "cannot write " + vdb + ": No such file or directory");
+}
+
+TEST_F(CliTest, UnknownOutputExtension)
+{
+    const std::string target = out("x.stl");
+    expectFailure("mesh " + quote(kCube) + " -o " + quote(target),
+                  "cannot write " + target + ": unknown mesh extension \".stl\" (use .obj, .ply or .vtk)");
+}
+
+TEST_F(CliTest, UsageErrorsAreOneLine)
+{
+    for (const std::string& args : {std::string(""), std::string("mesh"),
+                                   "mesh " + quote(kCube), std::string("frobnicate"),
+                                   "mesh " + quote(kCube) + " -o x.obj --radius abc"}) {
+        SCOPED_TRACE(args);
+        const RunResult r = run(args);
+        EXPECT_EQ(r.exitCode, 2);
+        const std::vector<std::string> errLines = lines(r.err);
+        ASSERT_EQ(errLines.size(), 1u) << r.err;
+        EXPECT_EQ(errLines[0].rfind("nonbloppy: ", 0), 0u) << errLines[0];
+    }
+}
+
+TEST_F(CliTest, InspectMissingFile)
+{
+    const std::string missing = in("missing.vdb");
+    const RunResult r = run("inspect " + quote(missing));
+    EXPECT_EQ(r.exitCode, 1);
+    EXPECT_EQ(r.err, "nonbloppy: cannot open " + missing + ": No such file or directory\n");
+}
+
+TEST_F(CliTest, VersionAndHelp)
+{
+    const RunResult version = run("--version");
+    EXPECT_EQ(version.exitCode, 0);
+    EXPECT_EQ(version.out, std::string("nonbloppy 0.1.0 (OpenVDB ") + OPENVDB_LIBRARY_VERSION_STRING
+                              + ")\n");
+
+    const RunResult help = run("--help");
+    EXPECT_EQ(help.exitCode, 0);
+    EXPECT_NE(help.out.find("mesh"), std::string::npos) << help.out;
+    EXPECT_NE(help.out.find("inspect"), std::string::npos) << help.out;
+
+    const RunResult meshHelp = run("mesh --help");
+    EXPECT_EQ(meshHelp.exitCode, 0);
+    for (const char* heading : {"Input/output", "Numerical parameters", "Advanced", "Debug"}) {
+        EXPECT_NE(meshHelp.out.find(heading), std::string::npos) << heading << "\n" << meshHelp.out;
+    }
+    const RunResult helpMesh = run("help mesh");
+    EXPECT_EQ(helpMesh.exitCode, 0);
+    EXPECT_EQ(helpMesh.out, meshHelp.out);
+}
