@@ -1,0 +1,106 @@
+// SPDX-License-Identifier: Apache-2.0
+/// @file MeasureMesh.cc
+/// @brief Edge topology (boundary, non-manifold, inconsistent), area and signed volume.
+
+#include <nonbloppy/MeasureMesh.h>
+
+#include <nonbloppy/Error.h>
+
+#include <algorithm>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace nonbloppy {
+
+namespace {
+
+/// An undirected edge (low, high) packed into one key, plus the direction it was used in.
+struct EdgeUse
+{
+    uint64_t key;
+    bool forward;  ///< used as low → high
+
+    bool operator<(const EdgeUse& other) const
+    {
+        return key < other.key || (key == other.key && forward < other.forward);
+    }
+};
+
+void
+addEdge(std::vector<EdgeUse>& edges, uint32_t from, uint32_t to)
+{
+    if (from == to) return;  // a collapsed edge of a degenerate polygon bounds nothing
+    const uint32_t low = std::min(from, to), high = std::max(from, to);
+    edges.push_back({(uint64_t(low) << 32) | high, from < to});
+}
+
+/// Adds the area and the signed volume of the tetrahedron (origin, p0, p1, p2).
+void
+addTriangle(const SurfaceMesh& mesh, uint32_t i0, uint32_t i1, uint32_t i2, MeshMeasures& m)
+{
+    const openvdb::Vec3d p0(mesh.points[i0]), p1(mesh.points[i1]), p2(mesh.points[i2]);
+    m.area += 0.5 * (p1 - p0).cross(p2 - p0).length();
+    // Divergence theorem: the volume is the sum over faces of p0 · (p1 × p2) / 6.
+    m.volume += p0.dot(p1.cross(p2)) / 6.0;
+}
+
+} // namespace
+
+MeshMeasures
+measureMesh(const SurfaceMesh& mesh)
+{
+    MeshMeasures m;
+    m.vertices = mesh.points.size();
+    m.polygons = mesh.polygonCount();
+
+    std::vector<bool> used(mesh.points.size(), false);
+    auto use = [&](size_t polygon, uint32_t index) {
+        if (index >= mesh.points.size()) {
+            throw ParameterError("polygon " + std::to_string(polygon) + " references vertex " +
+                std::to_string(index) + " but the mesh has " +
+                std::to_string(mesh.points.size()) + " vertices");
+        }
+        used[index] = true;
+    };
+
+    std::vector<EdgeUse> edges;
+    edges.reserve(3 * mesh.triangles.size() + 4 * mesh.quads.size());
+    size_t polygon = 0;
+    for (const openvdb::Vec3I& t : mesh.triangles) {
+        for (int i = 0; i < 3; ++i) use(polygon, t[i]);
+        for (int i = 0; i < 3; ++i) addEdge(edges, t[i], t[(i + 1) % 3]);
+        addTriangle(mesh, t[0], t[1], t[2], m);
+        ++polygon;
+    }
+    for (const openvdb::Vec4I& q : mesh.quads) {
+        for (int i = 0; i < 4; ++i) use(polygon, q[i]);
+        for (int i = 0; i < 4; ++i) addEdge(edges, q[i], q[(i + 1) % 4]);
+        addTriangle(mesh, q[0], q[1], q[2], m);
+        addTriangle(mesh, q[0], q[2], q[3], m);
+        ++polygon;
+    }
+    m.unusedVertices = size_t(std::count(used.begin(), used.end(), false));
+
+    std::sort(edges.begin(), edges.end());
+    for (size_t begin = 0; begin < edges.size();) {
+        size_t end = begin;
+        size_t forward = 0;
+        while (end < edges.size() && edges[end].key == edges[begin].key) {
+            forward += edges[end].forward ? 1 : 0;
+            ++end;
+        }
+        const size_t uses = end - begin;
+        const size_t backward = uses - forward;
+        if (uses == 1) ++m.boundaryEdges;
+        else if (uses >= 3) ++m.nonManifoldEdges;
+        else if (forward == 2 || backward == 2) ++m.inconsistentEdges;
+        begin = end;
+    }
+
+    m.closed = m.polygons > 0 && m.boundaryEdges == 0;
+    m.manifold = m.closed && m.nonManifoldEdges == 0 && m.inconsistentEdges == 0;
+    return m;
+}
+
+} // namespace nonbloppy

@@ -1,0 +1,291 @@
+// SPDX-License-Identifier: Apache-2.0
+/// @file WriteMesh.cc
+/// @brief Stage "write mesh": OBJ, binary little-endian PLY and legacy binary VTK POLYDATA.
+///
+/// Each writer formats into a large in-memory chunk that is handed to the stream a few
+/// megabytes at a time, instead of one ostream operation per value, and goes through
+/// AtomicFile so a failed write never leaves a partial mesh behind.
+
+#include <nonbloppy/WriteMesh.h>
+
+#include <nonbloppy/Error.h>
+
+#include "AtomicFile.h"
+#include "FileFormats.h"
+
+#include <charconv>
+#include <cstdint>
+#include <cstring>
+#include <limits>
+#include <ostream>
+
+namespace nonbloppy {
+
+namespace {
+
+/// Collects output bytes and passes them on to the stream in large chunks.
+class ChunkWriter
+{
+public:
+    explicit ChunkWriter(std::ostream& os) : mStream(os) { mBuffer.reserve(kChunk + 4096); }
+    ~ChunkWriter() = default;
+
+    void text(const char* s) { mBuffer.append(s); maybeFlush(); }
+    void text(const std::string& s) { mBuffer.append(s); maybeFlush(); }
+    void bytes(const void* p, size_t n)
+    {
+        mBuffer.append(static_cast<const char*>(p), n);
+        maybeFlush();
+    }
+    void character(char ch) { mBuffer.push_back(ch); }
+
+    /// Shortest decimal text that reads back as exactly @a value (deterministic).
+    void number(float value)
+    {
+        char digits[32];
+        const auto result = std::to_chars(digits, digits + sizeof(digits), value);
+        mBuffer.append(digits, size_t(result.ptr - digits));
+    }
+    void number(uint64_t value)
+    {
+        char digits[24];
+        const auto result = std::to_chars(digits, digits + sizeof(digits), value);
+        mBuffer.append(digits, size_t(result.ptr - digits));
+    }
+
+    template<typename T>
+    void littleEndian(T value)
+    {
+        static_assert(sizeof(T) == 4, "4-byte values only");
+        uint32_t bits;
+        std::memcpy(&bits, &value, 4);
+        if (__BYTE_ORDER__ == __ORDER_BIG_ENDIAN__) bits = __builtin_bswap32(bits);
+        bytes(&bits, 4);
+    }
+    template<typename T>
+    void bigEndian(T value)
+    {
+        static_assert(sizeof(T) == 4, "4-byte values only");
+        uint32_t bits;
+        std::memcpy(&bits, &value, 4);
+        if (__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__) bits = __builtin_bswap32(bits);
+        bytes(&bits, 4);
+    }
+
+    void maybeFlush()
+    {
+        if (mBuffer.size() >= kChunk) flush();
+    }
+    void flush()
+    {
+        mStream.write(mBuffer.data(), std::streamsize(mBuffer.size()));
+        mBuffer.clear();
+    }
+
+private:
+    static constexpr size_t kChunk = size_t(4) << 20;
+    std::ostream& mStream;
+    std::string mBuffer;
+};
+
+/// The polygons as they will be written: triangles first, then quads (kept or split).
+struct PolygonView
+{
+    const SurfaceMesh& mesh;
+    bool keepQuads;
+
+    size_t triangleCount() const
+    {
+        return mesh.triangles.size() + (keepQuads ? 0 : 2 * mesh.quads.size());
+    }
+    size_t quadCount() const { return keepQuads ? mesh.quads.size() : 0; }
+    size_t polygonCount() const { return triangleCount() + quadCount(); }
+    size_t cornerCount() const { return 3 * triangleCount() + 4 * quadCount(); }
+
+    /// Call op(const uint32_t* corners, int n) for every written polygon, in order.
+    template<typename OpT>
+    void forEach(OpT op) const
+    {
+        for (const openvdb::Vec3I& t : mesh.triangles) {
+            const uint32_t corners[3] = {t[0], t[1], t[2]};
+            op(corners, 3);
+        }
+        for (const openvdb::Vec4I& q : mesh.quads) {
+            if (keepQuads) {
+                const uint32_t corners[4] = {q[0], q[1], q[2], q[3]};
+                op(corners, 4);
+            } else {
+                const uint32_t first[3] = {q[0], q[1], q[2]};
+                const uint32_t second[3] = {q[0], q[2], q[3]};
+                op(first, 3);
+                op(second, 3);
+            }
+        }
+    }
+};
+
+/// A mesh with out-of-range indices would produce a file every reader rejects.
+void
+validateMesh(const SurfaceMesh& mesh, const std::string& path)
+{
+    const size_t vertexCount = mesh.points.size();
+    if (!mesh.normals.empty() && mesh.normals.size() != vertexCount) {
+        throw ParameterError("mesh has " + std::to_string(mesh.normals.size()) +
+            " normals for " + std::to_string(vertexCount) + " vertices (" + path + ")");
+    }
+    auto check = [&](size_t polygon, uint32_t index) {
+        if (index >= vertexCount) {
+            throw ParameterError("polygon " + std::to_string(polygon) + " references vertex " +
+                std::to_string(index) + " but the mesh has " + std::to_string(vertexCount) +
+                " vertices (" + path + ")");
+        }
+    };
+    size_t polygon = 0;
+    for (const openvdb::Vec3I& t : mesh.triangles) {
+        for (int i = 0; i < 3; ++i) check(polygon, t[i]);
+        ++polygon;
+    }
+    for (const openvdb::Vec4I& q : mesh.quads) {
+        for (int i = 0; i < 4; ++i) check(polygon, q[i]);
+        ++polygon;
+    }
+}
+
+void
+writeObj(const SurfaceMesh& mesh, const PolygonView& polygons, std::ostream& os)
+{
+    ChunkWriter out(os);
+    out.text("# nonbloppy surface mesh\n");
+    for (const openvdb::Vec3s& p : mesh.points) {
+        out.text("v ");
+        out.number(p[0]);
+        out.character(' ');
+        out.number(p[1]);
+        out.character(' ');
+        out.number(p[2]);
+        out.character('\n');
+        out.maybeFlush();
+    }
+    const bool withNormals = !mesh.normals.empty();
+    for (const openvdb::Vec3s& n : mesh.normals) {
+        out.text("vn ");
+        out.number(n[0]);
+        out.character(' ');
+        out.number(n[1]);
+        out.character(' ');
+        out.number(n[2]);
+        out.character('\n');
+        out.maybeFlush();
+    }
+    polygons.forEach([&](const uint32_t* corners, int n) {
+        out.character('f');
+        for (int i = 0; i < n; ++i) {
+            const uint64_t oneBased = uint64_t(corners[i]) + 1;
+            out.character(' ');
+            out.number(oneBased);
+            if (withNormals) {
+                out.text("//");
+                out.number(oneBased);
+            }
+        }
+        out.character('\n');
+        out.maybeFlush();
+    });
+    out.flush();
+}
+
+void
+requireInt32(size_t value, const char* what, const std::string& path)
+{
+    if (value > size_t(std::numeric_limits<int32_t>::max())) {
+        throw FileError(std::string("too many ") + what + " for 32-bit indices (" + path + ")");
+    }
+}
+
+void
+writePly(const SurfaceMesh& mesh, const PolygonView& polygons, const std::string& path,
+         std::ostream& os)
+{
+    requireInt32(mesh.points.size(), "vertices", path);
+    const bool withNormals = !mesh.normals.empty();
+    ChunkWriter out(os);
+    out.text("ply\nformat binary_little_endian 1.0\ncomment written by nonbloppy\n");
+    out.text("element vertex " + std::to_string(mesh.points.size()) + "\n");
+    out.text("property float x\nproperty float y\nproperty float z\n");
+    if (withNormals) out.text("property float nx\nproperty float ny\nproperty float nz\n");
+    out.text("element face " + std::to_string(polygons.polygonCount()) + "\n");
+    out.text("property list uchar int vertex_indices\nend_header\n");
+    for (size_t i = 0; i < mesh.points.size(); ++i) {
+        for (int axis = 0; axis < 3; ++axis) out.littleEndian(float(mesh.points[i][axis]));
+        if (withNormals) {
+            for (int axis = 0; axis < 3; ++axis) out.littleEndian(float(mesh.normals[i][axis]));
+        }
+    }
+    polygons.forEach([&](const uint32_t* corners, int n) {
+        out.character(char(n));
+        for (int i = 0; i < n; ++i) out.littleEndian(int32_t(corners[i]));
+    });
+    out.flush();
+}
+
+void
+writeVtk(const SurfaceMesh& mesh, const PolygonView& polygons, const std::string& path,
+         std::ostream& os)
+{
+    requireInt32(mesh.points.size(), "vertices", path);
+    requireInt32(polygons.polygonCount() + polygons.cornerCount(), "polygon corners", path);
+    ChunkWriter out(os);
+    out.text("# vtk DataFile Version 3.0\nnonbloppy surface mesh\nBINARY\nDATASET POLYDATA\n");
+    out.text("POINTS " + std::to_string(mesh.points.size()) + " float\n");
+    for (const openvdb::Vec3s& p : mesh.points) {
+        for (int axis = 0; axis < 3; ++axis) out.bigEndian(float(p[axis]));
+    }
+    out.text("\nPOLYGONS " + std::to_string(polygons.polygonCount()) + " " +
+        std::to_string(polygons.polygonCount() + polygons.cornerCount()) + "\n");
+    polygons.forEach([&](const uint32_t* corners, int n) {
+        out.bigEndian(int32_t(n));
+        for (int i = 0; i < n; ++i) out.bigEndian(int32_t(corners[i]));
+    });
+    out.text("\n");
+    if (!mesh.normals.empty()) {
+        out.text("POINT_DATA " + std::to_string(mesh.points.size()) +
+            "\nNORMALS normals float\n");
+        for (const openvdb::Vec3s& n : mesh.normals) {
+            for (int axis = 0; axis < 3; ++axis) out.bigEndian(float(n[axis]));
+        }
+        out.text("\n");
+    }
+    out.flush();
+}
+
+} // namespace
+
+void
+writeMesh(const SurfaceMesh& mesh, const std::string& path, const MeshWriteSettings& settings)
+{
+    const std::string ext = io_internal::lowerExtension(path);
+    if (ext.empty()) {
+        throw FileError("mesh file name has no extension (" + path +
+            "); expected .obj, .ply or .vtk");
+    }
+    if (!isMeshFile(path)) {
+        throw FileError("unknown mesh file extension '" + ext + "' (" + path +
+            "); expected .obj, .ply or .vtk");
+    }
+    validateMesh(mesh, path);
+    const PolygonView polygons{mesh, settings.keepQuads};
+    writeFileAtomically(path, [&](std::ostream& os) {
+        if (ext == ".obj") writeObj(mesh, polygons, os);
+        else if (ext == ".ply") writePly(mesh, polygons, path, os);
+        else writeVtk(mesh, polygons, path, os);
+    });
+}
+
+bool
+isMeshFile(const std::string& path)
+{
+    const std::string ext = io_internal::lowerExtension(path);
+    return ext == ".obj" || ext == ".ply" || ext == ".vtk";
+}
+
+} // namespace nonbloppy
