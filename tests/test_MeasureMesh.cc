@@ -1,0 +1,189 @@
+// SPDX-License-Identifier: Apache-2.0
+// Tests for measureMesh(): closed and open boxes, flipped faces, non-manifold edges, area
+// and signed volume.
+
+#include <nonbloppy/Error.h>
+#include <nonbloppy/MeasureMesh.h>
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+
+namespace {
+
+using nonbloppy::MeshMeasures;
+using nonbloppy::SurfaceMesh;
+using nonbloppy::measureMesh;
+
+/// The cube [0,1]³ (scaled by @a size and moved by @a offset) as six quads,
+/// counter-clockwise seen from outside.
+SurfaceMesh
+cube(float size = 1.0f, const openvdb::Vec3s& offset = openvdb::Vec3s(0.0f))
+{
+    SurfaceMesh mesh;
+    for (int i = 0; i < 8; ++i) {
+        mesh.points.push_back(offset +
+            size * openvdb::Vec3s(float(i & 1), float((i >> 1) & 1), float((i >> 2) & 1)));
+    }
+    mesh.quads = {
+        {0, 2, 3, 1}, {4, 5, 7, 6},  // z = 0, z = 1
+        {0, 1, 5, 4}, {2, 6, 7, 3},  // y = 0, y = 1
+        {0, 4, 6, 2}, {1, 3, 7, 5},  // x = 0, x = 1
+    };
+    return mesh;
+}
+
+SurfaceMesh
+reversed(SurfaceMesh mesh)
+{
+    for (openvdb::Vec4I& q : mesh.quads) std::swap(q[1], q[3]);
+    for (openvdb::Vec3I& t : mesh.triangles) std::swap(t[1], t[2]);
+    return mesh;
+}
+
+SurfaceMesh
+triangulated(SurfaceMesh mesh)
+{
+    for (const openvdb::Vec4I& q : mesh.quads) {
+        mesh.triangles.emplace_back(q[0], q[1], q[2]);
+        mesh.triangles.emplace_back(q[0], q[2], q[3]);
+    }
+    mesh.quads.clear();
+    return mesh;
+}
+
+TEST(MeasureMesh, UnitCubeOfQuadsIsClosedManifoldWithAreaSixAndVolumeOne)
+{
+    const MeshMeasures m = measureMesh(cube());
+    EXPECT_EQ(m.vertices, 8u);
+    EXPECT_EQ(m.polygons, 6u);
+    EXPECT_EQ(m.unusedVertices, 0u);
+    EXPECT_EQ(m.boundaryEdges, 0u);
+    EXPECT_EQ(m.nonManifoldEdges, 0u);
+    EXPECT_EQ(m.inconsistentEdges, 0u);
+    EXPECT_TRUE(m.closed);
+    EXPECT_TRUE(m.manifold);
+    EXPECT_DOUBLE_EQ(m.area, 6.0);
+    EXPECT_DOUBLE_EQ(m.volume, 1.0);
+}
+
+TEST(MeasureMesh, ReversedFacesGiveNegativeVolume)
+{
+    const MeshMeasures m = measureMesh(reversed(cube()));
+    EXPECT_TRUE(m.closed);
+    EXPECT_TRUE(m.manifold);  // consistently inward is still consistent
+    EXPECT_DOUBLE_EQ(m.area, 6.0);
+    EXPECT_DOUBLE_EQ(m.volume, -1.0);
+}
+
+TEST(MeasureMesh, TriangulatedScaledAndMovedCube)
+{
+    const MeshMeasures m = measureMesh(triangulated(cube(2.0f, openvdb::Vec3s(10, -5, 3))));
+    EXPECT_EQ(m.polygons, 12u);
+    EXPECT_TRUE(m.closed);
+    EXPECT_TRUE(m.manifold);
+    EXPECT_NEAR(m.area, 24.0, 1e-9);
+    EXPECT_NEAR(m.volume, 8.0, 1e-9);  // independent of where the closed box is
+}
+
+TEST(MeasureMesh, TetrahedronVolumeIsOneSixth)
+{
+    SurfaceMesh mesh;
+    mesh.points = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+    mesh.triangles = {{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}};
+    const MeshMeasures m = measureMesh(mesh);
+    EXPECT_TRUE(m.manifold);
+    EXPECT_NEAR(m.volume, 1.0 / 6.0, 1e-12);
+    EXPECT_NEAR(m.area, 1.5 + std::sqrt(3.0) / 2.0, 1e-9);
+}
+
+TEST(MeasureMesh, OpenBoxHasFourBoundaryEdges)
+{
+    SurfaceMesh box = cube();
+    box.quads.erase(box.quads.begin() + 1);  // remove the top, z = 1
+    const MeshMeasures m = measureMesh(box);
+    EXPECT_EQ(m.polygons, 5u);
+    EXPECT_EQ(m.boundaryEdges, 4u);
+    EXPECT_EQ(m.nonManifoldEdges, 0u);
+    EXPECT_EQ(m.inconsistentEdges, 0u);
+    EXPECT_FALSE(m.closed);
+    EXPECT_FALSE(m.manifold);  // manifold means every edge has exactly two polygons
+    EXPECT_DOUBLE_EQ(m.area, 5.0);
+    EXPECT_EQ(m.unusedVertices, 0u);
+}
+
+TEST(MeasureMesh, OneFlippedFaceMakesFourInconsistentEdges)
+{
+    SurfaceMesh mesh = cube();
+    std::swap(mesh.quads[3][1], mesh.quads[3][3]);
+    const MeshMeasures m = measureMesh(mesh);
+    EXPECT_EQ(m.inconsistentEdges, 4u);
+    EXPECT_EQ(m.boundaryEdges, 0u);
+    EXPECT_TRUE(m.closed);
+    EXPECT_FALSE(m.manifold);
+    EXPECT_DOUBLE_EQ(m.area, 6.0);
+}
+
+TEST(MeasureMesh, ThreeTrianglesOnOneEdgeAreNonManifold)
+{
+    SurfaceMesh mesh;
+    mesh.points = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {7, 7, 7}};
+    mesh.triangles = {{0, 1, 2}, {1, 0, 3}, {0, 1, 4}};
+    const MeshMeasures m = measureMesh(mesh);
+    EXPECT_EQ(m.nonManifoldEdges, 1u);
+    EXPECT_EQ(m.boundaryEdges, 6u);
+    EXPECT_EQ(m.unusedVertices, 1u);
+    EXPECT_FALSE(m.closed);
+    EXPECT_FALSE(m.manifold);
+    EXPECT_DOUBLE_EQ(m.area, 1.5);
+}
+
+TEST(MeasureMesh, TwoCubesSharingAnEdgeAreClosedButNotManifold)
+{
+    // Cube B sits diagonally next to cube A and shares A's edge from (1,1,0) to (1,1,1).
+    SurfaceMesh mesh = cube();
+    const SurfaceMesh other = cube(1.0f, openvdb::Vec3s(1, 1, 0));
+    // Reuse A's vertices 3 = (1,1,0) and 7 = (1,1,1) for B's vertices 0 and 4.
+    std::vector<uint32_t> remap(8);
+    for (uint32_t i = 0; i < 8; ++i) {
+        if (i == 0) remap[i] = 3;
+        else if (i == 4) remap[i] = 7;
+        else {
+            remap[i] = uint32_t(mesh.points.size());
+            mesh.points.push_back(other.points[i]);
+        }
+    }
+    for (const openvdb::Vec4I& q : other.quads) {
+        mesh.quads.emplace_back(remap[q[0]], remap[q[1]], remap[q[2]], remap[q[3]]);
+    }
+    const MeshMeasures m = measureMesh(mesh);
+    EXPECT_EQ(m.nonManifoldEdges, 1u);
+    EXPECT_EQ(m.boundaryEdges, 0u);
+    EXPECT_TRUE(m.closed);
+    EXPECT_FALSE(m.manifold);
+    EXPECT_DOUBLE_EQ(m.volume, 2.0);
+    EXPECT_DOUBLE_EQ(m.area, 12.0);
+}
+
+TEST(MeasureMesh, EmptyMeshIsNeitherClosedNorManifold)
+{
+    const MeshMeasures m = measureMesh(SurfaceMesh());
+    EXPECT_EQ(m.polygons, 0u);
+    EXPECT_FALSE(m.closed);
+    EXPECT_FALSE(m.manifold);
+    EXPECT_EQ(m.area, 0.0);
+}
+
+TEST(MeasureMesh, OutOfRangeIndexIsAParameterError)
+{
+    SurfaceMesh mesh = cube();
+    mesh.triangles.emplace_back(0, 1, 99);
+    try {
+        measureMesh(mesh);
+        FAIL() << "expected ParameterError";
+    } catch (const nonbloppy::ParameterError& e) {
+        EXPECT_STREQ(e.what(), "polygon 0 references vertex 99 but the mesh has 8 vertices");
+    }
+}
+
+} // namespace

@@ -1,0 +1,444 @@
+// SPDX-License-Identifier: Apache-2.0
+// Tests for writeMesh(), readMesh() and the AtomicFile helper: round trips through all three
+// formats, exact bytes, atomic replacement and clean failure.
+
+#include <nonbloppy/Error.h>
+#include <nonbloppy/MeasureMesh.h>
+#include <nonbloppy/ReadMesh.h>
+#include <nonbloppy/ReadParticles.h>
+#include <nonbloppy/WriteMesh.h>
+
+#include "../src/AtomicFile.h"
+
+#include <gtest/gtest.h>
+
+#include <dirent.h>
+#include <sys/stat.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <functional>
+#include <iterator>
+#include <set>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace {
+
+using nonbloppy::FileError;
+using nonbloppy::MeshWriteSettings;
+using nonbloppy::SurfaceMesh;
+using nonbloppy::readMesh;
+using nonbloppy::writeMesh;
+
+std::string
+readBytes(const std::string& path)
+{
+    std::ifstream is(path, std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(is), std::istreambuf_iterator<char>());
+}
+
+void
+writeBytes(const std::string& path, const std::string& bytes)
+{
+    std::ofstream os(path, std::ios::binary | std::ios::trunc);
+    os.write(bytes.data(), std::streamsize(bytes.size()));
+    ASSERT_TRUE(os.good()) << path;
+}
+
+std::set<std::string>
+listDirectory(const std::string& dir)
+{
+    std::set<std::string> names;
+    if (DIR* d = opendir(dir.c_str())) {
+        while (dirent* entry = readdir(d)) {
+            const std::string name = entry->d_name;
+            if (name != "." && name != "..") names.insert(name);
+        }
+        closedir(d);
+    }
+    return names;
+}
+
+template<typename ExceptionT>
+std::string
+messageOf(const std::function<void()>& f)
+{
+    try {
+        f();
+    } catch (const ExceptionT& e) {
+        return e.what();
+    }
+    return "";
+}
+
+/// A unit cube with corners at 0 and 1 and six outward-facing (counter-clockwise) quads.
+SurfaceMesh
+unitCube()
+{
+    SurfaceMesh mesh;
+    for (int i = 0; i < 8; ++i) {
+        mesh.points.emplace_back(float(i & 1), float((i >> 1) & 1), float((i >> 2) & 1));
+    }
+    mesh.quads = {
+        {0, 2, 3, 1}, {4, 5, 7, 6},  // z = 0 (facing -z), z = 1 (+z)
+        {0, 1, 5, 4}, {2, 6, 7, 3},  // y = 0, y = 1
+        {0, 4, 6, 2}, {1, 3, 7, 5},  // x = 0, x = 1
+    };
+    return mesh;
+}
+
+/// A mesh with triangles and quads, non-trivial float values and unit normals.
+SurfaceMesh
+mixedMesh()
+{
+    SurfaceMesh mesh;
+    mesh.points = {{0.1f, -2.5f, 3e-5f}, {1.0f / 3.0f, 2.0f, 1e7f}, {-0.0f, 0.7f, 4.25f},
+                   {5.5f, 6.5f, 7.5f}, {123.456f, -0.001f, 0.0f}};
+    mesh.normals = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {0.6f, 0.8f, 0}, {0, -0.6f, 0.8f}};
+    mesh.triangles = {{0, 1, 2}, {2, 3, 4}};
+    mesh.quads = {{0, 1, 3, 4}, {4, 3, 2, 1}};
+    return mesh;
+}
+
+class WriteMeshTest : public ::testing::Test
+{
+protected:
+    void SetUp() override
+    {
+        std::string pattern = ::testing::TempDir() + "nonbloppy_write_XXXXXX";
+        ASSERT_NE(mkdtemp(pattern.data()), nullptr);
+        mDir = pattern;
+    }
+    void TearDown() override
+    {
+        const std::string command = "rm -rf '" + mDir + "'";
+        EXPECT_EQ(std::system(command.c_str()), 0);
+    }
+    std::string path(const std::string& name) const { return mDir + "/" + name; }
+
+    std::string mDir;
+};
+
+/// The mesh @a mesh should read back as after writing with @a keepQuads.
+SurfaceMesh
+expectedAfterWrite(const SurfaceMesh& mesh, bool keepQuads)
+{
+    SurfaceMesh expected = mesh;
+    if (!keepQuads) {
+        expected.quads.clear();
+        for (const openvdb::Vec4I& q : mesh.quads) {
+            expected.triangles.emplace_back(q[0], q[1], q[2]);
+            expected.triangles.emplace_back(q[0], q[2], q[3]);
+        }
+    }
+    return expected;
+}
+
+void
+expectSameMesh(const SurfaceMesh& actual, const SurfaceMesh& expected)
+{
+    ASSERT_EQ(actual.points.size(), expected.points.size());
+    for (size_t i = 0; i < expected.points.size(); ++i) {
+        EXPECT_EQ(actual.points[i], expected.points[i]) << "point " << i;
+    }
+    ASSERT_EQ(actual.normals.size(), expected.normals.size());
+    for (size_t i = 0; i < expected.normals.size(); ++i) {
+        EXPECT_EQ(actual.normals[i], expected.normals[i]) << "normal " << i;
+    }
+    EXPECT_EQ(actual.triangles, expected.triangles);
+    EXPECT_EQ(actual.quads, expected.quads);
+}
+
+TEST_F(WriteMeshTest, RoundTripThroughEveryFormatWithQuadsKeptAndSplit)
+{
+    const SurfaceMesh cube = unitCube(), mixed = mixedMesh();
+    SurfaceMesh withoutNormals = mixedMesh();
+    withoutNormals.normals.clear();
+    for (const char* ext : {".obj", ".ply", ".vtk", ".OBJ"}) {
+        for (bool keepQuads : {true, false}) {
+            for (const SurfaceMesh* mesh : std::vector<const SurfaceMesh*>{&cube, &mixed, &withoutNormals}) {
+                SCOPED_TRACE(std::string(ext) + (keepQuads ? " keep" : " split") +
+                    " points " + std::to_string(mesh->points.size()) +
+                    (mesh->normals.empty() ? "" : " normals"));
+                const std::string p = path(std::string("mesh") + ext);
+                MeshWriteSettings settings;
+                settings.keepQuads = keepQuads;
+                writeMesh(*mesh, p, settings);
+                expectSameMesh(readMesh(p), expectedAfterWrite(*mesh, keepQuads));
+                EXPECT_EQ(listDirectory(mDir), std::set<std::string>{std::string("mesh") + ext});
+                std::remove(p.c_str());
+            }
+        }
+    }
+}
+
+TEST_F(WriteMeshTest, OutputIsDeterministicAndOfTheDocumentedLayout)
+{
+    const SurfaceMesh mesh = mixedMesh();
+    for (const char* ext : {".obj", ".ply", ".vtk"}) {
+        writeMesh(mesh, path(std::string("a") + ext));
+        writeMesh(mesh, path(std::string("b") + ext));
+        const std::string first = readBytes(path(std::string("a") + ext));
+        writeMesh(mesh, path(std::string("a") + ext));  // overwrite
+        EXPECT_EQ(first, readBytes(path(std::string("a") + ext))) << ext;
+        EXPECT_EQ(first, readBytes(path(std::string("b") + ext))) << ext;
+    }
+
+    // PLY: fixed header, then 24 bytes per vertex and 13 bytes per (split) triangle.
+    const std::string ply = readBytes(path("a.ply"));
+    const std::string header =
+        "ply\nformat binary_little_endian 1.0\ncomment written by nonbloppy\n"
+        "element vertex 5\nproperty float x\nproperty float y\nproperty float z\n"
+        "property float nx\nproperty float ny\nproperty float nz\n"
+        "element face 6\nproperty list uchar int vertex_indices\nend_header\n";
+    ASSERT_EQ(ply.substr(0, header.size()), header);
+    EXPECT_EQ(ply.size(), header.size() + 5 * 24 + 6 * 13);
+
+    // VTK: big-endian float coordinates right after the POINTS line.
+    const std::string vtk = readBytes(path("a.vtk"));
+    const std::string pointsLine = "DATASET POLYDATA\nPOINTS 5 float\n";
+    const size_t start = vtk.find(pointsLine);
+    ASSERT_NE(start, std::string::npos);
+    const unsigned char* x0 =
+        reinterpret_cast<const unsigned char*>(vtk.data() + start + pointsLine.size());
+    const uint32_t bits = (uint32_t(x0[0]) << 24) | (uint32_t(x0[1]) << 16) |
+        (uint32_t(x0[2]) << 8) | uint32_t(x0[3]);
+    float x;
+    std::memcpy(&x, &bits, 4);
+    EXPECT_EQ(x, 0.1f);
+    EXPECT_NE(vtk.find("\nPOLYGONS 6 24\n"), std::string::npos);
+    EXPECT_NE(vtk.find("\nPOINT_DATA 5\nNORMALS normals float\n"), std::string::npos);
+}
+
+TEST_F(WriteMeshTest, ObjTextIsExact)
+{
+    SurfaceMesh mesh;
+    mesh.points = {{0, 0, 0}, {1, 0, 0}, {0.1f, 1, 0}, {1, 1, -2.5f}};
+    mesh.quads = {{0, 1, 3, 2}};
+    MeshWriteSettings keep;
+    keep.keepQuads = true;
+    writeMesh(mesh, path("q.obj"), keep);
+    EXPECT_EQ(readBytes(path("q.obj")),
+        "# nonbloppy surface mesh\nv 0 0 0\nv 1 0 0\nv 0.1 1 0\nv 1 1 -2.5\nf 1 2 4 3\n");
+    writeMesh(mesh, path("t.obj"));
+    EXPECT_EQ(readBytes(path("t.obj")),
+        "# nonbloppy surface mesh\nv 0 0 0\nv 1 0 0\nv 0.1 1 0\nv 1 1 -2.5\nf 1 2 4\nf 1 4 3\n");
+
+    mesh.normals = {{0, 0, 1}, {0, 0, 1}, {0, 0, 1}, {0, 0, 1}};
+    writeMesh(mesh, path("n.obj"), keep);
+    EXPECT_EQ(readBytes(path("n.obj")),
+        "# nonbloppy surface mesh\nv 0 0 0\nv 1 0 0\nv 0.1 1 0\nv 1 1 -2.5\n"
+        "vn 0 0 1\nvn 0 0 1\nvn 0 0 1\nvn 0 0 1\nf 1//1 2//2 4//4 3//3\n");
+}
+
+TEST_F(WriteMeshTest, WrittenVtkIsAlsoAValidParticleFile)
+{
+    writeMesh(mixedMesh(), path("m.vtk"));
+    const nonbloppy::ParticleSet particles = nonbloppy::readParticles(path("m.vtk"));
+    ASSERT_EQ(particles.size(), 5u);
+    EXPECT_EQ(particles.positions[1], mixedMesh().points[1]);
+    ASSERT_NE(particles.findAttribute("normals"), nullptr);
+    EXPECT_EQ(particles.findAttribute("normals")->asDouble(3, 1), double(0.8f));
+}
+
+TEST_F(WriteMeshTest, FailuresNameThePathAndLeaveNothingBehind)
+{
+    const std::string missing = path("missing/mesh.obj");
+    EXPECT_EQ(messageOf<FileError>([&] { writeMesh(unitCube(), missing); }),
+        "cannot write " + missing + ": No such file or directory");
+    EXPECT_TRUE(listDirectory(mDir).empty());
+
+    EXPECT_EQ(messageOf<FileError>([&] { writeMesh(unitCube(), path("mesh.stl")); }),
+        "unknown mesh file extension '.stl' (" + path("mesh.stl") +
+        "); expected .obj, .ply or .vtk");
+    EXPECT_EQ(messageOf<FileError>([&] { readMesh(path("mesh.stl")); }),
+        "unknown mesh file extension '.stl' (" + path("mesh.stl") +
+        "); expected .obj, .ply or .vtk");
+    EXPECT_TRUE(listDirectory(mDir).empty());
+
+    SurfaceMesh broken = unitCube();
+    broken.quads[5][2] = 8;
+    EXPECT_EQ(messageOf<nonbloppy::ParameterError>([&] { writeMesh(broken, path("b.ply")); }),
+        "polygon 5 references vertex 8 but the mesh has 8 vertices (" + path("b.ply") + ")");
+    EXPECT_TRUE(listDirectory(mDir).empty());
+
+    EXPECT_FALSE(nonbloppy::isMeshFile("x.stl"));
+    EXPECT_TRUE(nonbloppy::isMeshFile("x.Vtk"));
+}
+
+TEST_F(WriteMeshTest, NewFilesGetTheUsualPermissions)
+{
+    // mkstemp() creates 0600 files; the renamed result must be readable like any new file.
+    const mode_t mask = umask(022);
+    umask(mask);
+    writeMesh(unitCube(), path("cube.ply"));
+    struct stat info;
+    ASSERT_EQ(stat(path("cube.ply").c_str(), &info), 0);
+    EXPECT_EQ(info.st_mode & 0777, 0666 & ~mask);
+}
+
+TEST_F(WriteMeshTest, AtomicFileRemovesItsTemporaryUnlessCommitted)
+{
+    const std::string target = path("out.vdb");
+    writeBytes(target, "old");
+    {
+        nonbloppy::AtomicFile file(target);
+        EXPECT_EQ(file.path(), target);
+        EXPECT_EQ(file.tempPath().rfind(target + ".tmp-", 0), 0u);
+        writeBytes(file.tempPath(), "new");
+        EXPECT_EQ(listDirectory(mDir).size(), 2u);
+    }  // not committed
+    EXPECT_EQ(listDirectory(mDir), std::set<std::string>{"out.vdb"});
+    EXPECT_EQ(readBytes(target), "old");
+
+    {
+        nonbloppy::AtomicFile file(target);
+        writeBytes(file.tempPath(), "new");
+        file.commit();
+        EXPECT_TRUE(file.committed());
+    }
+    EXPECT_EQ(listDirectory(mDir), std::set<std::string>{"out.vdb"});
+    EXPECT_EQ(readBytes(target), "new");
+
+    // A writer that fails half-way leaves the old file as it was.
+    EXPECT_EQ(messageOf<FileError>([&] {
+        nonbloppy::writeFileAtomically(target, [](std::ostream& os) {
+            os << "partial";
+            throw std::runtime_error("disk on fire");
+        });
+    }), "cannot write " + target + ": disk on fire");
+    EXPECT_EQ(readBytes(target), "new");
+    EXPECT_EQ(listDirectory(mDir), std::set<std::string>{"out.vdb"});
+
+    // nonbloppy errors (e.g. cancellation) pass through unchanged.
+    EXPECT_EQ(messageOf<nonbloppy::CancelledError>([&] {
+        nonbloppy::writeFileAtomically(target, [](std::ostream&) {
+            throw nonbloppy::CancelledError("cancelled");
+        });
+    }), "cancelled");
+    EXPECT_EQ(listDirectory(mDir), std::set<std::string>{"out.vdb"});
+
+    nonbloppy::writeFileAtomically(target, [](std::ostream& os) { os << "newest"; });
+    EXPECT_EQ(readBytes(target), "newest");
+}
+
+// ------------------------------------------------------------------------------------------
+// readMesh on files from other writers
+
+TEST_F(WriteMeshTest, ReadObjWithEveryCornerFormAndNegativeIndices)
+{
+    writeBytes(path("forms.obj"),
+        "# comment\nmtllib x.mtl\no thing\n"
+        "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0.5 1.5 0\n"
+        "vt 0 0\nvt 1 0\nvt 1 1\n"
+        "vn 0 0 1\nvn 0 0 -1\n"
+        "s off\nusemtl red\n"
+        "f 1 2 3\n"                    // v
+        "f 1/1 3/2 4/3\n"              // v/vt
+        "f -5//2 -4//2 -3//2 -2//2\n"  // v//vn with negative indices
+        "f 1/1/1 2/2/1 3/3/1 5/1/1 4/2/1\r\n");  // v/vt/vn pentagon, CRLF
+    const SurfaceMesh mesh = readMesh(path("forms.obj"));
+    ASSERT_EQ(mesh.points.size(), 5u);
+    EXPECT_EQ(mesh.points[4], openvdb::Vec3s(0.5f, 1.5f, 0));
+    const std::vector<openvdb::Vec3I> triangles = {
+        {0, 1, 2}, {0, 2, 3}, {0, 1, 2}, {0, 2, 4}, {0, 4, 3}};
+    EXPECT_EQ(mesh.triangles, triangles);
+    EXPECT_EQ(mesh.quads, std::vector<openvdb::Vec4I>{openvdb::Vec4I(0, 1, 2, 3)});
+    // Normals are per corner in OBJ; the last corner to name a vertex wins.
+    ASSERT_EQ(mesh.normals.size(), 5u);
+    EXPECT_EQ(mesh.normals[0], openvdb::Vec3s(0, 0, 1));
+    EXPECT_EQ(mesh.normals[4], openvdb::Vec3s(0, 0, 1));
+
+    writeBytes(path("bad.obj"), "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n");
+    EXPECT_EQ(messageOf<FileError>([&] { readMesh(path("bad.obj")); }),
+        "polygon 0 references vertex 3 but the file has 3 vertices (" + path("bad.obj") + ")");
+    writeBytes(path("bad.obj"), "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 x\n");
+    EXPECT_EQ(messageOf<FileError>([&] { readMesh(path("bad.obj")); }),
+        "bad vertex index 'x' at line 4 (" + path("bad.obj") + ")");
+    writeBytes(path("bad.obj"), "v 0 0\n");
+    EXPECT_EQ(messageOf<FileError>([&] { readMesh(path("bad.obj")); }),
+        "expected three coordinates at line 1 (" + path("bad.obj") + ")");
+    EXPECT_EQ(messageOf<FileError>([&] { readMesh(path("none.obj")); }),
+        "cannot open " + path("none.obj") + ": No such file or directory");
+}
+
+TEST_F(WriteMeshTest, ReadAsciiPlyAndVtkMeshes)
+{
+    writeBytes(path("a.ply"),
+        "ply\nformat ascii 1.0\nelement vertex 5\nproperty float x\nproperty float y\n"
+        "property float z\nproperty uchar red\nelement face 2\n"
+        "property uchar flags\nproperty list uchar uint vertex_indices\nend_header\n"
+        "0 0 0 1\n1 0 0 2\n1 1 0 3\n0 1 0 4\n0.5 2 0 5\n"
+        "7 4 0 1 2 3\n7 5 0 1 2 4 3\n");
+    SurfaceMesh mesh = readMesh(path("a.ply"));
+    EXPECT_EQ(mesh.points.size(), 5u);
+    EXPECT_TRUE(mesh.normals.empty());
+    EXPECT_EQ(mesh.quads, std::vector<openvdb::Vec4I>{openvdb::Vec4I(0, 1, 2, 3)});
+    EXPECT_EQ(mesh.triangles.size(), 3u);
+
+    writeBytes(path("a.vtk"),
+        "# vtk DataFile Version 3.0\nmesh\nASCII\nDATASET POLYDATA\n"
+        "POINTS 4 float\n0 0 0 1 0 0 1 1 0 0 1 0\n"
+        "LINES 1 3\n2 0 1\n"
+        "POLYGONS 2 7\n3 0 1 2\n2 0 2\n");
+    EXPECT_EQ(messageOf<FileError>([&] { readMesh(path("a.vtk")); }),
+        "polygon 1 has only 2 vertices (" + path("a.vtk") + ")");
+    writeBytes(path("a.vtk"),
+        "# vtk DataFile Version 3.0\nmesh\nASCII\nDATASET POLYDATA\n"
+        "POINTS 4 float\n0 0 0 1 0 0 1 1 0 0 1 0\n"
+        "LINES 1 3\n2 0 1\n"
+        "POLYGONS 2 9\n3 0 1 2\n4 0 1 2 3\n"
+        "POINT_DATA 4\nNORMALS n float\n0 0 1 0 0 1 0 0 1 0 0 1\n");
+    mesh = readMesh(path("a.vtk"));
+    EXPECT_EQ(mesh.triangles, std::vector<openvdb::Vec3I>{openvdb::Vec3I(0, 1, 2)});
+    EXPECT_EQ(mesh.quads, std::vector<openvdb::Vec4I>{openvdb::Vec4I(0, 1, 2, 3)});
+    ASSERT_EQ(mesh.normals.size(), 4u);
+    EXPECT_EQ(mesh.normals[3], openvdb::Vec3s(0, 0, 1));
+
+    writeBytes(path("b.vtk"),
+        "# vtk DataFile Version 3.0\nmesh\nASCII\nDATASET POLYDATA\n"
+        "POINTS 3 float\n0 0 0 1 0 0 1 1 0\nPOLYGONS 1 4\n3 0 1 7\n");
+    EXPECT_EQ(messageOf<FileError>([&] { readMesh(path("b.vtk")); }),
+        "polygon 0 references vertex 7 but the file has 3 vertices (" + path("b.vtk") + ")");
+}
+
+TEST_F(WriteMeshTest, TruncatedMeshFilesAreFileErrors)
+{
+    const SurfaceMesh mesh = mixedMesh();
+    for (const char* ext : {".ply", ".vtk"}) {
+        const std::string full = path(std::string("full") + ext);
+        writeMesh(mesh, full);
+        const std::string bytes = readBytes(full);
+        const std::string cut = path(std::string("cut") + ext);
+        size_t failures = 0;
+        for (size_t k = 0; k + 1 < bytes.size(); ++k) {
+            writeBytes(cut, bytes.substr(0, k));
+            try {
+                readMesh(cut);
+            } catch (const FileError& e) {
+                EXPECT_NE(std::string(e.what()).find("(" + cut + ")"), std::string::npos);
+                ++failures;
+            }
+        }
+        // Only cuts at the very end of the faces / before POINT_DATA can still parse.
+        EXPECT_GT(failures, bytes.size() - 10) << ext;
+    }
+}
+
+TEST_F(WriteMeshTest, MeasuresSurviveARoundTrip)
+{
+    const SurfaceMesh cube = unitCube();
+    for (const char* ext : {".obj", ".ply", ".vtk"}) {
+        writeMesh(cube, path(std::string("c") + ext));
+        const nonbloppy::MeshMeasures m = nonbloppy::measureMesh(readMesh(path(std::string("c") + ext)));
+        EXPECT_TRUE(m.closed && m.manifold) << ext;
+        EXPECT_DOUBLE_EQ(m.volume, 1.0) << ext;
+        EXPECT_EQ(m.polygons, 12u) << ext;  // quads split by default
+    }
+}
+
+} // namespace
