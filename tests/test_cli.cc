@@ -8,8 +8,14 @@
 
 #include <openvdb/version.h>
 
+#include <fcntl.h>
+#include <signal.h>
+#include <spawn.h>
 #include <sys/wait.h>
 #include <unistd.h>
+
+#include <chrono>
+#include <thread>
 
 #include <algorithm>
 #include <cmath>
@@ -363,6 +369,42 @@ TEST_F(CliTest, InspectMissingFile)
     const RunResult r = run("inspect " + quote(missing));
     EXPECT_EQ(r.exitCode, 1);
     EXPECT_EQ(r.err, "nonbloppy: cannot open " + missing + ": No such file or directory\n");
+}
+
+TEST_F(CliTest, SigintCancelsWithoutLeavingFiles)
+{
+    // A run long enough to be caught mid-way: a fine grid on the dam-break frame.
+    const std::string errFile = dir() + "/stderr.txt";
+    const std::vector<std::string> args = {
+        kCli, "mesh", kData + "/dam_break_frame_23_24389_particles.vtk", "-o", out("dam.obj"),
+        "--vdb", out("dam.vdb"), "--voxel-size", "0.005", "-v"};
+    std::vector<char*> argv;
+    for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+    argv.push_back(nullptr);
+
+    posix_spawn_file_actions_t actions;
+    posix_spawn_file_actions_init(&actions);
+    posix_spawn_file_actions_addopen(&actions, 1, "/dev/null", O_WRONLY, 0);
+    posix_spawn_file_actions_addopen(&actions, 2, errFile.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    pid_t pid = 0;
+    ASSERT_EQ(posix_spawn(&pid, kCli.c_str(), &actions, nullptr, argv.data(), environ), 0);
+    posix_spawn_file_actions_destroy(&actions);
+
+    // The progress line shows that the signal handlers are installed; interrupt then.
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+    while (readText(errFile).find("[progress] rasterize density") == std::string::npos
+           && std::chrono::steady_clock::now() < deadline) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    }
+    ::kill(pid, SIGINT);
+    int status = 0;
+    ASSERT_EQ(::waitpid(pid, &status, 0), pid);
+    ASSERT_TRUE(WIFEXITED(status)) << "killed by signal " << WTERMSIG(status);
+    EXPECT_EQ(WEXITSTATUS(status), 130);
+    const std::vector<std::string> errLines = lines(readText(errFile));
+    ASSERT_FALSE(errLines.empty());
+    EXPECT_EQ(errLines.back(), "nonbloppy: interrupted");
+    EXPECT_TRUE(listDir(dir() + "/out").empty()) << "output files left behind";
 }
 
 TEST_F(CliTest, VersionAndHelp)

@@ -103,8 +103,10 @@ public:
         if (mVerbose) {
             const std::chrono::duration<double> elapsed =
                 std::chrono::steady_clock::now() - mStages.back().start;
-            std::cerr << "[progress] " << mStages.back().name << " done ("
-                      << formatNumber(elapsed.count()) << " s)" << std::endl;
+            char seconds[32];
+            std::snprintf(seconds, sizeof(seconds), "%.3f", elapsed.count());
+            std::cerr << "[progress] " << mStages.back().name << " done (" << seconds << " s)"
+                      << std::endl;
         }
         mStages.pop_back();
     }
@@ -286,7 +288,7 @@ void printSummary(const MeshOptions& o, const nonbloppy::SurfaceResult& result,
     std::ostream& out = std::cout;
 
     auto row = [&](const char* label, const std::string& value, const std::string& note) {
-        std::snprintf(line, sizeof(line), "  %-18s %-14s %s", label, value.c_str(), note.c_str());
+        std::snprintf(line, sizeof(line), "  %-20s %-14s %s", label, value.c_str(), note.c_str());
         std::string text = line;
         while (!text.empty() && text.back() == ' ') text.pop_back();
         out << text << "\n";
@@ -327,11 +329,11 @@ void printSummary(const MeshOptions& o, const nonbloppy::SurfaceResult& result,
     out << "timings\n";
     const double total = timings.total();
     for (const auto& entry : timings.entries) {
-        std::snprintf(line, sizeof(line), "  %-18s %8.3f s  (%4.1f%%)", entry.stage.c_str(),
+        std::snprintf(line, sizeof(line), "  %-20s %8.3f s  (%4.1f%%)", entry.stage.c_str(),
                       entry.seconds, total > 0 ? 100.0 * entry.seconds / total : 0.0);
         out << line << "\n";
     }
-    std::snprintf(line, sizeof(line), "  %-18s %8.3f s", "total", total);
+    std::snprintf(line, sizeof(line), "  %-20s %8.3f s", "total", total);
     out << line << "\n";
     out.flush();
 }

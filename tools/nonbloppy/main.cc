@@ -78,7 +78,7 @@ int run(int argc, char** argv)
         }
         for (const Command& command : commands) {
             if (command.app->get_name() == helpTopic) {
-                std::cout << command.app->help();
+                std::cout << command.app->help(app.get_name());
                 return 0;
             }
         }
