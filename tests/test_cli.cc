@@ -346,7 +346,30 @@ TEST_F(CliTest, UnknownOutputExtension)
 {
     const std::string target = out("x.stl");
     expectFailure("mesh " + quote(kCube) + " -o " + quote(target),
-                  "cannot write " + target + ": unknown mesh extension \".stl\" (use .obj, .ply or .vtk)");
+                  "unknown mesh file extension '.stl' (" + target + "); expected .obj, .ply or .vtk");
+}
+
+TEST_F(CliTest, BadVdbNameAndInputAsOutput)
+{
+    const std::string vdb = out("x.cache");
+    expectFailure("mesh " + quote(kCube) + " -o " + quote(out("x.obj")) + " --vdb " + quote(vdb),
+                  "--vdb file name must end in .vdb (" + vdb + ")");
+    const std::string copy = in("cube.vtk");
+    fs::copy_file(kCube, copy);
+    const RunResult r = run("mesh " + quote(copy) + " -o " + quote(copy));
+    EXPECT_EQ(r.exitCode, 1);
+    EXPECT_EQ(r.err, "nonbloppy: cannot write " + copy + ": it is the input file\n");
+    EXPECT_EQ(readText(copy), readText(kCube));
+}
+
+TEST_F(CliTest, InspectUnknownExtension)
+{
+    const std::string path = in("notes.txt");
+    writeText(path, "hello\n");
+    const RunResult r = run("inspect " + quote(path));
+    EXPECT_EQ(r.exitCode, 1);
+    EXPECT_EQ(r.err, "nonbloppy: unknown file extension '.txt' (" + path
+                         + "); expected .vdb, .obj, .ply, .vtk or .xyz\n");
 }
 
 TEST_F(CliTest, UsageErrorsAreOneLine)

@@ -508,8 +508,8 @@ int runInspect(const std::string& path, bool json)
     if (nonbloppy::isParticleFile(path)) {
         return inspectParticles(path, nonbloppy::readParticles(path), json);
     }
-    throw nonbloppy::FileError("cannot inspect " + path + ": unknown file extension \"" + ext
-                               + "\" (expected .vdb, a mesh or a particle file)");
+    throw nonbloppy::FileError("unknown file extension '" + ext + "' (" + path
+                               + "); expected .vdb, .obj, .ply, .vtk or .xyz");
 }
 
 } // namespace

@@ -241,13 +241,16 @@ void validate(const MeshOptions& o)
         throw nonbloppy::ParameterError("--threads must be >= 1, got " + std::to_string(o.threads));
     }
 
+    // Spelled as writeMesh() spells it, which would say the same after all the work.
     if (!nonbloppy::isMeshFile(o.output)) {
-        throw nonbloppy::FileError("cannot write " + o.output + ": unknown mesh extension \""
-                                   + lowerExtension(o.output) + "\" (use .obj, .ply or .vtk)");
+        const std::string ext = lowerExtension(o.output);
+        throw nonbloppy::FileError(
+            (ext.empty() ? "mesh file name has no extension ("
+                         : "unknown mesh file extension '" + ext + "' (")
+            + o.output + "); expected .obj, .ply or .vtk");
     }
     if (!o.vdbPath.empty() && lowerExtension(o.vdbPath) != ".vdb") {
-        throw nonbloppy::FileError("cannot write " + o.vdbPath
-                                   + ": --vdb needs a file name ending in .vdb");
+        throw nonbloppy::FileError("--vdb file name must end in .vdb (" + o.vdbPath + ")");
     }
 
     struct stat info;
