@@ -19,16 +19,21 @@ struct MeshMeasures
     size_t unusedVertices = 0;    ///< vertices no polygon references
     size_t boundaryEdges = 0;     ///< edges with one adjacent polygon
     size_t nonManifoldEdges = 0;  ///< edges with three or more adjacent polygons
-    size_t inconsistentEdges = 0; ///< edges used twice in the same direction (flipped faces)
-    bool closed = false;          ///< no boundary edges
-    bool manifold = false;        ///< every edge has exactly two polygons, oriented consistently
+    size_t inconsistentEdges = 0; ///< edges of two polygons that both use it in the same
+                                  ///< direction (one of them is flipped)
+    bool closed = false;          ///< at least one polygon and no boundary edges
+    bool manifold = false;        ///< every edge has exactly two polygons, oriented
+                                  ///< consistently (so an open mesh is not manifold here)
     double area = 0.0;            ///< world units²
     double volume = 0.0;          ///< signed enclosed volume (divergence theorem), world units³;
                                   ///< positive when polygons face outwards
 };
 
-/// Measure @a mesh (quads split into two triangles for area and volume).
+/// Measure @a mesh (quads split into two triangles for area and volume; edges joining a
+/// vertex to itself, from degenerate polygons, are not counted). Edge checks only: two
+/// surfaces touching at a single vertex are not detected as non-manifold.
 /// Cost: O(P log P) for P polygons (edge sort), memory O(P).
+/// @throw ParameterError if a polygon references a vertex index out of range.
 MeshMeasures measureMesh(const SurfaceMesh& mesh);
 
 } // namespace nonbloppy

@@ -13,8 +13,12 @@
 namespace nonbloppy {
 
 /// Read the polygons of @a path: triangles and quads are kept, larger polygons are fanned
-/// into triangles. Vertex normals are read when present.
-/// @throw FileError for a missing, truncated or corrupt file or an unknown extension.
+/// into triangles (v0, vi, vi+1). Vertex normals are read when present: PLY nx ny nz, VTK
+/// NORMALS, OBJ vn (OBJ normals belong to face corners; each vertex gets the normal of the
+/// last corner naming it). OBJ faces may use v, v/vt, v//vn and v/vt/vn, and negative
+/// (relative) indices.
+/// @throw FileError for a missing, truncated or corrupt file, an unknown extension, a
+///        polygon with fewer than three vertices or a vertex index out of range.
 SurfaceMesh readMesh(const std::string& path);
 
 } // namespace nonbloppy

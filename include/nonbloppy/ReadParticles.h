@@ -3,12 +3,23 @@
 /// @brief Stage "read particles": load a particle file into a ParticleSet.
 ///
 /// Formats, chosen by the file extension (case-insensitive):
-/// - `.vtk`  legacy VTK (ASCII or binary big-endian), UNSTRUCTURED_GRID or POLYDATA,
-///           float or double POINTS; POINT_DATA arrays (SCALARS, VECTORS, FIELD) are kept by name.
+/// - `.vtk`  legacy VTK (ASCII or binary big-endian, versions up to 5.1), UNSTRUCTURED_GRID
+///           or POLYDATA, float or double POINTS (stored as float). Cell sections are
+///           skipped (both the count-prefixed layout and VTK 5's OFFSETS/CONNECTIVITY), as
+///           are CELL_DATA, dataset-level FIELD data and METADATA blocks. Every POINT_DATA
+///           array (SCALARS, VECTORS, NORMALS, TENSORS, TEXTURE_COORDINATES, COLOR_SCALARS,
+///           FIELD arrays) becomes an attribute in its stored type; `long` is read as 64-bit
+///           and `vtkIdType` as 32-bit, as VTK's legacy writer stores them. Names written
+///           with %XX escapes (VTK 5) are decoded.
 /// - `.ply`  PLY (ascii, binary_little_endian, binary_big_endian); vertex x y z (float or
-///           double) plus every other scalar vertex property as a 1-component attribute.
+///           double) plus every other scalar vertex property as a 1-component attribute;
+///           list properties and other elements are skipped.
 /// - `.xyz`  raw little-endian float32 triples, no header.
-/// Cost: one pass over the file; memory is the particle set itself plus the file buffer.
+/// A file with zero particles is read without complaint (the pipeline rejects it later).
+/// Cost: one pass over the file held in memory; binary data are copied with memcpy and a
+/// byte swap, text parsed with std::from_chars (about 0.1 s for 2M binary particles).
+/// Memory is the file plus the particle set, with no per-particle heap objects. Every
+/// count in a header is checked against the bytes left in the file before allocating.
 
 #ifndef NONBLOPPY_READ_PARTICLES_H
 #define NONBLOPPY_READ_PARTICLES_H
@@ -21,8 +32,11 @@ namespace nonbloppy {
 
 /// Read every particle and per-particle attribute of @a path.
 /// @throw FileError  for a missing, unreadable, truncated or corrupt file, or an unknown
-///                   extension; the message names @a path.
-/// @throw ParameterError  for NaN or infinite coordinates (naming the file and particle).
+///                   extension; one line naming @a path, e.g.
+///                   "cannot open x.vtk: No such file or directory",
+///                   "truncated POINTS section (x.vtk)".
+/// @throw ParameterError  for NaN or infinite coordinates, or doubles too large for float:
+///                   "non-finite position of particle 17 (x.vtk)".
 /// Thread-safe: yes (no shared state).
 ParticleSet readParticles(const std::string& path);
 

@@ -24,8 +24,14 @@ struct MeshWriteSettings
 /// int faces), `.vtk` (legacy binary POLYDATA, POINTS float, POLYGONS, POINT_DATA NORMALS).
 /// The file is written to a temporary file beside @a path and renamed into place, so a
 /// failed or interrupted write never leaves a partial file.
-/// Output is byte-identical for identical meshes (fixed float formatting, no timestamps).
-/// @throw FileError for an unknown extension or a file that cannot be written (names @a path).
+/// Output is byte-identical for identical meshes: OBJ coordinates use the shortest decimal
+/// text that reads back as the same float (std::to_chars), and nothing depends on time.
+/// Normals are written only when mesh.normals is non-empty.
+/// Cost: one pass; output is formatted into multi-megabyte chunks.
+/// @throw FileError for an unknown extension or a file that cannot be written, e.g.
+///        "cannot write out/mesh.obj: No such file or directory"; nothing is left behind.
+/// @throw ParameterError if a polygon references a vertex that does not exist, or
+///        mesh.normals is non-empty but not one per vertex.
 void writeMesh(const SurfaceMesh& mesh, const std::string& path,
                const MeshWriteSettings& settings = MeshWriteSettings());
 
