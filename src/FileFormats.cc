@@ -634,6 +634,15 @@ public:
             }
         }
         if (!havePoints) fail(mPath, "missing POINTS section in VTK file");
+        // POINT_DATA may precede POINTS; every array must still have one tuple per point.
+        for (const NumericArray& array : mData.pointArrays) {
+            const size_t tuples =
+                array.bytes.size() / (scalarSize(array.type) * size_t(array.components));
+            if (tuples != mData.points.size()) {
+                fail(mPath, "POINT_DATA count " + std::to_string(tuples) +
+                    " differs from POINTS count " + std::to_string(mData.points.size()));
+            }
+        }
         return std::move(mData);
     }
 
