@@ -6,6 +6,7 @@
 #include <nonbloppy/RelaxVertices.h>
 
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_sort.h>
 
 #include <atomic>
 #include <cmath>
@@ -15,10 +16,76 @@ namespace nonbloppy {
 
 namespace {
 
-/// One relaxation step for a block of vertices: reads `previous`, writes `next`.
+constexpr size_t kLanes = 8;  ///< candidates processed side by side (two SSE or one AVX register)
+
+/// Candidate particles of one group of vertices, as separate x, y, z arrays padded to a
+/// multiple of kLanes with particles far outside every support (weight 0).
+struct CandidateBuffer
+{
+    std::vector<float> x, y, z;
+    size_t count = 0;
+
+    void clear() { count = 0; }
+
+    /// Append the particles of slots [first, end) that lie within @a radius of the box
+    /// [boxMin, boxMax]: only they can reach a vertex inside the box. Skipping the others
+    /// (the corners and edges of the grown box) halves the work of every vertex. Written
+    /// without branches (store, then advance only if kept): half the particles are
+    /// dropped at random, which a branch would mispredict.
+    void gather(const std::vector<openvdb::Vec3f>& positions, uint32_t first, uint32_t end,
+                const openvdb::Vec3f& boxMin, const openvdb::Vec3f& boxMax, float radius2)
+    {
+        reserve(count + (end - first) + kLanes);
+        float* __restrict px = x.data();
+        float* __restrict py = y.data();
+        float* __restrict pz = z.data();
+        size_t n = count;
+        for (uint32_t k = first; k < end; ++k) {
+            const openvdb::Vec3f& p = positions[k];
+            float outside2 = 0.0f;
+            for (int a = 0; a < 3; ++a) {
+                const float gap = std::max(0.0f, std::max(boxMin[a] - p[a], p[a] - boxMax[a]));
+                outside2 += gap * gap;
+            }
+            px[n] = p[0];
+            py[n] = p[1];
+            pz[n] = p[2];
+            n += outside2 < radius2 ? 1 : 0;
+        }
+        count = n;
+    }
+
+    /// Pad to a multiple of kLanes with a position at least r_e away from every vertex.
+    void pad(float farAway)
+    {
+        reserve(count + kLanes);
+        while (count % kLanes != 0) {
+            x[count] = y[count] = z[count] = farAway;
+            ++count;
+        }
+    }
+
+private:
+    void reserve(size_t size)
+    {
+        if (x.size() < size) {
+            x.resize(2 * size);
+            y.resize(2 * size);
+            z.resize(2 * size);
+        }
+    }
+};
+
+/// One relaxation step: reads `previous`, writes `next`. Vertices are processed in groups
+/// sharing a particle-index cell; each group gathers the particles within r_e of its cell
+/// once, and every vertex of the group then sums over that contiguous list with per-lane
+/// accumulators (vectorizable without reassociating any sum, so results stay exact and
+/// independent of threads: a vertex's sum order depends only on its group's list).
 struct RelaxStepOp
 {
     const ParticleIndex& particles;
+    const std::vector<uint32_t>& vertexOrder;   ///< vertices sorted by cell
+    const std::vector<size_t>& groupStart;      ///< groups of vertexOrder sharing a cell
     const std::vector<openvdb::Vec3s>& previous;
     std::vector<openvdb::Vec3s>& next;
     float effectiveRadius;
@@ -32,39 +99,93 @@ struct RelaxStepOp
         if (interrupter && interrupter->wasInterrupted()) { cancelled = true; return; }
         const auto& positions = particles.sortedPositions();
         auto accessor = particles.impl().grid->getConstAccessor();
-        const float radius2 = effectiveRadius * effectiveRadius;
-        const float minDistance2 = (kMinDistanceFraction * effectiveRadius) * (kMinDistanceFraction * effectiveRadius);
-        const openvdb::Vec3d reach(effectiveRadius);
-        for (size_t i = range.begin(); i < range.end(); ++i) {
-            const openvdb::Vec3s v = previous[i];
-            // Sum offsets from the vertex rather than absolute positions: the mean is then
-            // exact to float precision however far the fluid is from the origin.
-            float weightSum = 0.0f, sx = 0.0f, sy = 0.0f, sz = 0.0f;
-            particle_index_internal::forEachRunInBox(accessor, particles.cellSize(),
-                openvdb::Vec3d(v) - reach, openvdb::Vec3d(v) + reach,
-                [&](uint32_t first, uint32_t end) {
-                    for (uint32_t k = first; k < end; ++k) {
-                        const float dx = positions[k][0] - v[0];
-                        const float dy = positions[k][1] - v[1];
-                        const float dz = positions[k][2] - v[2];
-                        const float d2 = dx * dx + dy * dy + dz * dz;
-                        float w = effectiveRadius / std::sqrt(std::max(d2, minDistance2)) - 1.0f;
-                        w = d2 < radius2 ? w : 0.0f;
-                        weightSum += w;
-                        sx += w * dx;
-                        sy += w * dy;
-                        sz += w * dz;
-                    }
+        const double cellSize = particles.cellSize();
+        const float radius = effectiveRadius;
+        const float minDistance2 = (kMinDistanceFraction * radius) * (kMinDistanceFraction * radius);
+        CandidateBuffer candidates;
+        for (size_t g = range.begin(); g < range.end(); ++g) {
+            const size_t begin = groupStart[g], end = groupStart[g + 1];
+            // The group's cell, grown by r_e, holds every particle near any of its vertices.
+            const openvdb::Coord cell = particle_index_internal::cellOf(previous[vertexOrder[begin]], cellSize);
+            const openvdb::Vec3d cellMin = (cell.asVec3d() - 0.5) * cellSize;
+            const openvdb::Vec3d cellMax = (cell.asVec3d() + 0.5) * cellSize;
+            // Vertices sit in the cell up to float rounding: grow it by a hair so the filter
+            // never drops a particle that a vertex on the cell's face can reach.
+            const float slack = 1e-4f * float(cellSize);
+            const openvdb::Vec3f boxMin = openvdb::Vec3f(cellMin) - openvdb::Vec3f(slack);
+            const openvdb::Vec3f boxMax = openvdb::Vec3f(cellMax) + openvdb::Vec3f(slack);
+            candidates.clear();
+            particle_index_internal::forEachRunInBox(accessor, cellSize,
+                cellMin - openvdb::Vec3d(radius), cellMax + openvdb::Vec3d(radius),
+                [&](uint32_t first, uint32_t last) {
+                    candidates.gather(positions, first, last, boxMin, boxMax, radius * radius);
                 });
-            if (weightSum > 0.0f) {
-                const float scale = blend / weightSum;
-                next[i] = openvdb::Vec3s(v[0] + scale * sx, v[1] + scale * sy, v[2] + scale * sz);
-            } else {
-                next[i] = v;  // no particle within r_e: stays put
+            candidates.pad(float(cellMax[0] + 4.0 * radius));
+            const size_t count = candidates.count;
+            const float* cx = candidates.x.data();
+            const float* cy = candidates.y.data();
+            const float* cz = candidates.z.data();
+
+            for (size_t n = begin; n < end; ++n) {
+                const uint32_t i = vertexOrder[n];
+                const openvdb::Vec3s v = previous[i];
+                // Offsets from the vertex rather than absolute positions: the mean is then
+                // exact to float precision however far the fluid is from the origin.
+                float sw[kLanes] = {}, sx[kLanes] = {}, sy[kLanes] = {}, sz[kLanes] = {};
+                for (size_t c = 0; c < count; c += kLanes) {
+                    for (size_t l = 0; l < kLanes; ++l) {
+                        const float dx = cx[c + l] - v[0];
+                        const float dy = cy[c + l] - v[1];
+                        const float dz = cz[c + l] - v[2];
+                        const float d2 = dx * dx + dy * dy + dz * dz;
+                        // re/d − 1 is ≤ 0 from d = r_e on: clamping at 0 cuts the support
+                        // without a branch, so the loop vectorizes.
+                        float w = radius / std::sqrt(std::max(d2, minDistance2)) - 1.0f;
+                        w = w > 0.0f ? w : 0.0f;
+                        sw[l] += w;
+                        sx[l] += w * dx;
+                        sy[l] += w * dy;
+                        sz[l] += w * dz;
+                    }
+                }
+                float weightSum = 0.0f, mx = 0.0f, my = 0.0f, mz = 0.0f;
+                for (size_t l = 0; l < kLanes; ++l) {
+                    weightSum += sw[l];
+                    mx += sx[l];
+                    my += sy[l];
+                    mz += sz[l];
+                }
+                if (weightSum > 0.0f) {
+                    const float scale = blend / weightSum;
+                    next[i] = openvdb::Vec3s(v[0] + scale * mx, v[1] + scale * my, v[2] + scale * mz);
+                } else {
+                    next[i] = v;  // no particle within r_e: stays put
+                }
             }
         }
     }
 };
+
+/// Sort vertex numbers by the particle-index cell their position falls in and return the
+/// start of each run of equal cells (plus the end). Ties keep vertex order: deterministic.
+void groupVerticesByCell(const std::vector<openvdb::Vec3s>& points, double cellSize,
+                         std::vector<uint32_t>& order, std::vector<size_t>& groupStart)
+{
+    std::vector<openvdb::Coord> cells(points.size());
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, points.size()), [&](const tbb::blocked_range<size_t>& r) {
+        for (size_t i = r.begin(); i < r.end(); ++i) cells[i] = particle_index_internal::cellOf(points[i], cellSize);
+    });
+    order.resize(points.size());
+    for (size_t i = 0; i < order.size(); ++i) order[i] = uint32_t(i);
+    tbb::parallel_sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) {
+        return cells[a] < cells[b] || (cells[a] == cells[b] && a < b);
+    });
+    groupStart.clear();
+    for (size_t n = 0; n < order.size(); ++n) {
+        if (n == 0 || cells[order[n]] != cells[order[n - 1]]) groupStart.push_back(n);
+    }
+    groupStart.push_back(order.size());
+}
 
 } // namespace
 
@@ -88,11 +209,14 @@ void relaxVertices(SurfaceMesh& mesh, const ParticleIndex& particles, const Rela
 
     if (interrupter) interrupter->start("relax vertices");
     std::vector<openvdb::Vec3s> next(mesh.points.size());
+    std::vector<uint32_t> order;
+    std::vector<size_t> groupStart;
     std::atomic<bool> cancelled{false};
     for (int iteration = 0; iteration < settings.iterations && !cancelled; ++iteration) {
-        tbb::parallel_for(tbb::blocked_range<size_t>(0, mesh.points.size(), 256),
-            RelaxStepOp{particles, mesh.points, next, float(settings.effectiveRadius), float(settings.blend),
-                        interrupter, cancelled});
+        groupVerticesByCell(mesh.points, particles.cellSize(), order, groupStart);
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, groupStart.size() - 1, 64),
+            RelaxStepOp{particles, order, groupStart, mesh.points, next, float(settings.effectiveRadius),
+                        float(settings.blend), interrupter, cancelled});
         mesh.points.swap(next);
         if (interrupter && interrupter->wasInterrupted(100 * (iteration + 1) / settings.iterations)) {
             cancelled = true;
