@@ -16,7 +16,9 @@ namespace nonbloppy {
 
 namespace {
 
-constexpr size_t kLanes = 8;  ///< candidates processed side by side (two SSE or one AVX register)
+constexpr size_t kLanes = 8;
+/// Edge of a vertex group in particle-index cells.
+constexpr double kGroupCells = 2.0;  ///< candidates processed side by side (two SSE or one AVX register)
 
 /// Candidate particles of one group of vertices, as separate x, y, z arrays padded to a
 /// multiple of kLanes with particles far outside every support (weight 0).
@@ -100,15 +102,16 @@ struct RelaxStepOp
         const auto& positions = particles.sortedPositions();
         auto accessor = particles.impl().grid->getConstAccessor();
         const double cellSize = particles.cellSize();
+        const double groupSize = kGroupCells * cellSize;
         const float radius = effectiveRadius;
         const float minDistance2 = (kMinDistanceFraction * radius) * (kMinDistanceFraction * radius);
         CandidateBuffer candidates;
         for (size_t g = range.begin(); g < range.end(); ++g) {
             const size_t begin = groupStart[g], end = groupStart[g + 1];
             // The group's cell, grown by r_e, holds every particle near any of its vertices.
-            const openvdb::Coord cell = particle_index_internal::cellOf(previous[vertexOrder[begin]], cellSize);
-            const openvdb::Vec3d cellMin = (cell.asVec3d() - 0.5) * cellSize;
-            const openvdb::Vec3d cellMax = (cell.asVec3d() + 0.5) * cellSize;
+            const openvdb::Coord cell = particle_index_internal::cellOf(previous[vertexOrder[begin]], groupSize);
+            const openvdb::Vec3d cellMin = (cell.asVec3d() - 0.5) * groupSize;
+            const openvdb::Vec3d cellMax = (cell.asVec3d() + 0.5) * groupSize;
             // Vertices sit in the cell up to float rounding: grow it by a hair so the filter
             // never drops a particle that a vertex on the cell's face can reach.
             const float slack = 1e-4f * float(cellSize);
@@ -213,7 +216,7 @@ void relaxVertices(SurfaceMesh& mesh, const ParticleIndex& particles, const Rela
     std::vector<size_t> groupStart;
     std::atomic<bool> cancelled{false};
     for (int iteration = 0; iteration < settings.iterations && !cancelled; ++iteration) {
-        groupVerticesByCell(mesh.points, particles.cellSize(), order, groupStart);
+        groupVerticesByCell(mesh.points, kGroupCells * particles.cellSize(), order, groupStart);
         tbb::parallel_for(tbb::blocked_range<size_t>(0, groupStart.size() - 1, 64),
             RelaxStepOp{particles, order, groupStart, mesh.points, next, float(settings.effectiveRadius),
                         float(settings.blend), interrupter, cancelled});
