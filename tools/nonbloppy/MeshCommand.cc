@@ -360,6 +360,75 @@ private:
     std::vector<std::string> mPaths;
 };
 
+/// What meshing one frame produced: the library's result and every stage's seconds
+/// (the tool's own "read particles", "write mesh", "write vdb" included).
+struct FrameOutcome
+{
+    nonbloppy::SurfaceResult result;
+    nonbloppy::StageTimings timings;
+};
+
+/// Read o.input, build the surface, write o.output (and o.vdbPath). Used for a single file
+/// and, with the paths of one frame filled in, for every frame of a sequence.
+/// On any exception the files written so far are removed again.
+FrameOutcome meshFrame(const MeshOptions& o, ProgressInterrupter& interrupter)
+{
+    OutputCleanup cleanup;
+    nonbloppy::StageTimings before, after;
+
+    nonbloppy::ParticleSet particles;
+    {
+        StageScope stage(interrupter, before, "read particles");
+        particles = nonbloppy::readParticles(o.input);
+    }
+    if (particles.size() == 0) {
+        throw nonbloppy::FileError("no particles in " + o.input);
+    }
+    throwIfInterrupted();
+
+    nonbloppy::SurfaceParameters params;
+    params.spacing = ifGiven(o.spacingOpt, o.spacing);
+    params.effectiveRadius = ifGiven(o.radiusOpt, o.radius);
+    params.threshold = ifGiven(o.thresholdOpt, o.threshold);
+    params.voxelSize = ifGiven(o.voxelSizeOpt, o.voxelSize);
+    params.blend = o.blend;
+    params.iterations = o.iterations;
+    params.adaptivity = o.adaptivity;
+
+    // The particles are handed over; their attributes are not needed for meshing.
+    FrameOutcome outcome;
+    outcome.result = nonbloppy::buildSurface(std::move(particles.positions), params, &interrupter);
+    nonbloppy::SurfaceResult& result = outcome.result;
+    particles = nonbloppy::ParticleSet();
+    throwIfInterrupted();
+
+    {
+        StageScope stage(interrupter, after, "write mesh");
+        nonbloppy::MeshWriteSettings settings;
+        settings.keepQuads = o.quads;
+        nonbloppy::writeMesh(result.mesh, o.output, settings);
+        cleanup.add(o.output);
+    }
+    throwIfInterrupted();
+
+    if (!o.vdbPath.empty()) {
+        if (!result.density) throw nonbloppy::Error("no density grid to write");
+        StageScope stage(interrupter, after, "write vdb");
+        result.density->insertMeta("source_file", openvdb::StringMetadata(o.input));
+        openvdb::MetaMap fileMetadata;
+        fileMetadata.insertMeta("creator", openvdb::StringMetadata(versionLine()));
+        nonbloppy::writeVdb({result.density}, o.vdbPath, fileMetadata);
+        cleanup.add(o.vdbPath);
+    }
+    throwIfInterrupted();
+    cleanup.keep();
+
+    outcome.timings = before;
+    for (const auto& entry : result.timings.entries) outcome.timings.add(entry.stage, entry.seconds);
+    for (const auto& entry : after.entries) outcome.timings.add(entry.stage, entry.seconds);
+    return outcome;
+}
+
 int runMesh(const MeshOptions& o)
 {
     validate(o);
@@ -374,66 +443,13 @@ int runMesh(const MeshOptions& o)
 
     SignalHandlerScope signals;
     ProgressInterrupter interrupter(o.verbose);
-    OutputCleanup cleanup;
 
     try {
-        nonbloppy::StageTimings before, after;
-
-        nonbloppy::ParticleSet particles;
-        {
-            StageScope stage(interrupter, before, "read particles");
-            particles = nonbloppy::readParticles(o.input);
-        }
-        if (particles.size() == 0) {
-            throw nonbloppy::FileError("no particles in " + o.input);
-        }
-        throwIfInterrupted();
-
-        nonbloppy::SurfaceParameters params;
-        params.spacing = ifGiven(o.spacingOpt, o.spacing);
-        params.effectiveRadius = ifGiven(o.radiusOpt, o.radius);
-        params.threshold = ifGiven(o.thresholdOpt, o.threshold);
-        params.voxelSize = ifGiven(o.voxelSizeOpt, o.voxelSize);
-        params.blend = o.blend;
-        params.iterations = o.iterations;
-        params.adaptivity = o.adaptivity;
-
-        // The particles are handed over; their attributes are not needed for meshing.
-        nonbloppy::SurfaceResult result =
-            nonbloppy::buildSurface(std::move(particles.positions), params, &interrupter);
-        particles = nonbloppy::ParticleSet();
-        throwIfInterrupted();
-
-        {
-            StageScope stage(interrupter, after, "write mesh");
-            nonbloppy::MeshWriteSettings settings;
-            settings.keepQuads = o.quads;
-            nonbloppy::writeMesh(result.mesh, o.output, settings);
-            cleanup.add(o.output);
-        }
-        throwIfInterrupted();
-
-        if (!o.vdbPath.empty()) {
-            if (!result.density) throw nonbloppy::Error("no density grid to write");
-            StageScope stage(interrupter, after, "write vdb");
-            result.density->insertMeta("source_file", openvdb::StringMetadata(o.input));
-            openvdb::MetaMap fileMetadata;
-            fileMetadata.insertMeta("creator", openvdb::StringMetadata(versionLine()));
-            nonbloppy::writeVdb({result.density}, o.vdbPath, fileMetadata);
-            cleanup.add(o.vdbPath);
-        }
-        throwIfInterrupted();
-        cleanup.keep();
-
-        if (!o.quiet) {
-            nonbloppy::StageTimings timings = before;
-            for (const auto& entry : result.timings.entries) timings.add(entry.stage, entry.seconds);
-            for (const auto& entry : after.entries) timings.add(entry.stage, entry.seconds);
-            printSummary(o, result, timings, threads);
-        }
+        const FrameOutcome outcome = meshFrame(o, interrupter);
+        if (!o.quiet) printSummary(o, outcome.result, outcome.timings, threads);
         return 0;
     } catch (const nonbloppy::CancelledError&) {
-        // OutputCleanup has removed what was written; the library leaves nothing behind.
+        // meshFrame() has removed what was written; the library leaves nothing behind.
         std::cerr << "nonbloppy: interrupted" << std::endl;
         return kExitInterrupted;
     }
