@@ -61,16 +61,19 @@ std::vector<openvdb::Coord> candidateLeafOrigins(const ParticleIndex& particles,
     return all;
 }
 
-/// Add the weights of one particle to the 8 voxels of a leaf row: voxel l is at squared
-/// distance dxy2 + (l·h − pz)². re/d − 1 ≤ 0 from d = r_e on, so clamping at 0 cuts the
+/// Add the weights of one particle to voxels zFirst..zLast (rounded out to groups of 4) of a
+/// leaf row: voxel l is at squared distance dxy2 + (l·h − pz)². re/d − 1 ≤ 0 from d = r_e on, so clamping at 0 cuts the
 /// support without a branch. SSE and scalar paths give identical bits (IEEE sqrt and div).
-inline void addRowWeights(float* row, float dxy2, float pz, float h, float radius, float minDistance2)
+inline void addRowWeights(float* row, int zFirst, int zLast, float dxy2, float pz, float h, float radius,
+                          float minDistance2)
 {
 #if defined(__SSE2__)
     const __m128 vh = _mm_set1_ps(h), vpz = _mm_set1_ps(pz), vdxy2 = _mm_set1_ps(dxy2);
     const __m128 vradius = _mm_set1_ps(radius), vmin = _mm_set1_ps(minDistance2);
     const __m128 one = _mm_set1_ps(1.0f), zero = _mm_setzero_ps();
-    for (int half = 0; half < 2; ++half) {
+    // Only the 4-voxel halves the support reaches (a particle's 9-voxel span usually
+    // straddles two leaves, so one half is often idle).
+    for (int half = zFirst >> 2; half <= (zLast >> 2); ++half) {
         const __m128 lz = _mm_set_ps(float(4 * half + 3), float(4 * half + 2), float(4 * half + 1), float(4 * half));
         const __m128 dz = _mm_sub_ps(_mm_mul_ps(lz, vh), vpz);
         const __m128 d2 = _mm_add_ps(vdxy2, _mm_mul_ps(dz, dz));
@@ -79,7 +82,7 @@ inline void addRowWeights(float* row, float dxy2, float pz, float h, float radiu
         _mm_storeu_ps(row + 4 * half, _mm_add_ps(_mm_loadu_ps(row + 4 * half), w));
     }
 #else
-    for (int l = 0; l < 8; ++l) {
+    for (int l = zFirst & ~3; l <= (zLast | 3); ++l) {
         const float dz = float(l) * h - pz;
         const float d2 = dxy2 + dz * dz;
         const float w = radius / std::sqrt(std::max(d2, minDistance2)) - 1.0f;
@@ -145,7 +148,7 @@ struct RasterizeLeafOp
                                 if (!(dxy2 < radius2)) continue;
                                 // Always the whole 8-voxel row of the leaf: branch-free SIMD;
                                 // voxels outside the support get 0.
-                                addRowWeights(values + (i << 6) + (j << 3), dxy2, pz, h, radius, minDistance2);
+                                addRowWeights(values + (i << 6) + (j << 3), lo[2], hi[2], dxy2, pz, h, radius, minDistance2);
                             }
                         }
                     }

@@ -10,6 +10,8 @@
 
 #include <atomic>
 #include <cmath>
+#include <limits>
+#include <utility>
 #include <sstream>
 
 namespace nonbloppy {
@@ -169,23 +171,39 @@ struct RelaxStepOp
     }
 };
 
-/// Sort vertex numbers by the particle-index cell their position falls in and return the
-/// start of each run of equal cells (plus the end). Ties keep vertex order: deterministic.
-void groupVerticesByCell(const std::vector<openvdb::Vec3s>& points, double cellSize,
+/// Sort vertex numbers by the group cell (edge @a groupSize) their position falls in and
+/// return the start of each run of equal cells (plus the end). Cells are packed into 64-bit
+/// keys relative to the smallest cell, so the sort compares integers, not coordinates through
+/// an index; ties keep vertex order, so grouping is deterministic.
+void groupVerticesByCell(const std::vector<openvdb::Vec3s>& points, double groupSize,
                          std::vector<uint32_t>& order, std::vector<size_t>& groupStart)
 {
-    std::vector<openvdb::Coord> cells(points.size());
+    using particle_index_internal::cellOf;
+    openvdb::Coord lowest(std::numeric_limits<int>::max()), highest(std::numeric_limits<int>::min());
+    for (const openvdb::Vec3s& p : points) {
+        const openvdb::Coord c = cellOf(p, groupSize);
+        lowest.minComponent(c);
+        highest.maxComponent(c);
+    }
+    constexpr int64_t kSpan = int64_t(1) << 21;
+    const openvdb::Coord extent = highest - lowest;
+    if (extent[0] >= kSpan || extent[1] >= kSpan || extent[2] >= kSpan) {
+        throw ParameterError("mesh vertices span more than 2^21 relaxation cells per axis; use a larger --radius");
+    }
+    std::vector<std::pair<uint64_t, uint32_t>> keyed(points.size());
     tbb::parallel_for(tbb::blocked_range<size_t>(0, points.size()), [&](const tbb::blocked_range<size_t>& r) {
-        for (size_t i = r.begin(); i < r.end(); ++i) cells[i] = particle_index_internal::cellOf(points[i], cellSize);
+        for (size_t i = r.begin(); i < r.end(); ++i) {
+            const openvdb::Coord c = cellOf(points[i], groupSize) - lowest;
+            const uint64_t key = (uint64_t(c[0]) << 42) | (uint64_t(c[1]) << 21) | uint64_t(c[2]);
+            keyed[i] = {key, uint32_t(i)};
+        }
     });
+    tbb::parallel_sort(keyed.begin(), keyed.end());
     order.resize(points.size());
-    for (size_t i = 0; i < order.size(); ++i) order[i] = uint32_t(i);
-    tbb::parallel_sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) {
-        return cells[a] < cells[b] || (cells[a] == cells[b] && a < b);
-    });
     groupStart.clear();
-    for (size_t n = 0; n < order.size(); ++n) {
-        if (n == 0 || cells[order[n]] != cells[order[n - 1]]) groupStart.push_back(n);
+    for (size_t n = 0; n < keyed.size(); ++n) {
+        order[n] = keyed[n].second;
+        if (n == 0 || keyed[n].first != keyed[n - 1].first) groupStart.push_back(n);
     }
     groupStart.push_back(order.size());
 }
