@@ -64,7 +64,9 @@ SurfaceResult buildSurface(std::vector<openvdb::Vec3f> positions, const SurfaceP
     {
         ScopedStageTimer timer(result.timings, "extract surface");
         if (interrupter) interrupter->start("extract surface");
+        if (!params.keepDensity) tileDeepInterior(*result.density, p.threshold);
         result.mesh = extractSurface(*result.density, p.threshold, p.adaptivity);
+        if (!params.keepDensity) result.density.reset();
         if (interrupter) interrupter->end();
     }
     checkCancelled(interrupter, "extract surface");

@@ -2,6 +2,7 @@
 #include "TestUtil.h"
 
 #include <nonbloppy/BuildSurface.h>
+#include <nonbloppy/ExtractSurface.h>
 #include <nonbloppy/MeasureMesh.h>
 #include <nonbloppy/ReadParticles.h>
 
@@ -86,4 +87,36 @@ TEST(BuildSurface, IdenticalWithOneAndTwoThreads)
     EXPECT_EQ(serial.mesh.quads, parallel.mesh.quads);
     EXPECT_EQ(serial.mesh.triangles, parallel.mesh.triangles);
     EXPECT_EQ(serial.density->activeVoxelCount(), parallel.density->activeVoxelCount());
+}
+
+TEST(BuildSurface, DroppingTheDensityTilesTheInteriorAndKeepsTheMeshBitForBit)
+{
+    const ParticleSet particles = readParticles(dataPath("dam_break_frame_23_24389_particles.vtk"));
+    SurfaceParameters params;
+    const SurfaceResult exact = buildSurface(particles, params);
+    params.keepDensity = false;
+    const SurfaceResult tiled = buildSurface(particles, params);
+    EXPECT_FALSE(tiled.density);
+    EXPECT_EQ(exact.mesh.points, tiled.mesh.points);
+    EXPECT_EQ(exact.mesh.quads, tiled.mesh.quads);
+    EXPECT_EQ(exact.mesh.triangles, tiled.mesh.triangles);
+    EXPECT_EQ(exact.mesh.normals, tiled.mesh.normals);
+}
+
+TEST(ExtractSurface, DeepInteriorLeavesBecomeTilesAndTheSurfaceStaysTheSame)
+{
+    // A ball 36 spacings across (9 leaves) has leaves deep inside.
+    const auto ball = latticeParticles(0.1, 1.9, [](const openvdb::Vec3d& x) { return x.length() < 1.8; });
+    SurfaceParameters params;
+    params.iterations = 0;
+    const SurfaceResult result = buildSurface(ball, params);
+    const openvdb::FloatGrid::Ptr tiled = result.density->deepCopy();
+    const size_t leavesBefore = tiled->tree().leafCount();
+    const size_t replaced = tileDeepInterior(*tiled, result.parameters.threshold);
+    EXPECT_GT(replaced, 0u);
+    EXPECT_EQ(tiled->tree().leafCount(), leavesBefore - replaced);
+    // Tiles hold a value above r_0 (inside), so the surface is the same.
+    const SurfaceMesh mesh = extractSurface(*tiled, result.parameters.threshold);
+    EXPECT_EQ(mesh.points, result.mesh.points);
+    EXPECT_EQ(mesh.quads, result.mesh.quads);
 }

@@ -46,6 +46,10 @@ struct SurfaceParameters
     double blend = kDefaultBlend;           ///< c in [0,1]
     int iterations = kDefaultIterations;    ///< t ≥ 0
     double adaptivity = kDefaultAdaptivity; ///< in [0,1]
+    /// Return the exact density grid in SurfaceResult::density. false lets buildSurface()
+    /// replace leaves deep inside the fluid by tiles before extraction and return no grid:
+    /// the same mesh, bit for bit, with less memory and a faster extraction.
+    bool keepDensity = true;
 };
 
 /// Every parameter's value as used, and whether the user gave it.
