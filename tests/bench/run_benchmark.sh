@@ -1,0 +1,134 @@
+#!/usr/bin/env bash
+# Speed and memory of `nonbloppy mesh` against OpenVDB's own particle mesher, measured in one run
+# on the same inputs: the real dam-break frame tiled into 1, 64 and 512 disjoint copies.
+#
+#   bash tests/bench/run_benchmark.sh [--quick] [--runs N] [--out DIR]
+#
+#   --quick   skip the 512x input (12.5M particles) and the t/threads scans run once each
+#   --runs N  repetitions per tool and input, alternating the tools (default 3; the median is kept)
+#   --out DIR where the generated inputs, meshes and the report go (default /tmp/nonbloppy-bench)
+#
+# The peer is `vdb_tool` from Debian's libopenvdb-tools:
+#   vdb_tool -read IN.ply -points2ls voxel=0.025 radius=2 width=3 -ls2mesh adapt=0 -write OUT.ply
+# nonbloppy runs with voxel size 0.025, r_e = 0.1, c = 0.3, t = 2 and writes binary PLY too.
+# Wall time, CPU time (user + system) and peak RSS come from GNU time. The report is markdown,
+# printed and written to DIR/benchmark.md.
+set -euo pipefail
+cd "$(dirname "$0")/../.."
+
+runs=3
+quick=0
+out=/tmp/nonbloppy-bench
+while (($#)); do
+  case "$1" in
+    --quick) quick=1 ;;
+    --runs) runs="$2"; shift ;;
+    --out) out="$2"; shift ;;
+    *) echo "run_benchmark.sh: unknown option '$1'" >&2; exit 2 ;;
+  esac
+  shift
+done
+
+bash tools/setup.sh >/dev/null
+nonbloppy="$PWD/build/nonbloppy"
+tile="$PWD/build/nonbloppy_tile"
+frame="$PWD/tests/data/dam_break_frame_23_24389_particles.vtk"
+mkdir -p "$out"
+report="$out/benchmark.md"
+: > "$report"
+say() { printf '%s\n' "$*" | tee -a "$report"; }
+
+nb_args=(--voxel-size 0.025 --radius 0.1 --blend 0.3 --iterations 2)
+
+# run_timed LOG CMD...: runs CMD, appends "wall cpu rss_kb" to LOG; CMD's stdout goes to LOG.out.
+run_timed() {
+  local log="$1"; shift
+  /usr/bin/time -f "%e %U %S %M" -o "$log.time" "$@" > "$log.out" 2> "$log.err"
+  awk '{printf "%s %.2f %s\n", $1, $2 + $3, $4}' "$log.time" >> "$log"
+}
+
+# median COLUMN FILE
+median() { cut -d' ' -f"$1" "$2" | sort -g | awk '{v[NR] = $1} END {print v[int((NR + 1) / 2)]}'; }
+
+declare -A copies_of=([1]=1 [64]=4 [512]=8)
+sizes=(1 64 512)
+((quick)) && sizes=(1 64)
+
+say "# nonbloppy benchmark"
+say ""
+say "Command: \`bash tests/bench/run_benchmark.sh$( ((quick)) && printf ' --quick')  --runs $runs\`, $(date -u +%Y-%m-%d), $(nproc) cores, $(awk '/MemTotal/ {printf "%.0f GiB", $2 / 1048576}' /proc/meminfo)."
+say "Input: \`tests/data/dam_break_frame_23_24389_particles.vtk\` tiled by \`nonbloppy_tile --copies N\` (binary PLY)."
+say "nonbloppy: \`mesh IN -o OUT.ply ${nb_args[*]}\`; vdb_tool: \`-points2ls voxel=0.025 radius=2 width=3 -ls2mesh adapt=0\`."
+say "Median of $runs runs each, the two tools alternating."
+say ""
+say "| input | particles | tool | wall s | CPU s | peak RSS MB | particles/s | wall ratio | RSS ratio |"
+say "| --- | --- | --- | --- | --- | --- | --- | --- | --- |"
+
+declare -A nb_wall
+for size in "${sizes[@]}"; do
+  input="$out/dam_break_x${size}.ply"
+  [ -s "$input" ] || "$tile" "$frame" "$input" --copies "${copies_of[$size]}" > /dev/null
+  particles=$(( 24389 * size ))
+  rm -f "$out/nb_$size" "$out/vt_$size"
+  for ((r = 0; r < runs; ++r)); do
+    run_timed "$out/nb_$size" "$nonbloppy" mesh "$input" -o "$out/nb_x$size.ply" "${nb_args[@]}"
+    run_timed "$out/vt_$size" vdb_tool -read "$input" -points2ls voxel=0.025 radius=2 width=3 \
+      -ls2mesh adapt=0 -write "$out/vt_x$size.ply"
+  done
+  nbw=$(median 1 "$out/nb_$size"); nbc=$(median 2 "$out/nb_$size"); nbm=$(median 3 "$out/nb_$size")
+  vtw=$(median 1 "$out/vt_$size"); vtc=$(median 2 "$out/vt_$size"); vtm=$(median 3 "$out/vt_$size")
+  nb_wall[$size]=$nbw
+  ratio_wall=$(awk -v a="$nbw" -v b="$vtw" 'BEGIN {printf "%.2f", a / b}')
+  ratio_rss=$(awk -v a="$nbm" -v b="$vtm" 'BEGIN {printf "%.2f", a / b}')
+  rate() { awk -v n="$particles" -v t="$1" 'BEGIN {printf "%.3gM", n / t / 1e6}'; }
+  say "| ${size}x | $particles | nonbloppy | $nbw | $nbc | $((nbm / 1024)) | $(rate "$nbw") | $ratio_wall | $ratio_rss |"
+  say "| ${size}x | $particles | vdb_tool | $vtw | $vtc | $((vtm / 1024)) | $(rate "$vtw") | | |"
+done
+
+say ""
+say "Per-particle wall time, 512x relative to 64x (1.00 = linear): $(
+  if [ -n "${nb_wall[512]:-}" ]; then
+    awk -v a="${nb_wall[512]}" -v b="${nb_wall[64]}" 'BEGIN {printf "%.2f", (a / 512) / (b / 64)}'
+  else echo "not measured (--quick)"; fi)"
+
+# Stages of the last 64x run, as nonbloppy prints them.
+say ""
+say "nonbloppy stages, 64x input (last run):"
+say ""
+say '```'
+sed -n '/^timings/,$p' "$out/nb_64.out" | tee -a "$report"
+say '```'
+
+# Scaling with t and with threads on the 64x input.
+scan_runs=$runs
+((quick)) && scan_runs=1
+scan() {  # scan LABEL ARGS...: median wall of nonbloppy with ARGS on the 64x input
+  local log="$out/scan_$1"; shift
+  rm -f "$log"
+  for ((r = 0; r < scan_runs; ++r)); do
+    run_timed "$log" "$nonbloppy" mesh "$out/dam_break_x64.ply" -o "$out/scan.ply" "$@"
+  done
+  median 1 "$log"
+}
+say ""
+say "| 64x input | wall s |"
+say "| --- | --- |"
+declare -A t_wall
+for t in 0 1 2 4; do
+  t_wall[$t]=$(scan "t$t" --voxel-size 0.025 --radius 0.1 --blend 0.3 --iterations "$t")
+  say "| t = $t | ${t_wall[$t]} |"
+done
+threads1=$(scan threads1 "${nb_args[@]}" --threads 1)
+threads2=$(scan threads2 "${nb_args[@]}" --threads 2)
+say "| t = 2, --threads 1 | $threads1 |"
+say "| t = 2, --threads 2 | $threads2 |"
+say ""
+say "Each relaxation iteration costs $(awk -v a="${t_wall[4]}" -v b="${t_wall[0]}" 'BEGIN {printf "%.1f%%", 100 * (a - b) / 4 / b}') of the t = 0 run; two threads are $(awk -v a="$threads1" -v b="$threads2" 'BEGIN {printf "%.2fx", a / b}') faster than one."
+
+# The paper's figure: 14,272 particles, t = 2, about 15 s on a 2008 desktop. Compute time of the
+# 1x frame (24,389 particles; stages without reading and writing) scaled to 14,272 particles.
+compute=$(sed -n '/^timings/,$p' "$out/nb_1.out" | grep -vE 'read particles|write |total|timings' \
+  | awk '{for (i = 1; i <= NF; ++i) if ($i == "s") s += $(i - 1)} END {print s}')
+say ""
+say "Paper comparison: the 24,389-particle frame computes in ${compute} s (stages other than reading and writing, 2 threads), that is $(awk -v c="$compute" 'BEGIN {printf "%.3f", c * 14272 / 24389}') s for 14,272 particles (paper: about 15 s, t = 2)."
+echo "report: $report" >&2
