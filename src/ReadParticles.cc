@@ -7,6 +7,7 @@
 #include <nonbloppy/Error.h>
 
 #include "FileFormats.h"
+#include "ParticleReaders.h"
 
 #include <cmath>
 #include <cstring>
@@ -16,6 +17,9 @@ namespace nonbloppy {
 namespace {
 
 using namespace io_internal;
+
+const char* const kParticleExtensions =
+    ".vtk, .vtu, .vtp, .ply, .xyz, .bgeo, .vdb, .csv, .txt or .json";
 
 ParticleAttribute
 toAttribute(NumericArray&& array)
@@ -95,18 +99,23 @@ readParticles(const std::string& path)
     const std::string ext = lowerExtension(path);
     if (ext.empty()) {
         throw FileError("particle file name has no extension (" + path +
-            "); expected .vtk, .ply or .xyz");
+            "); expected " + kParticleExtensions);
     }
     if (!isParticleFile(path)) {
         throw FileError("unknown particle file extension '" + ext + "' (" + path +
-            "); expected .vtk, .ply or .xyz");
+            "); expected " + kParticleExtensions);
     }
     const std::vector<char> file = loadFile(path);
 
     ParticleSet particles;
     if (ext == ".vtk") particles = readVtkParticles(file, path);
     else if (ext == ".ply") particles = readPlyParticles(file, path);
-    else particles = readXyzParticles(file, path);
+    else if (ext == ".xyz") particles = readXyzParticles(file, path);
+    else if (ext == ".bgeo") particles = readBgeoParticles(file.data(), file.size(), path);
+    else if (ext == ".vtu" || ext == ".vtp") particles = readVtuParticles(file.data(), file.size(), path);
+    else if (ext == ".csv" || ext == ".txt") particles = readTableParticles(file.data(), file.size(), path);
+    else if (ext == ".json") particles = readJsonParticles(file.data(), file.size(), path);
+    else particles = readVdbPointsParticles(file.data(), file.size(), path);
 
     // Later stages hash positions into voxels; one NaN would poison the whole grid.
     for (size_t i = 0; i < particles.positions.size(); ++i) {
@@ -123,7 +132,8 @@ bool
 isParticleFile(const std::string& path)
 {
     const std::string ext = io_internal::lowerExtension(path);
-    return ext == ".vtk" || ext == ".ply" || ext == ".xyz";
+    return ext == ".vtk" || ext == ".ply" || ext == ".xyz" || ext == ".bgeo" || ext == ".vtu"
+        || ext == ".vtp" || ext == ".csv" || ext == ".txt" || ext == ".json" || ext == ".vdb";
 }
 
 } // namespace nonbloppy

@@ -266,7 +266,8 @@ TEST_F(ReadParticlesTest, ExtensionIsCaseInsensitive)
     EXPECT_EQ(readParticles(path("upper.VTK")).size(), 8u);
     EXPECT_TRUE(nonbloppy::isParticleFile("a/b.Ply"));
     EXPECT_TRUE(nonbloppy::isParticleFile("x.xyz"));
-    EXPECT_FALSE(nonbloppy::isParticleFile("x.vtu"));
+    EXPECT_TRUE(nonbloppy::isParticleFile("x.VTU"));
+    EXPECT_FALSE(nonbloppy::isParticleFile("x.vtm"));
     EXPECT_FALSE(nonbloppy::isParticleFile("dir.vtk/file"));
     EXPECT_FALSE(nonbloppy::isParticleFile("vtk"));
 }
@@ -528,10 +529,10 @@ TEST_F(ReadParticlesTest, MissingFileAndUnknownExtension)
         "cannot open " + path("missing.vtk") + ": No such file or directory");
     EXPECT_EQ(fileErrorOf(path("particles.foo")),
         "unknown particle file extension '.foo' (" + path("particles.foo") +
-        "); expected .vtk, .ply or .xyz");
+        "); expected .vtk, .vtu, .vtp, .ply, .xyz, .bgeo, .vdb, .csv, .txt or .json");
     EXPECT_EQ(fileErrorOf(path("particles")),
         "particle file name has no extension (" + path("particles") +
-        "); expected .vtk, .ply or .xyz");
+        "); expected .vtk, .vtu, .vtp, .ply, .xyz, .bgeo, .vdb, .csv, .txt or .json");
     const std::string directory = path("dir.vtk");
     ASSERT_EQ(mkdir(directory.c_str(), 0755), 0);
     EXPECT_EQ(fileErrorOf(directory), "cannot read " + directory + ": Is a directory");

@@ -273,7 +273,7 @@ TEST_F(CliTest, UnknownInputExtension)
     writeText(path, "1 2 3\n");
     expectFailure("mesh " + quote(path) + " -o " + quote(out("x.obj")),
                   "unknown particle file extension '.foo' (" + path
-                      + "); expected .vtk, .ply or .xyz");
+                      + "); expected .vtk, .vtu, .vtp, .ply, .xyz, .bgeo, .vdb, .csv, .txt or .json");
 }
 
 TEST_F(CliTest, TruncatedInput)
@@ -364,12 +364,13 @@ TEST_F(CliTest, BadVdbNameAndInputAsOutput)
 
 TEST_F(CliTest, InspectUnknownExtension)
 {
-    const std::string path = in("notes.txt");
+    const std::string path = in("notes.md");
     writeText(path, "hello\n");
     const RunResult r = run("inspect " + quote(path));
     EXPECT_EQ(r.exitCode, 1);
-    EXPECT_EQ(r.err, "nonbloppy: unknown file extension '.txt' (" + path
-                         + "); expected .vdb, .obj, .ply, .vtk or .xyz\n");
+    EXPECT_EQ(r.err, "nonbloppy: unknown file extension '.md' (" + path
+                         + "); expected .vdb, .obj, .ply, .vtk, .vtu, .vtp, .xyz, .bgeo, .csv, .txt "
+                           "or .json\n");
 }
 
 TEST_F(CliTest, UsageErrorsAreOneLine)

@@ -15,6 +15,20 @@
 ///           double) plus every other scalar vertex property as a 1-component attribute;
 ///           list properties and other elements are skipped.
 /// - `.xyz`  raw little-endian float32 triples, no header.
+/// - `.bgeo` Houdini classic binary geometry (`BgeoV` version 5, as Partio and SPlisHSPlasH
+///           write it), gzip-compressed or not; float, int, vector and index point
+///           attributes. JSON-based `.bgeo` (Houdini 12+) is rejected as unsupported.
+/// - `.vtu`, `.vtp`  VTK XML UnstructuredGrid / PolyData: ascii, inline base64 and appended
+///           (raw or base64) arrays, zlib-compressed or not, UInt32/UInt64 headers, either
+///           byte order, Float32/Float64 points; every PointData array in its type.
+/// - `.vdb`  the first openvdb::points::PointDataGrid: world positions from `P` plus every
+///           numeric and vector attribute (group and string attributes are skipped); a .vdb
+///           without one (e.g. a density cache) is an error.
+/// - `.csv`, `.txt`  a header row naming the columns (x, y, z or ParaView's Points:0..2,
+///           plus any others; `name:0..2`, `name_x/_y/_z` and `name[0..2]` form 3-vectors),
+///           separated by ',', ';', tabs or spaces; attributes are int64 if every value is
+///           an integer, else float64.
+/// - `.json` `[[x, y, z], ...]` (positions only).
 /// A file with zero particles is read without complaint (the pipeline rejects it later).
 /// Cost: one pass over the file held in memory; binary data are copied with memcpy and a
 /// byte swap, text parsed with std::from_chars (about 0.1 s for 2M binary particles).

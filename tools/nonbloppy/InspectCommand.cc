@@ -509,7 +509,8 @@ int runInspect(const std::string& path, bool json)
         return inspectParticles(path, nonbloppy::readParticles(path), json);
     }
     throw nonbloppy::FileError("unknown file extension '" + ext + "' (" + path
-                               + "); expected .vdb, .obj, .ply, .vtk or .xyz");
+                               + "); expected .vdb, .obj, .ply, .vtk, .vtu, .vtp, .xyz, .bgeo, "
+                                 ".csv, .txt or .json");
 }
 
 } // namespace

@@ -1,0 +1,39 @@
+// SPDX-License-Identifier: Apache-2.0
+/// @file ParticleReaders.h
+/// @brief Private: the particle readers added after VTK/PLY/XYZ, one source file each,
+///        all working on a buffer holding the whole file (so the fuzz targets in
+///        tests/fuzz/ can feed them bytes directly). readParticles() dispatches to them.
+///
+/// Each one names @a path in its errors only; it never opens it. Every count read from a
+/// header is checked against the bytes present before anything is allocated.
+
+#ifndef NONBLOPPY_PARTICLE_READERS_H
+#define NONBLOPPY_PARTICLE_READERS_H
+
+#include <nonbloppy/Particles.h>
+
+#include <cstddef>
+#include <string>
+
+namespace nonbloppy {
+namespace io_internal {
+
+/// Houdini classic BGEO (`BgeoV`, version 5, big-endian), gzip-compressed or not.
+ParticleSet readBgeoParticles(const char* data, size_t size, const std::string& path);
+
+/// VTK XML UnstructuredGrid or PolyData (`.vtu`, `.vtp`).
+ParticleSet readVtuParticles(const char* data, size_t size, const std::string& path);
+
+/// Delimited text with a header row naming the columns (`.csv`, `.txt`).
+ParticleSet readTableParticles(const char* data, size_t size, const std::string& path);
+
+/// JSON `[[x,y,z], ...]`.
+ParticleSet readJsonParticles(const char* data, size_t size, const std::string& path);
+
+/// The first openvdb::points::PointDataGrid of a `.vdb` file.
+ParticleSet readVdbPointsParticles(const char* data, size_t size, const std::string& path);
+
+} // namespace io_internal
+} // namespace nonbloppy
+
+#endif // NONBLOPPY_PARTICLE_READERS_H

@@ -1,0 +1,332 @@
+// SPDX-License-Identifier: Apache-2.0
+/// @file ReadTable.cc
+/// @brief Text particle tables: CSV/TXT with a header row, and JSON `[[x,y,z], ...]`.
+///
+/// Table layout: lines starting with '#' and blank lines are skipped; the first other line
+/// names the columns, separated by ',' or ';' or tabs or spaces (the first of these found
+/// in the header is the separator), names optionally quoted. Positions are the columns
+/// x, y, z (any case), or ParaView's `Points:0..2`, or `<name>_x/_y/_z` with name
+/// position, pos or p. Every other column is an attribute; consecutive columns
+/// `<name>:0,:1,:2` (ParaView), `<name>_x,_y,_z`, `<name>[0..2]` form one 3-component
+/// attribute `<name>`. An attribute whose values are all integers is Int64, else Float64.
+
+#include "FileFormats.h"
+#include "ParticleReaders.h"
+
+#include <nonbloppy/Error.h>
+
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <cstring>
+#include <string_view>
+
+namespace nonbloppy {
+namespace io_internal {
+
+namespace {
+
+std::string
+lower(std::string_view text)
+{
+    std::string out(text);
+    for (char& c : out) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    return out;
+}
+
+std::string_view
+trimmed(std::string_view text)
+{
+    while (!text.empty() && (text.front() == ' ' || text.front() == '\t' || text.front() == '\r')) text.remove_prefix(1);
+    while (!text.empty() && (text.back() == ' ' || text.back() == '\t' || text.back() == '\r')) text.remove_suffix(1);
+    if (text.size() >= 2 && (text.front() == '"' || text.front() == '\'') && text.back() == text.front()) {
+        text = text.substr(1, text.size() - 2);
+    }
+    return text;
+}
+
+/// Split @a line at @a separator (' ' means runs of spaces and tabs).
+void
+splitLine(std::string_view line, char separator, std::vector<std::string_view>& fields)
+{
+    fields.clear();
+    if (separator == ' ') {
+        size_t pos = 0;
+        while (pos < line.size()) {
+            while (pos < line.size() && (line[pos] == ' ' || line[pos] == '\t' || line[pos] == '\r')) ++pos;
+            const size_t start = pos;
+            while (pos < line.size() && line[pos] != ' ' && line[pos] != '\t' && line[pos] != '\r') ++pos;
+            if (pos > start) fields.push_back(line.substr(start, pos - start));
+        }
+        return;
+    }
+    size_t start = 0;
+    while (true) {
+        const size_t end = line.find(separator, start);
+        fields.push_back(trimmed(line.substr(start, end == std::string_view::npos ? end : end - start)));
+        if (end == std::string_view::npos) break;
+        start = end + 1;
+    }
+}
+
+/// If @a name is "<base><suffix>" with suffix one of the component spellings, return the
+/// component (0..2) and set @a base; else -1.
+int
+componentOf(const std::string& name, std::string& base)
+{
+    static const char* suffixes[3][4] = {{":0", "_x", "[0]", ".x"},
+                                         {":1", "_y", "[1]", ".y"},
+                                         {":2", "_z", "[2]", ".z"}};
+    const std::string low = lower(name);
+    for (int c = 0; c < 3; ++c) {
+        for (const char* suffix : suffixes[c]) {
+            const size_t n = std::strlen(suffix);
+            if (low.size() > n && low.compare(low.size() - n, n, suffix) == 0) {
+                base = name.substr(0, name.size() - n);
+                return c;
+            }
+        }
+    }
+    return -1;
+}
+
+bool
+isPositionBase(const std::string& base)
+{
+    const std::string low = lower(base);
+    return low == "points" || low == "position" || low == "pos" || low == "p";
+}
+
+struct Column
+{
+    int attribute = -1;  ///< index into the attribute list, or -1 for a position
+    int component = 0;   ///< axis for positions, component for attributes
+};
+
+bool
+parseDoubleField(std::string_view text, double& value)
+{
+    if (!text.empty() && text[0] == '+') text.remove_prefix(1);
+    const auto result = std::from_chars(text.data(), text.data() + text.size(), value);
+    if (result.ec == std::errc::result_out_of_range) {
+        value = std::strtod(std::string(text).c_str(), nullptr);
+        return std::isfinite(value);
+    }
+    return result.ec == std::errc() && result.ptr == text.data() + text.size() && !text.empty();
+}
+
+} // namespace
+
+ParticleSet
+readTableParticles(const char* data, size_t size, const std::string& path)
+{
+    const std::string_view text(data, size);
+    size_t pos = 0;
+    size_t lineNumber = 0;
+    auto nextLine = [&](std::string_view& line) {
+        while (pos < text.size()) {
+            size_t end = text.find('\n', pos);
+            if (end == std::string_view::npos) end = text.size();
+            line = text.substr(pos, end - pos);
+            pos = end + 1;
+            ++lineNumber;
+            const std::string_view content = trimmed(line);
+            if (content.empty() || content[0] == '#') continue;
+            return true;
+        }
+        return false;
+    };
+
+    std::string_view header;
+    if (!nextLine(header)) fail(path, "empty table: no header row");
+    char separator = ' ';
+    for (char candidate : {',', ';', '\t'}) {
+        if (header.find(candidate) != std::string_view::npos) {
+            separator = candidate;
+            break;
+        }
+    }
+    std::vector<std::string_view> fields;
+    splitLine(header, separator, fields);
+
+    // Map the columns to positions and attributes.
+    std::vector<Column> columns(fields.size());
+    std::vector<std::string> names;
+    std::vector<int> componentCounts;
+    int axisColumn[3] = {-1, -1, -1};
+    for (size_t i = 0; i < fields.size(); ++i) {
+        const std::string name(trimmed(fields[i]));
+        if (name.empty()) fail(path, "empty column name in header (column " + std::to_string(i + 1) + ")");
+        const std::string low = lower(name);
+        int axis = low == "x" ? 0 : low == "y" ? 1 : low == "z" ? 2 : -1;
+        std::string base;
+        const int component = componentOf(name, base);
+        if (axis < 0 && component >= 0 && isPositionBase(base)) axis = component;
+        if (axis >= 0) {
+            if (axisColumn[axis] >= 0) fail(path, "two columns for coordinate " + std::string(1, "xyz"[axis]));
+            axisColumn[axis] = int(i);
+            columns[i] = {-1, axis};
+            continue;
+        }
+        // Continue the previous column's vector if this is its next component.
+        if (component > 0 && i > 0 && columns[i - 1].attribute >= 0
+            && names[size_t(columns[i - 1].attribute)] == base
+            && columns[i - 1].component == component - 1) {
+            columns[i] = {columns[i - 1].attribute, component};
+            componentCounts[size_t(columns[i - 1].attribute)] = component + 1;
+            continue;
+        }
+        const std::string attributeName = component == 0 ? base : name;
+        if (std::find(names.begin(), names.end(), attributeName) != names.end()) {
+            fail(path, "duplicate column '" + printable(attributeName) + "'");
+        }
+        columns[i] = {int(names.size()), 0};
+        names.push_back(attributeName);
+        componentCounts.push_back(1);
+    }
+    if (axisColumn[0] < 0 || axisColumn[1] < 0 || axisColumn[2] < 0) {
+        fail(path, "the header must name columns x, y and z, got '" + printable(header) + "'");
+    }
+
+    // Values, as doubles first; the type of each attribute is settled at the end.
+    std::vector<std::vector<double>> values(names.size());
+    std::vector<bool> integral(names.size(), true);
+    ParticleSet particles;
+    std::string_view line;
+    while (nextLine(line)) {
+        splitLine(line, separator, fields);
+        if (fields.size() != columns.size()) {
+            fail(path, "line " + std::to_string(lineNumber) + " has " + std::to_string(fields.size()) +
+                 " fields, the header " + std::to_string(columns.size()));
+        }
+        openvdb::Vec3f p;
+        for (size_t i = 0; i < fields.size(); ++i) {
+            double value;
+            const std::string_view field = trimmed(fields[i]);
+            if (!parseDoubleField(field, value)) {
+                fail(path, "bad number '" + printable(field) + "' on line " + std::to_string(lineNumber));
+            }
+            if (columns[i].attribute < 0) {
+                p[columns[i].component] = static_cast<float>(value);
+            } else {
+                const size_t a = size_t(columns[i].attribute);
+                values[a].push_back(value);
+                if (integral[a] && (field.find_first_of(".eE") != std::string_view::npos
+                                    || !(std::abs(value) < 9.0e15))) {
+                    integral[a] = false;
+                }
+            }
+        }
+        particles.positions.push_back(p);
+    }
+    for (size_t a = 0; a < names.size(); ++a) {
+        ParticleAttribute attribute;
+        attribute.name = names[a];
+        attribute.components = componentCounts[a];
+        attribute.type = integral[a] ? ScalarType::Int64 : ScalarType::Float64;
+        attribute.bytes.resize(values[a].size() * 8);
+        for (size_t k = 0; k < values[a].size(); ++k) {
+            if (integral[a]) {
+                const int64_t v = static_cast<int64_t>(values[a][k]);
+                std::memcpy(attribute.bytes.data() + 8 * k, &v, 8);
+            } else {
+                std::memcpy(attribute.bytes.data() + 8 * k, &values[a][k], 8);
+            }
+        }
+        particles.attributes.push_back(std::move(attribute));
+    }
+    return particles;
+}
+
+namespace {
+
+/// SAX handler for `[[x,y,z], ...]`: nothing but numbers two levels deep, three per inner
+/// array; no DOM is built, so memory is the particles only.
+class JsonPointsHandler : public nlohmann::json_sax<nlohmann::json>
+{
+public:
+    explicit JsonPointsHandler(const std::string& path) : mPath(path) {}
+
+    std::vector<openvdb::Vec3f> positions;
+    std::string error;
+
+    bool number(double value)
+    {
+        if (mDepth != 2) return reject("expected an array of [x, y, z] arrays");
+        if (mComponent >= 3) return reject("particle " + std::to_string(positions.size()) + " has more than 3 coordinates");
+        mPoint[mComponent++] = static_cast<float>(value);
+        return true;
+    }
+    bool null() override { return reject("null where a coordinate was expected"); }
+    bool boolean(bool) override { return reject("boolean where a coordinate was expected"); }
+    bool number_integer(number_integer_t value) override { return number(double(value)); }
+    bool number_unsigned(number_unsigned_t value) override { return number(double(value)); }
+    bool number_float(number_float_t value, const string_t&) override { return number(value); }
+    bool string(string_t&) override { return reject("string where a coordinate was expected"); }
+    bool binary(binary_t&) override { return reject("binary value where a coordinate was expected"); }
+    bool start_object(std::size_t) override { return reject("object where an array was expected"); }
+    bool key(string_t&) override { return reject("object where an array was expected"); }
+    bool end_object() override { return reject("object where an array was expected"); }
+    bool start_array(std::size_t) override
+    {
+        if (++mDepth > 2) return reject("arrays nested deeper than [[x, y, z], ...]");
+        mComponent = 0;
+        return true;
+    }
+    bool end_array() override
+    {
+        if (mDepth == 2) {
+            if (mComponent != 3) {
+                return reject("particle " + std::to_string(positions.size()) + " has " +
+                              std::to_string(mComponent) + " coordinates, expected 3");
+            }
+            positions.push_back(mPoint);
+        }
+        --mDepth;
+        return true;
+    }
+    bool parse_error(std::size_t position, const std::string&, const nlohmann::detail::exception& e) override
+    {
+        // e.what() is "[json.exception.parse_error.101] parse error at line 1, column 2: ..."
+        std::string message = e.what();
+        const size_t bracket = message.find("] ");
+        if (bracket != std::string::npos) message = message.substr(bracket + 2);
+        for (char& c : message) {
+            if (static_cast<unsigned char>(c) < 0x20 || static_cast<unsigned char>(c) >= 0x7f) c = '?';
+        }
+        return reject(message + " (byte " + std::to_string(position) + ")");
+    }
+
+private:
+    bool reject(const std::string& message)
+    {
+        if (error.empty()) error = message;
+        return false;
+    }
+
+    const std::string& mPath;
+    int mDepth = 0;
+    int mComponent = 0;
+    openvdb::Vec3f mPoint;
+};
+
+} // namespace
+
+ParticleSet
+readJsonParticles(const char* data, size_t size, const std::string& path)
+{
+    JsonPointsHandler handler(path);
+    const bool ok = nlohmann::json::sax_parse(data, data + size, &handler,
+                                              nlohmann::json::input_format_t::json, true);
+    if (!ok || !handler.error.empty()) {
+        fail(path, "bad JSON particle list: " + (handler.error.empty() ? "parse error" : handler.error));
+    }
+    ParticleSet particles;
+    particles.positions = std::move(handler.positions);
+    return particles;
+}
+
+} // namespace io_internal
+} // namespace nonbloppy

@@ -1,0 +1,592 @@
+// SPDX-License-Identifier: Apache-2.0
+// Tests for the BGEO, VTU, CSV/TXT, JSON and VDB-points readers: real frames in tests/data
+// checked against the other reader of the same frame, synthetic files in every encoding,
+// and truncated, corrupt and hostile input with their exact messages.
+
+#include <nonbloppy/Error.h>
+#include <nonbloppy/ReadParticles.h>
+
+#include <openvdb/openvdb.h>
+#include <openvdb/points/PointConversion.h>
+#include <openvdb/points/PointCount.h>
+
+#include <gtest/gtest.h>
+#include <zlib.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <functional>
+#include <iterator>
+#include <string>
+#include <vector>
+
+#include <unistd.h>
+
+namespace {
+
+using nonbloppy::FileError;
+using nonbloppy::ParticleAttribute;
+using nonbloppy::ParticleSet;
+using nonbloppy::ScalarType;
+using nonbloppy::readParticles;
+
+std::string
+dataPath(const std::string& name)
+{
+    return std::string(NONBLOPPY_TEST_DATA_DIR) + "/" + name;
+}
+
+std::string
+readBytes(const std::string& path)
+{
+    std::ifstream is(path, std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(is), std::istreambuf_iterator<char>());
+}
+
+void
+writeBytes(const std::string& path, const std::string& bytes)
+{
+    std::ofstream os(path, std::ios::binary | std::ios::trunc);
+    os.write(bytes.data(), std::streamsize(bytes.size()));
+    ASSERT_TRUE(os.good()) << path;
+}
+
+std::string
+gunzipBytes(const std::string& compressed)
+{
+    z_stream stream{};
+    EXPECT_EQ(inflateInit2(&stream, 16 + MAX_WBITS), Z_OK);
+    std::string out(compressed.size() * 20, '\0');
+    stream.next_in = reinterpret_cast<Bytef*>(const_cast<char*>(compressed.data()));
+    stream.avail_in = uInt(compressed.size());
+    stream.next_out = reinterpret_cast<Bytef*>(out.data());
+    stream.avail_out = uInt(out.size());
+    EXPECT_EQ(inflate(&stream, Z_FINISH), Z_STREAM_END);
+    out.resize(stream.total_out);
+    inflateEnd(&stream);
+    return out;
+}
+
+std::string
+zlibBytes(const std::string& raw)
+{
+    uLongf size = compressBound(uLong(raw.size()));
+    std::string out(size, '\0');
+    EXPECT_EQ(compress(reinterpret_cast<Bytef*>(out.data()), &size,
+                       reinterpret_cast<const Bytef*>(raw.data()), uLong(raw.size())), Z_OK);
+    out.resize(size);
+    return out;
+}
+
+std::string
+base64(const std::string& bytes)
+{
+    static const char* alphabet = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    std::string out;
+    for (size_t i = 0; i < bytes.size(); i += 3) {
+        uint32_t bits = uint32_t(static_cast<unsigned char>(bytes[i])) << 16;
+        if (i + 1 < bytes.size()) bits |= uint32_t(static_cast<unsigned char>(bytes[i + 1])) << 8;
+        if (i + 2 < bytes.size()) bits |= uint32_t(static_cast<unsigned char>(bytes[i + 2]));
+        out += alphabet[(bits >> 18) & 63];
+        out += alphabet[(bits >> 12) & 63];
+        out += i + 1 < bytes.size() ? alphabet[(bits >> 6) & 63] : '=';
+        out += i + 2 < bytes.size() ? alphabet[bits & 63] : '=';
+    }
+    return out;
+}
+
+template<typename T>
+std::string
+bytesOf(T value, bool bigEndian = false)
+{
+    std::string bytes(sizeof(T), '\0');
+    std::memcpy(bytes.data(), &value, sizeof(T));
+    if (bigEndian) std::reverse(bytes.begin(), bytes.end());
+    return bytes;
+}
+
+class ReadFormatsTest : public ::testing::Test
+{
+protected:
+    void SetUp() override
+    {
+        std::string pattern = ::testing::TempDir() + "nonbloppy_formats_XXXXXX";
+        ASSERT_NE(mkdtemp(pattern.data()), nullptr);
+        mDir = pattern;
+    }
+    void TearDown() override
+    {
+        const std::string command = "rm -rf '" + mDir + "'";
+        EXPECT_EQ(std::system(command.c_str()), 0);
+    }
+    std::string path(const std::string& name) const { return mDir + "/" + name; }
+    std::string write(const std::string& name, const std::string& bytes) const
+    {
+        writeBytes(path(name), bytes);
+        return path(name);
+    }
+
+    std::string mDir;
+};
+
+std::string
+fileErrorOf(const std::string& path)
+{
+    try {
+        readParticles(path);
+    } catch (const FileError& e) {
+        return e.what();
+    }
+    return "";
+}
+
+const ParticleAttribute&
+attribute(const ParticleSet& particles, const std::string& name)
+{
+    const ParticleAttribute* found = particles.findAttribute(name);
+    if (!found) throw std::runtime_error("no attribute " + name);
+    return *found;
+}
+
+void
+expectSameParticles(const ParticleSet& a, const ParticleSet& b, bool compareAttributes = true)
+{
+    ASSERT_EQ(a.size(), b.size());
+    for (size_t i = 0; i < a.size(); ++i) {
+        ASSERT_EQ(a.positions[i], b.positions[i]) << "particle " << i;
+    }
+    if (!compareAttributes) return;
+    ASSERT_EQ(a.attributes.size(), b.attributes.size());
+    for (size_t k = 0; k < a.attributes.size(); ++k) {
+        EXPECT_EQ(a.attributes[k].name, b.attributes[k].name);
+        EXPECT_EQ(a.attributes[k].type, b.attributes[k].type) << a.attributes[k].name;
+        EXPECT_EQ(a.attributes[k].components, b.attributes[k].components) << a.attributes[k].name;
+        EXPECT_TRUE(a.attributes[k].bytes == b.attributes[k].bytes) << a.attributes[k].name;
+    }
+}
+
+// ---------------------------------------------------------------------------------------
+// BGEO
+
+TEST_F(ReadFormatsTest, BgeoFrame9HasItsParticlesAndAttributes)
+{
+    const ParticleSet particles = readParticles(dataPath("dam_break_frame_9_6859_particles.bgeo"));
+    ASSERT_EQ(particles.size(), 6859u);
+    ASSERT_EQ(particles.attributes.size(), 3u);
+    const ParticleAttribute& id = attribute(particles, "id");
+    EXPECT_EQ(id.type, ScalarType::Int32);
+    EXPECT_EQ(id.components, 1);
+    EXPECT_EQ(attribute(particles, "density").type, ScalarType::Float32);
+    const ParticleAttribute& velocity = attribute(particles, "velocity");
+    EXPECT_EQ(velocity.type, ScalarType::Float32);
+    EXPECT_EQ(velocity.components, 3);
+    EXPECT_EQ(velocity.size(), 6859u);
+
+    // The first point as the decompressed bytes spell it (big-endian float bits).
+    auto fromBits = [](uint32_t bits) { float f; std::memcpy(&f, &bits, 4); return f; };
+    EXPECT_EQ(particles.positions[0], openvdb::Vec3f(fromBits(0xbff4823a), fromBits(0x3d70357b),
+                                                      fromBits(0x3e21aeee)));
+    EXPECT_EQ(id.asDouble(0), 30.0);
+    EXPECT_EQ(float(attribute(particles, "density").asDouble(0)), fromBits(0x447a083b));
+    // Ids are a permutation of 0..N-1.
+    std::vector<int> ids(particles.size());
+    for (size_t i = 0; i < ids.size(); ++i) ids[i] = int(id.asDouble(i));
+    std::sort(ids.begin(), ids.end());
+    for (size_t i = 0; i < ids.size(); ++i) ASSERT_EQ(ids[i], int(i));
+}
+
+TEST_F(ReadFormatsTest, BgeoFrame23MatchesTheVtkOfTheSameFrame)
+{
+    const ParticleSet bgeo = readParticles(dataPath("dam_break_frame_23_24389_particles.bgeo"));
+    const ParticleSet vtk = readParticles(dataPath("dam_break_frame_23_24389_particles.vtk"));
+    ASSERT_EQ(bgeo.size(), 24389u);
+    expectSameParticles(bgeo, vtk, /*compareAttributes=*/false);
+}
+
+TEST_F(ReadFormatsTest, BgeoUncompressedReadsTheSame)
+{
+    const std::string gz = dataPath("dam_break_frame_9_6859_particles.bgeo");
+    const std::string plain = write("plain.bgeo", gunzipBytes(readBytes(gz)));
+    expectSameParticles(readParticles(plain), readParticles(gz));
+}
+
+TEST_F(ReadFormatsTest, BgeoTruncatedCorruptAndUnsupported)
+{
+    const std::string raw = gunzipBytes(readBytes(dataPath("dam_break_frame_9_6859_particles.bgeo")));
+    // Header (41 bytes) + attribute table: "id" 2+2+2+4+4, "density" 2+7+2+4+4, "velocity" 2+8+2+4+12.
+    const size_t tableEnd = 41 + 14 + 19 + 28;
+    const std::string cut = write("cut.bgeo", raw.substr(0, tableEnd + 1000));
+    EXPECT_EQ(fileErrorOf(cut), "truncated BGEO points: header claims 6859 points of 36 bytes, 1000 "
+                                "bytes left (" + cut + ")");
+    const std::string inTable = write("table.bgeo", raw.substr(0, 50));
+    EXPECT_EQ(fileErrorOf(inTable), "truncated BGEO attribute table (" + inTable + ")");
+    const std::string header = write("header.bgeo", raw.substr(0, 20));
+    EXPECT_EQ(fileErrorOf(header), "truncated BGEO header (" + header + ")");
+
+    const std::string gz = readBytes(dataPath("dam_break_frame_9_6859_particles.bgeo"));
+    const std::string cutGz = write("cutgz.bgeo", gz.substr(0, gz.size() / 2));
+    EXPECT_EQ(fileErrorOf(cutGz), "truncated gzip data (" + cutGz + ")");
+    std::string flipped = gz;
+    for (size_t i = 100; i < 200; ++i) flipped[i] = char(~flipped[i]);
+    const std::string corrupt = write("corrupt.bgeo", flipped);
+    EXPECT_EQ(fileErrorOf(corrupt).rfind("corrupt gzip data: ", 0), 0u) << fileErrorOf(corrupt);
+
+    std::string v6 = raw;
+    v6[8] = 6;
+    const std::string version6 = write("v6.bgeo", v6);
+    EXPECT_EQ(fileErrorOf(version6), "unsupported BGEO version (6) (" + version6 + ")");
+    const std::string json = write("json.bgeo", "[\"fileversion\",\"19.0.383\",\"hasindex\",false]");
+    EXPECT_EQ(fileErrorOf(json), "unsupported BGEO version (JSON-based, Houdini 12 or later); only "
+                                 "the classic binary BgeoV layout is read (" + json + ")");
+    const std::string binaryJson = write("bjson.bgeo", std::string("\x7fNSJb", 5) + "\x01");
+    EXPECT_EQ(fileErrorOf(binaryJson), "unsupported BGEO version (JSON-based, Houdini 12 or later); "
+                                       "only the classic binary BgeoV layout is read (" + binaryJson + ")");
+    const std::string other = write("other.bgeo", "hello world");
+    EXPECT_EQ(fileErrorOf(other), "not a BGEO file (no 'BgeoV' magic) (" + other + ")");
+}
+
+TEST_F(ReadFormatsTest, BgeoHostileCountIsRejectedBeforeAllocating)
+{
+    std::string bytes = "BgeoV" + bytesOf<int32_t>(5, true) + bytesOf<int32_t>(1000000000, true);
+    for (int i = 0; i < 7; ++i) bytes += bytesOf<int32_t>(0, true);
+    bytes += std::string(1000, '\0');
+    const std::string hostile = write("hostile.bgeo", bytes);
+    const auto start = std::chrono::steady_clock::now();
+    EXPECT_EQ(fileErrorOf(hostile), "truncated BGEO points: header claims 1000000000 points of 16 "
+                                    "bytes, 1000 bytes left (" + hostile + ")");
+    EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), 1.0);
+    // A gzip stream expanding far beyond its size is cut off, not inflated into memory.
+    std::string bomb = "BgeoV" + bytesOf<int32_t>(5, true) + bytesOf<int32_t>(0, true);
+    for (int i = 0; i < 7; ++i) bomb += bytesOf<int32_t>(0, true);
+    bomb += std::string(50u << 20, '\0');
+    uLongf size = compressBound(uLong(bomb.size()));
+    std::string deflated(size, '\0');
+    z_stream stream{};
+    ASSERT_EQ(deflateInit2(&stream, 9, Z_DEFLATED, 16 + MAX_WBITS, 9, Z_DEFAULT_STRATEGY), Z_OK);
+    stream.next_in = reinterpret_cast<Bytef*>(bomb.data());
+    stream.avail_in = uInt(bomb.size());
+    stream.next_out = reinterpret_cast<Bytef*>(deflated.data());
+    stream.avail_out = uInt(deflated.size());
+    ASSERT_EQ(deflate(&stream, Z_FINISH), Z_STREAM_END);
+    deflated.resize(stream.total_out);
+    deflateEnd(&stream);
+    // 50 MB of zeros deflate to ~50 KB: within deflate's ratio, so it is read (0 points).
+    EXPECT_EQ(readParticles(write("zeros.bgeo", deflated)).size(), 0u);
+}
+
+// ---------------------------------------------------------------------------------------
+// VTU
+
+TEST_F(ReadFormatsTest, VtuCubeMatchesTheLegacyVtk)
+{
+    const ParticleSet vtu = readParticles(dataPath("cube_8_particles.vtu"));
+    const ParticleSet vtk = readParticles(dataPath("cube_8_particles.vtk"));
+    ASSERT_EQ(vtu.size(), 8u);
+    expectSameParticles(vtu, vtk, /*compareAttributes=*/false);
+    ASSERT_EQ(vtu.attributes.size(), 4u);
+    EXPECT_EQ(vtu.attributes[0].name, "velocity");
+    EXPECT_EQ(vtu.attributes[0].type, ScalarType::Float64);
+    EXPECT_EQ(vtu.attributes[0].components, 3);
+    EXPECT_EQ(vtu.attributes[1].name, "pressure");
+    EXPECT_EQ(vtu.attributes[2].name, "density");
+    EXPECT_EQ(vtu.attributes[3].name, "index");
+    EXPECT_EQ(vtu.attributes[3].type, ScalarType::Int64);
+    for (const ParticleAttribute& a : vtu.attributes) EXPECT_EQ(a.size(), 8u) << a.name;
+}
+
+TEST_F(ReadFormatsTest, VtuCompressedAndBase64FluidAgree)
+{
+    const ParticleSet compressed = readParticles(dataPath("fluid_250_particles.vtu"));
+    const ParticleSet encoded = readParticles(dataPath("fluid_encoded_250_particles.vtu"));
+    ASSERT_EQ(compressed.size(), 250u);
+    expectSameParticles(compressed, encoded);
+    const ParticleAttribute& index = attribute(compressed, "index");
+    std::vector<int64_t> ids;
+    for (size_t i = 0; i < 250; ++i) ids.push_back(int64_t(index.asDouble(i)));
+    std::sort(ids.begin(), ids.end());
+    EXPECT_EQ(ids.front(), 1);
+    EXPECT_EQ(ids.back(), 250);
+}
+
+/// A VTU of three particles (positions (i, 2i, 3i)/4) and an Int32 "id" = 10 + i, in the
+/// given encoding.
+struct VtuVariant
+{
+    std::string format = "appended";  ///< ascii, binary, appended
+    std::string encoding = "raw";     ///< appended: raw or base64
+    bool zlib = false, uint64Header = false, bigEndian = false, float64 = false;
+    bool jointBase64 = false;         ///< one base64 segment for header and data
+};
+
+std::string
+makeVtu(const VtuVariant& v)
+{
+    auto number = [&](auto value) { return bytesOf(value, v.bigEndian); };
+    auto headerWord = [&](uint64_t value) {
+        return v.uint64Header ? number(uint64_t(value)) : number(uint32_t(value));
+    };
+    std::string points, ids, pointsText, idsText;
+    for (int i = 0; i < 3; ++i) {
+        for (int a = 1; a <= 3; ++a) {
+            const double value = i * a / 4.0;
+            points += v.float64 ? number(value) : number(float(value));
+            pointsText += std::to_string(value) + " ";
+        }
+        ids += number(int32_t(10 + i));
+        idsText += std::to_string(10 + i) + " ";
+    }
+    // [header][data] blocks as VTK writes them; for base64 the header and data are two
+    // padded segments unless jointBase64.
+    auto block = [&](const std::string& raw, bool encode) {
+        std::string header, data;
+        if (v.zlib) {
+            data = zlibBytes(raw);
+            header = headerWord(1) + headerWord(raw.size()) + headerWord(raw.size()) + headerWord(data.size());
+        } else {
+            header = headerWord(raw.size());
+            data = raw;
+        }
+        if (!encode) return header + data;
+        return v.jointBase64 ? base64(header + data) : base64(header) + base64(data);
+    };
+    std::string appended;
+    auto dataArray = [&](const std::string& type, const std::string& name, int components,
+                         const std::string& raw, const std::string& text) {
+        std::string xml = "<DataArray type=\"" + type + "\" Name=\"" + name +
+                          "\" NumberOfComponents=\"" + std::to_string(components) + "\" format=\"" + v.format + "\"";
+        if (v.format == "appended") {
+            xml += " offset=\"" + std::to_string(appended.size()) + "\"/>\n";
+            appended += block(raw, v.encoding == "base64");
+        } else if (v.format == "binary") {
+            xml += ">\n" + block(raw, true) + "\n</DataArray>\n";
+        } else {
+            xml += ">\n" + text + "\n</DataArray>\n";
+        }
+        return xml;
+    };
+    std::string body = "<Piece NumberOfPoints=\"3\" NumberOfCells=\"0\">\n<Points>\n";
+    body += dataArray(v.float64 ? "Float64" : "Float32", "Points", 3, points, pointsText);
+    body += "</Points>\n<PointData>\n";
+    body += dataArray("Int32", "id", 1, ids, idsText);
+    body += "</PointData>\n</Piece>\n";
+    std::string xml = "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"";
+    xml += v.bigEndian ? "BigEndian" : "LittleEndian";
+    xml += std::string("\" header_type=\"") + (v.uint64Header ? "UInt64" : "UInt32") + "\"";
+    if (v.zlib) xml += " compressor=\"vtkZLibDataCompressor\"";
+    xml += ">\n<UnstructuredGrid>\n" + body + "</UnstructuredGrid>\n";
+    if (v.format == "appended") {
+        xml += "<AppendedData encoding=\"" + v.encoding + "\">\n_" + appended + "\n</AppendedData>\n";
+    }
+    return xml + "</VTKFile>\n";
+}
+
+void
+expectThreeParticles(const ParticleSet& particles, const std::string& label)
+{
+    ASSERT_EQ(particles.size(), 3u) << label;
+    for (int i = 0; i < 3; ++i) {
+        EXPECT_EQ(particles.positions[i], openvdb::Vec3f(i / 4.0f, 2 * i / 4.0f, 3 * i / 4.0f)) << label;
+    }
+    ASSERT_EQ(particles.attributes.size(), 1u) << label;
+    EXPECT_EQ(particles.attributes[0].name, "id");
+    EXPECT_EQ(particles.attributes[0].type, ScalarType::Int32);
+    for (int i = 0; i < 3; ++i) EXPECT_EQ(particles.attributes[0].asDouble(i), 10 + i) << label;
+}
+
+TEST_F(ReadFormatsTest, VtuEveryEncoding)
+{
+    int n = 0;
+    for (const std::string format : {"ascii", "binary", "appended"}) {
+        for (const std::string encoding : {"raw", "base64"}) {
+            if (format != "appended" && encoding == "base64") continue;
+            for (int flags = 0; flags < 32; ++flags) {
+                VtuVariant v;
+                v.format = format;
+                v.encoding = encoding;
+                v.zlib = flags & 1;
+                v.uint64Header = flags & 2;
+                v.bigEndian = flags & 4;
+                v.float64 = flags & 8;
+                v.jointBase64 = flags & 16;
+                if (format == "ascii" && (v.zlib || v.uint64Header || v.jointBase64)) continue;
+                const std::string label = format + "/" + encoding + "/" + std::to_string(flags);
+                const std::string file = write("v" + std::to_string(n++) + ".vtu", makeVtu(v));
+                expectThreeParticles(readParticles(file), label);
+            }
+        }
+    }
+    EXPECT_EQ(n, 4 + 32 + 32 + 32);
+}
+
+TEST_F(ReadFormatsTest, VtuTruncatedCorruptAndHostile)
+{
+    const std::string fluid = readBytes(dataPath("fluid_250_particles.vtu"));
+    const std::string half = write("half.vtu", fluid.substr(0, fluid.size() / 2));
+    EXPECT_EQ(fileErrorOf(half), "truncated AppendedData (no </AppendedData>) (" + half + ")");
+    const std::string noXml = write("noxml.vtu", fluid.substr(0, 300));
+    EXPECT_EQ(fileErrorOf(noXml).rfind("XML error at byte ", 0), 0u) << fileErrorOf(noXml);
+
+    VtuVariant v;
+    v.zlib = true;
+    std::string text = makeVtu(v);
+    const size_t data = text.find("\n_") + 2 + 16;  // inside the first zlib stream
+    text[data + 2] = char(~text[data + 2]);
+    text[data + 3] = char(~text[data + 3]);
+    const std::string corrupt = write("corrupt.vtu", text);
+    EXPECT_EQ(fileErrorOf(corrupt).rfind("corrupt compressed data in block 0 of Points", 0), 0u)
+        << fileErrorOf(corrupt);
+
+    v = VtuVariant();
+    text = makeVtu(v);
+    const size_t count = text.find("NumberOfPoints=\"3\"");
+    text.replace(count, 18, "NumberOfPoints=\"1000000000\"");
+    const std::string hostile = write("hostile.vtu", text);
+    EXPECT_EQ(fileErrorOf(hostile), "truncated Points: the file is too small for 1000000000 tuples (" +
+                                        hostile + ")");
+
+    v = VtuVariant();
+    v.format = "binary";
+    text = makeVtu(v);
+    const size_t b64 = text.find("format=\"binary\">\n") + 17;
+    text[b64 + 5] = '*';
+    const std::string badChar = write("badchar.vtu", text);
+    EXPECT_EQ(fileErrorOf(badChar).rfind("invalid base64 character '*'", 0), 0u) << fileErrorOf(badChar);
+
+    v = VtuVariant();
+    v.format = "ascii";
+    text = makeVtu(v);
+    text.replace(text.find("10 11 12"), 8, "10 xx 12");
+    const std::string badNumber = write("badnumber.vtu", text);
+    EXPECT_EQ(fileErrorOf(badNumber), "bad value 'xx' in 'id' (" + badNumber + ")");
+
+    const std::string lz4 = write("lz4.vtu", "<VTKFile type=\"UnstructuredGrid\" compressor=\"vtkLZ4DataCompressor\"/>");
+    EXPECT_EQ(fileErrorOf(lz4), "unsupported compressor 'vtkLZ4DataCompressor'; only "
+                                "vtkZLibDataCompressor is read (" + lz4 + ")");
+    const std::string image = write("image.vtu", "<VTKFile type=\"ImageData\"/>");
+    EXPECT_EQ(fileErrorOf(image), "unsupported VTKFile type 'ImageData'; expected UnstructuredGrid "
+                                  "or PolyData (" + image + ")");
+}
+
+// ---------------------------------------------------------------------------------------
+// CSV, TXT, JSON
+
+TEST_F(ReadFormatsTest, CsvWithVectorAndScalarColumns)
+{
+    const std::string file = write("p.csv",
+        "# exported by a test\n"
+        "\"Points:0\",\"Points:1\",\"Points:2\",\"velocity:0\",\"velocity:1\",\"velocity:2\",id,density\n"
+        "0.5,1,1.5,1,2,3,7,1000.5\n"
+        "\n"
+        "-1,-2,-3e-1,4,5,6,8,999\n");
+    const ParticleSet particles = readParticles(file);
+    ASSERT_EQ(particles.size(), 2u);
+    EXPECT_EQ(particles.positions[0], openvdb::Vec3f(0.5f, 1.0f, 1.5f));
+    EXPECT_EQ(particles.positions[1], openvdb::Vec3f(-1.0f, -2.0f, -0.3f));
+    ASSERT_EQ(particles.attributes.size(), 3u);
+    const ParticleAttribute& velocity = attribute(particles, "velocity");
+    EXPECT_EQ(velocity.components, 3);
+    EXPECT_EQ(velocity.type, ScalarType::Int64);  // every value an integer
+    EXPECT_EQ(velocity.asDouble(1, 2), 6.0);
+    EXPECT_EQ(attribute(particles, "id").type, ScalarType::Int64);
+    EXPECT_EQ(attribute(particles, "id").asDouble(1), 8.0);
+    EXPECT_EQ(attribute(particles, "density").type, ScalarType::Float64);
+    EXPECT_EQ(attribute(particles, "density").asDouble(0), 1000.5);
+}
+
+TEST_F(ReadFormatsTest, TxtWithSpacesAndAnyColumnOrder)
+{
+    const std::string file = write("p.txt", "id  Z y X\n1 3 2 1\n2\t6 5 4\n");
+    const ParticleSet particles = readParticles(file);
+    ASSERT_EQ(particles.size(), 2u);
+    EXPECT_EQ(particles.positions[0], openvdb::Vec3f(1, 2, 3));
+    EXPECT_EQ(particles.positions[1], openvdb::Vec3f(4, 5, 6));
+    EXPECT_EQ(attribute(particles, "id").asDouble(1), 2.0);
+}
+
+TEST_F(ReadFormatsTest, TableErrors)
+{
+    const std::string noZ = write("noz.csv", "x,y,w\n1,2,3\n");
+    EXPECT_EQ(fileErrorOf(noZ), "the header must name columns x, y and z, got 'x,y,w' (" + noZ + ")");
+    const std::string bad = write("bad.csv", "x,y,z\n1,2,3\n1,2,abc\n");
+    EXPECT_EQ(fileErrorOf(bad), "bad number 'abc' on line 3 (" + bad + ")");
+    const std::string fields = write("fields.csv", "x,y,z\n1,2\n");
+    EXPECT_EQ(fileErrorOf(fields), "line 2 has 2 fields, the header 3 (" + fields + ")");
+    const std::string empty = write("empty.csv", "# nothing\n");
+    EXPECT_EQ(fileErrorOf(empty), "empty table: no header row (" + empty + ")");
+}
+
+TEST_F(ReadFormatsTest, JsonPointList)
+{
+    const std::string file = write("p.json", " [[1, 2, 3], [4.5, -5e-1, 6]]\n");
+    const ParticleSet particles = readParticles(file);
+    ASSERT_EQ(particles.size(), 2u);
+    EXPECT_EQ(particles.positions[0], openvdb::Vec3f(1, 2, 3));
+    EXPECT_EQ(particles.positions[1], openvdb::Vec3f(4.5f, -0.5f, 6));
+    EXPECT_EQ(readParticles(write("e.json", "[]")).size(), 0u);
+
+    const std::string two = write("two.json", "[[1,2,3],[1,2]]");
+    EXPECT_EQ(fileErrorOf(two), "bad JSON particle list: particle 1 has 2 coordinates, expected 3 (" + two + ")");
+    const std::string deep = write("deep.json", std::string(100000, '[') + std::string(100000, ']'));
+    EXPECT_EQ(fileErrorOf(deep), "bad JSON particle list: arrays nested deeper than [[x, y, z], ...] (" + deep + ")");
+    const std::string object = write("object.json", "{\"x\": 1}");
+    EXPECT_EQ(fileErrorOf(object), "bad JSON particle list: object where an array was expected (" + object + ")");
+    const std::string cut = write("cut.json", "[[1,2,3],[4,");
+    EXPECT_EQ(fileErrorOf(cut).rfind("bad JSON particle list: parse error at line 1, column 13", 0), 0u)
+        << fileErrorOf(cut);
+}
+
+// ---------------------------------------------------------------------------------------
+// VDB points
+
+TEST_F(ReadFormatsTest, VdbPointDataGridWithAttributes)
+{
+    openvdb::initialize();
+    const ParticleSet source = readParticles(dataPath("free_particles_125_particles.vtk"));
+    std::vector<openvdb::Vec3R> positions(source.positions.begin(), source.positions.end());
+    const openvdb::points::PointAttributeVector<openvdb::Vec3R> wrapper(positions);
+    auto transform = openvdb::math::Transform::createLinearTransform(0.5);
+    auto index = openvdb::tools::createPointIndexGrid<openvdb::tools::PointIndexGrid>(wrapper, *transform);
+    auto grid = openvdb::points::createPointDataGrid<openvdb::points::NullCodec,
+        openvdb::points::PointDataGrid>(*index, wrapper, *transform);
+    grid->setName("points");
+    std::vector<float> temperature(positions.size());
+    for (size_t i = 0; i < temperature.size(); ++i) temperature[i] = float(i) * 0.5f;
+    openvdb::points::appendAttribute<float>(grid->tree(), "temperature");
+    openvdb::points::populateAttribute<openvdb::points::PointDataTree, openvdb::tools::PointIndexTree,
+        openvdb::points::PointAttributeVector<float>>(grid->tree(), index->tree(), "temperature",
+            openvdb::points::PointAttributeVector<float>(temperature));
+    const std::string file = path("points.vdb");
+    openvdb::io::File(file).write({grid});
+
+    const ParticleSet particles = readParticles(file);
+    ASSERT_EQ(particles.size(), positions.size());
+    const ParticleAttribute& t = attribute(particles, "temperature");
+    EXPECT_EQ(t.type, ScalarType::Float32);
+    // Points come back in voxel order; the temperature tells which particle each one is.
+    for (size_t n = 0; n < particles.size(); ++n) {
+        const size_t i = size_t(t.asDouble(n) * 2.0);
+        ASSERT_LT(i, positions.size());
+        for (int a = 0; a < 3; ++a) EXPECT_NEAR(particles.positions[n][a], positions[i][a], 1e-5);
+    }
+}
+
+TEST_F(ReadFormatsTest, VdbWithoutPointsIsAClearError)
+{
+    openvdb::initialize();
+    auto density = openvdb::FloatGrid::create();
+    density->setName("density");
+    density->tree().setValue(openvdb::Coord(1, 2, 3), 1.0f);
+    const std::string file = path("density.vdb");
+    openvdb::io::File(file).write({density});
+    EXPECT_EQ(fileErrorOf(file), "no PointDataGrid in this .vdb file (grids: density float); a density "
+                                 "cache cannot be meshed as particles (" + file + ")");
+    const std::string junk = write("junk.vdb", "not a vdb file at all");
+    EXPECT_EQ(fileErrorOf(junk).rfind("cannot read .vdb file: ", 0), 0u) << fileErrorOf(junk);
+}
+
+} // namespace
