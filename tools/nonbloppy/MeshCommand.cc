@@ -5,6 +5,9 @@
 
 #include "Commands.h"
 
+#include "BatchRun.h"
+#include "FrameSequence.h"
+
 #include <nonbloppy/BuildSurface.h>
 #include <nonbloppy/Error.h>
 #include <nonbloppy/ReadParticles.h>
@@ -170,6 +173,12 @@ struct MeshOptions
     double adaptivity = nonbloppy::kDefaultAdaptivity;
     int threads = 0;
     bool quads = false, quiet = false, verbose = false;
+    // Frame sequences (FrameSequence.h, BatchRun.h).
+    std::string frames, logPath;
+    int frameJobs = 1;
+    bool skipExisting = false, keepGoing = false;
+    CLI::Option *framesOpt = nullptr, *frameJobsOpt = nullptr, *skipExistingOpt = nullptr,
+                *keepGoingOpt = nullptr, *logOpt = nullptr;
 
     // Set after declaration, to tell "given" from "default".
     CLI::Option *spacingOpt = nullptr, *radiusOpt = nullptr, *thresholdOpt = nullptr,
@@ -225,7 +234,8 @@ void requireWritableDirectory(const std::string& path)
 
 /// Check everything that can be checked without reading the input, so a mistake costs
 /// nothing and leaves no file behind. The library checks the same ranges again.
-void validate(const MeshOptions& o)
+/// validateParameters() checks the numbers, validatePaths() the files of one frame.
+void validateParameters(const MeshOptions& o)
 {
     requirePositive(o.spacingOpt, o.spacing, "--spacing");
     requirePositive(o.radiusOpt, o.radius, "--radius");
@@ -240,7 +250,10 @@ void validate(const MeshOptions& o)
     if (o.threadsOpt->count() > 0 && o.threads < 1) {
         throw nonbloppy::ParameterError("--threads must be >= 1, got " + std::to_string(o.threads));
     }
+}
 
+void validatePaths(const MeshOptions& o)
+{
     // Spelled as writeMesh() spells it, which would say the same after all the work.
     if (!nonbloppy::isMeshFile(o.output)) {
         const std::string ext = lowerExtension(o.output);
@@ -275,6 +288,12 @@ void validate(const MeshOptions& o)
                                        + ": --vdb and --output name the same file");
         }
     }
+}
+
+void validate(const MeshOptions& o)
+{
+    validateParameters(o);
+    validatePaths(o);
 }
 
 // ---------------------------------------------------------------------------------------
@@ -429,8 +448,126 @@ FrameOutcome meshFrame(const MeshOptions& o, ProgressInterrupter& interrupter)
     return outcome;
 }
 
+// ---------------------------------------------------------------------------------------
+// Frame sequences
+
+/// True if IN names a sequence: it has a frame placeholder and is not itself a file
+/// (so a single file whose name happens to contain '#' still meshes as before).
+bool isSequenceInput(const std::string& input)
+{
+    struct stat info;
+    if (::stat(input.c_str(), &info) == 0) return false;
+    return parseFramePattern(input, "IN").hasPlaceholder();
+}
+
+/// @a o with the paths of @a frame filled in. Every option that names a file per frame
+/// must be substituted here.
+MeshOptions optionsForFrame(const MeshOptions& o, const Frame& frame)
+{
+    MeshOptions f = o;
+    f.input = frame.input;
+    f.output = parseFramePattern(o.output, "--output").path(frame);
+    if (!o.vdbPath.empty()) f.vdbPath = parseFramePattern(o.vdbPath, "--vdb").path(frame);
+    return f;
+}
+
+/// An output option for a sequence must hold a placeholder, or every frame would overwrite
+/// the same file.
+void requirePlaceholder(const std::string& path, const std::string& option, const MeshOptions& o)
+{
+    if (!parseFramePattern(path, option).hasPlaceholder()) {
+        throw nonbloppy::ParameterError(option + ": no frame placeholder ({}, #### or %04d) in '"
+                                        + path + "', but IN is the sequence '" + o.input + "'");
+    }
+}
+
+int runSequence(const MeshOptions& o)
+{
+    validateParameters(o);
+    if (o.frameJobs < 1) {
+        throw nonbloppy::ParameterError("--frame-jobs must be >= 1, got "
+                                        + std::to_string(o.frameJobs));
+    }
+    const FramePattern input = parseFramePattern(o.input, "IN");
+    requirePlaceholder(o.output, "--output", o);
+    if (!o.vdbPath.empty()) requirePlaceholder(o.vdbPath, "--vdb", o);
+    std::optional<std::vector<int>> requested;
+    if (o.framesOpt->count() > 0) requested = parseFrameList(o.frames, "--frames");
+
+    const FramePlan plan = planFrames(input, requested);
+    if (plan.frames.empty()) {
+        throw nonbloppy::FileError(requested ? "none of the frames " + formatFrameList(*requested)
+                                                   + " of " + o.input + " exist"
+                                             : "no file matches " + o.input);
+    }
+    std::vector<BatchJob> jobs;
+    for (const Frame& frame : plan.frames) {
+        const MeshOptions f = optionsForFrame(o, frame);
+        BatchJob job{frame, {f.output}};
+        if (!f.vdbPath.empty()) job.outputs.push_back(f.vdbPath);
+        jobs.push_back(std::move(job));
+    }
+    // Output extensions and directories, before any work.
+    validatePaths(optionsForFrame(o, plan.frames.front()));
+
+    std::unique_ptr<tbb::global_control> threadLimit;
+    if (o.threadsOpt->count() > 0) {
+        threadLimit = std::make_unique<tbb::global_control>(
+            tbb::global_control::max_allowed_parallelism, static_cast<size_t>(o.threads));
+    }
+    SignalHandlerScope signals;
+
+    BatchSettings settings;
+    settings.frameJobs = o.frameJobs;
+    settings.skipExisting = o.skipExisting;
+    settings.keepGoing = o.keepGoing;
+    settings.quiet = o.quiet;
+    settings.logPath = o.logPath;
+    settings.inputPattern = o.input;
+    settings.outputPattern = o.output;
+    settings.missing = plan.missing;
+
+    std::mutex verboseMutex;
+    auto meshOne = [&](const BatchJob& job) {
+        const MeshOptions f = optionsForFrame(o, job.frame);
+        validatePaths(f);
+        ProgressInterrupter interrupter(o.verbose);
+        std::unique_ptr<ResidentSampler> sampler;
+        if (o.verbose) sampler = std::make_unique<ResidentSampler>();
+        const FrameOutcome outcome = meshFrame(f, interrupter);
+
+        FrameReport report;
+        const nonbloppy::SurfaceResult& result = outcome.result;
+        const nonbloppy::ResolvedParameters& p = result.parameters;
+        report.particles = result.particleCount;
+        report.vertices = result.mesh.points.size();
+        report.faces = result.mesh.polygonCount();
+        report.timings = outcome.timings;
+        report.parameters = {{"spacing", p.spacing}, {"effective_radius", p.effectiveRadius},
+                             {"threshold", p.threshold}, {"voxel_size", p.voxelSize},
+                             {"blend", p.blend}, {"iterations", double(p.iterations)},
+                             {"adaptivity", p.adaptivity}};
+        if (sampler) {
+            sampler->stop();
+            std::lock_guard<std::mutex> lock(verboseMutex);
+            std::cerr << "[memory] frame " << job.frame.number << "\n"
+                      << sampler->report(outcome.timings, result.particleCount) << std::flush;
+        }
+        return report;
+    };
+    return runBatch(jobs, settings, meshOne, [] { return gInterruptRequested.load(); });
+}
+
 int runMesh(const MeshOptions& o)
 {
+    if (isSequenceInput(o.input)) return runSequence(o);
+    for (const CLI::Option* option : {o.framesOpt, o.frameJobsOpt, o.skipExistingOpt,
+                                      o.keepGoingOpt, o.logOpt}) {
+        if (option->count() > 0) {
+            throw nonbloppy::ParameterError(option->get_name() + " needs a frame sequence as IN "
+                                            "(a name with {}, #### or %04d), got '" + o.input + "'");
+        }
+    }
     validate(o);
 
     std::unique_ptr<tbb::global_control> threadLimit;
@@ -443,9 +580,15 @@ int runMesh(const MeshOptions& o)
 
     SignalHandlerScope signals;
     ProgressInterrupter interrupter(o.verbose);
+    std::unique_ptr<ResidentSampler> sampler;
+    if (o.verbose) sampler = std::make_unique<ResidentSampler>();
 
     try {
         const FrameOutcome outcome = meshFrame(o, interrupter);
+        if (sampler) {
+            sampler->stop();
+            std::cerr << sampler->report(outcome.timings, outcome.result.particleCount);
+        }
         if (!o.quiet) printSummary(o, outcome.result, outcome.timings, threads);
         return 0;
     } catch (const nonbloppy::CancelledError&) {
@@ -469,9 +612,12 @@ Command setupMeshCommand(CLI::App& parent)
         "Unset parameters are derived from the particle spacing s: r_e = 2 s, h = s/2, and r_0\n"
         "so that a flat block of fluid gets its surface s/2 outside the outer particles.");
 
-    cmd->add_option("IN", o.input, "Particle file (.vtk, .ply, .xyz, ...)")
+    cmd->add_option("IN", o.input,
+        "Particle file (.vtk, .ply, .xyz, ...), or a sequence: fluid_{}.vtk, fluid_####.vtk, "
+        "fluid_%04d.vtk")
         ->required()->group(kGroupInputOutput);
-    cmd->add_option("-o,--output", o.output, "Mesh to write (.obj, .ply or .vtk)")
+    cmd->add_option("-o,--output", o.output,
+        "Mesh to write (.obj, .ply or .vtk); for a sequence, with a placeholder: mesh_{}.obj")
         ->required()->group(kGroupInputOutput);
     cmd->add_flag("--quads", o.quads, "Keep quads instead of splitting them into triangles")
         ->group(kGroupInputOutput);
@@ -500,10 +646,27 @@ Command setupMeshCommand(CLI::App& parent)
     o.vdbOpt = cmd->add_option("--vdb", o.vdbPath,
         "Also write the density grid to this .vdb file (vdb_print reads it)")
         ->group(kGroupDebug);
+    // Frame sequences: IN and the outputs are patterns such as fluid_{}.vtk.
+    constexpr const char* kGroupSequence = "Frame sequences";
+    o.framesOpt = cmd->add_option("--frames", o.frames,
+        "Frames to mesh: 1-240, 1-240:2, 12,15,90-99 (default: every frame found)")
+        ->group(kGroupSequence);
+    o.skipExistingOpt = cmd->add_flag("--skip-existing", o.skipExisting,
+        "Skip frames whose outputs all exist (resume an interrupted run)")->group(kGroupSequence);
+    o.keepGoingOpt = cmd->add_flag("--keep-going", o.keepGoing,
+        "Go on after a failed frame; list the failed frames and exit 1 at the end")
+        ->group(kGroupSequence);
+    o.frameJobsOpt = cmd->add_option("--frame-jobs", o.frameJobs,
+        "Frames meshed at once (default 1); they share the --threads workers")
+        ->group(kGroupSequence);
+    o.logOpt = cmd->add_option("--log", o.logPath,
+        "Write one JSON object per frame and a summary line to this file")
+        ->group(kGroupSequence);
+
     CLI::Option* quiet = cmd->add_flag("-q,--quiet", o.quiet, "Print nothing but errors")
         ->group(kGroupDebug);
     CLI::Option* verbose = cmd->add_flag("-v,--verbose", o.verbose,
-        "Print each stage and its progress on stderr")->group(kGroupDebug);
+        "Print each stage, its progress and its memory (bytes per particle) on stderr")->group(kGroupDebug);
     quiet->excludes(verbose);
 
     return {cmd, [options]() { return runMesh(*options); }};

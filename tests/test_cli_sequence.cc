@@ -1,0 +1,393 @@
+// SPDX-License-Identifier: Apache-2.0
+/// @file test_cli_sequence.cc
+/// @brief `nonbloppy mesh` on frame sequences, run as a user would (NONBLOPPY_CLI_PATH):
+///        patterns, --frames, missing frames, --skip-existing, --keep-going with a corrupt
+///        frame, split ranges giving the same bytes, --frame-jobs, the --log JSON lines, an
+///        interrupted run, and -v's bytes per particle.
+
+#include <gtest/gtest.h>
+
+#include <fcntl.h>
+#include <signal.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+namespace {
+
+namespace fs = std::filesystem;
+
+const std::string kCli = NONBLOPPY_CLI_PATH;
+const std::string kData = NONBLOPPY_TEST_DATA_DIR;
+const std::string kCube = kData + "/cube_2366_particles.vtk";
+const std::string kFree = kData + "/free_particles_125_particles.vtk";
+
+std::string readText(const std::string& path)
+{
+    std::ifstream in(path, std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+void writeText(const std::string& path, const std::string& text)
+{
+    std::ofstream out(path, std::ios::binary);
+    out << text;
+}
+
+std::string quote(const std::string& s)
+{
+    std::string out = "'";
+    for (char c : s) {
+        if (c == '\'') out += "'\\''";
+        else out += c;
+    }
+    return out + "'";
+}
+
+std::vector<std::string> lines(const std::string& text)
+{
+    std::vector<std::string> out;
+    std::istringstream in(text);
+    for (std::string line; std::getline(in, line);) out.push_back(line);
+    return out;
+}
+
+std::vector<std::string> listDir(const std::string& dir)
+{
+    std::vector<std::string> names;
+    for (const auto& entry : fs::directory_iterator(dir)) {
+        names.push_back(entry.path().filename().string());
+    }
+    std::sort(names.begin(), names.end());
+    return names;
+}
+
+size_t count(const std::string& text, const std::string& needle)
+{
+    size_t n = 0;
+    for (size_t at = text.find(needle); at != std::string::npos; at = text.find(needle, at + 1)) ++n;
+    return n;
+}
+
+struct RunResult
+{
+    int exitCode = -1;
+    std::string out, err;
+};
+
+class CliSequenceTest : public ::testing::Test
+{
+protected:
+    void SetUp() override
+    {
+        const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+        mDir = (fs::path(::testing::TempDir()) / ("nonbloppy_seq_" + std::string(info->name())
+                                                  + "_" + std::to_string(::getpid())))
+                   .string();
+        fs::remove_all(mDir);
+        fs::create_directories(mDir + "/in");
+        fs::create_directories(mDir + "/out");
+    }
+    void TearDown() override
+    {
+        std::error_code ec;
+        fs::remove_all(mDir, ec);
+    }
+
+    RunResult run(const std::string& args) const
+    {
+        const std::string outFile = mDir + "/stdout.txt", errFile = mDir + "/stderr.txt";
+        const std::string command = quote(kCli) + " " + args + " >" + quote(outFile) + " 2>"
+                                    + quote(errFile) + " </dev/null";
+        const int status = std::system(command.c_str());
+        RunResult result;
+        result.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+        result.out = readText(outFile);
+        result.err = readText(errFile);
+        return result;
+    }
+
+    /// in/fluid_0001.vtk ... one file per source, numbered from @a first.
+    void makeFrames(const std::vector<std::string>& sources, int first = 1) const
+    {
+        for (size_t i = 0; i < sources.size(); ++i) {
+            char name[64];
+            std::snprintf(name, sizeof(name), "/in/fluid_%04d.vtk", int(first + i));
+            fs::copy_file(sources[i], mDir + name, fs::copy_options::overwrite_existing);
+        }
+    }
+
+    /// A frame cut short in its POINTS section.
+    void makeCorruptFrame(int number) const
+    {
+        char name[64];
+        std::snprintf(name, sizeof(name), "/in/fluid_%04d.vtk", number);
+        writeText(mDir + name, readText(kCube).substr(0, 300));
+    }
+
+    std::string dir() const { return mDir; }
+    std::string in(const std::string& name) const { return mDir + "/in/" + name; }
+    std::string out(const std::string& name) const { return mDir + "/out/" + name; }
+
+    /// `mesh in/fluid_{}.vtk -o OUTDIR/mesh_{}.obj --vdb OUTDIR/density_####.vdb -q EXTRA`
+    RunResult meshSequence(const std::string& outDir, const std::string& extra) const
+    {
+        fs::create_directories(outDir);
+        return run("mesh " + quote(in("fluid_{}.vtk")) + " -o " + quote(outDir + "/mesh_{}.obj")
+                   + " --vdb " + quote(outDir + "/density_####.vdb") + " " + extra);
+    }
+
+private:
+    std::string mDir;
+};
+
+} // namespace
+
+TEST_F(CliSequenceTest, MeshesEveryFrameFoundWithOneLinePerFrame)
+{
+    makeFrames({kFree, kCube, kFree});
+    const RunResult r = run("mesh " + quote(in("fluid_{}.vtk")) + " -o " + quote(out("mesh_{}.obj")));
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_TRUE(r.err.empty()) << r.err;
+    EXPECT_EQ(listDir(dir() + "/out"),
+              (std::vector<std::string>{"mesh_0001.obj", "mesh_0002.obj", "mesh_0003.obj"}));
+    // stdout is not a terminal: one line per frame, then the summary.
+    const std::vector<std::string> outLines = lines(r.out);
+    ASSERT_EQ(outLines.size(), 4u) << r.out;
+    EXPECT_EQ(outLines[1].rfind("frame 2 (2/3): " + in("fluid_0002.vtk") + " -> "
+                                + out("mesh_0002.obj") + ": 2366 particles, ", 0), 0u)
+        << outLines[1];
+    EXPECT_EQ(outLines[3].rfind("3 frames: 3 done, 0 failed, 0 skipped, 0 missing in ", 0), 0u)
+        << outLines[3];
+    // The same frame gives the same mesh.
+    EXPECT_EQ(readText(out("mesh_0001.obj")), readText(out("mesh_0003.obj")));
+}
+
+TEST_F(CliSequenceTest, HashAndPrintfPatterns)
+{
+    makeFrames({kFree, kFree}, 9);
+    const RunResult r = run("mesh " + quote(in("fluid_####.vtk")) + " -o " + quote(out("m_%03d.ply"))
+                            + " --vdb " + quote(out("d_{}.vdb")) + " -q");
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_TRUE(r.out.empty()) << r.out;
+    EXPECT_EQ(listDir(dir() + "/out"), (std::vector<std::string>{"d_0009.vdb", "d_0010.vdb",
+                                                                 "m_009.ply", "m_010.ply"}));
+}
+
+TEST_F(CliSequenceTest, OutputWithoutPlaceholderIsAnError)
+{
+    makeFrames({kFree});
+    for (const std::string& extra : {std::string(""), " --vdb " + quote(out("d.vdb"))}) {
+        const std::string output = extra.empty() ? out("mesh.obj") : out("mesh_{}.obj");
+        const RunResult r = run("mesh " + quote(in("fluid_{}.vtk")) + " -o " + quote(output) + extra);
+        EXPECT_EQ(r.exitCode, 1);
+        const std::string option = extra.empty() ? "--output" : "--vdb";
+        const std::string path = extra.empty() ? output : out("d.vdb");
+        EXPECT_EQ(r.err, "nonbloppy: " + option + ": no frame placeholder ({}, #### or %04d) in '"
+                             + path + "', but IN is the sequence '" + in("fluid_{}.vtk") + "'\n");
+        EXPECT_TRUE(listDir(dir() + "/out").empty());
+    }
+}
+
+TEST_F(CliSequenceTest, SequenceOptionsNeedASequence)
+{
+    const RunResult r = run("mesh " + quote(kFree) + " -o " + quote(out("m.obj")) + " --frames 1-3");
+    EXPECT_EQ(r.exitCode, 1);
+    EXPECT_EQ(r.err, "nonbloppy: --frames needs a frame sequence as IN (a name with {}, #### or "
+                     "%04d), got '" + kFree + "'\n");
+    EXPECT_TRUE(listDir(dir() + "/out").empty());
+}
+
+TEST_F(CliSequenceTest, FramesSelectsAndListsMissingOnce)
+{
+    makeFrames({kFree, kFree, kFree});
+    const RunResult r = run("mesh " + quote(in("fluid_{}.vtk")) + " -o " + quote(out("m_{}.obj"))
+                            + " --frames 1-7:2");
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_EQ(r.err, "nonbloppy: 2 missing frames skipped: 5, 7 (" + in("fluid_{}.vtk") + ")\n");
+    EXPECT_EQ(listDir(dir() + "/out"), (std::vector<std::string>{"m_0001.obj", "m_0003.obj"}));
+    EXPECT_NE(r.out.find("4 frames: 2 done, 0 failed, 0 skipped, 2 missing"), std::string::npos)
+        << r.out;
+
+    const RunResult none = run("mesh " + quote(in("fluid_{}.vtk")) + " -o " + quote(out("m_{}.obj"))
+                               + " --frames 20-21");
+    EXPECT_EQ(none.exitCode, 1);
+    EXPECT_EQ(none.err, "nonbloppy: none of the frames 20-21 of " + in("fluid_{}.vtk") + " exist\n");
+}
+
+TEST_F(CliSequenceTest, BadFramesIsAOneLineError)
+{
+    makeFrames({kFree});
+    const std::string base = "mesh " + quote(in("fluid_{}.vtk")) + " -o " + quote(out("m_{}.obj"));
+    for (const auto& [frames, message] : std::vector<std::pair<std::string, std::string>>{
+             {"12-3", "--frames: bad range '12-3' (end before start)"},
+             {"1-9:0", "--frames: bad step in '1-9:0' (must be an integer >= 1)"},
+             {"1,,2", "--frames: empty item in '1,,2'"}}) {
+        const RunResult r = run(base + " --frames " + quote(frames));
+        EXPECT_EQ(r.exitCode, 1);
+        EXPECT_EQ(r.err, "nonbloppy: " + message + "\n");
+    }
+    const RunResult jobs = run(base + " --frame-jobs 0");
+    EXPECT_EQ(jobs.err, "nonbloppy: --frame-jobs must be >= 1, got 0\n");
+    const RunResult noFiles = run("mesh " + quote(in("gas_{}.vtk")) + " -o " + quote(out("m_{}.obj")));
+    EXPECT_EQ(noFiles.err, "nonbloppy: no file matches " + in("gas_{}.vtk") + "\n");
+    EXPECT_TRUE(listDir(dir() + "/out").empty());
+}
+
+TEST_F(CliSequenceTest, SkipExistingResumes)
+{
+    makeFrames({kFree, kFree, kFree});
+    ASSERT_EQ(meshSequence(dir() + "/out", "--frames 1-2").exitCode, 0);
+    // A finished frame is kept as it is, even if it was changed since.
+    writeText(out("mesh_0001.obj"), "# kept\n");
+    const RunResult r = meshSequence(dir() + "/out", "--skip-existing --log " + quote(dir() + "/run.jsonl"));
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_EQ(readText(out("mesh_0001.obj")), "# kept\n");
+    EXPECT_EQ(listDir(dir() + "/out").size(), 6u);
+    const std::string log = readText(dir() + "/run.jsonl");
+    EXPECT_EQ(count(log, "\"status\": \"skipped\""), 2u) << log;
+    EXPECT_EQ(count(log, "\"status\": \"done\""), 1u) << log;
+
+    // Without --skip-existing every frame is made again.
+    ASSERT_EQ(meshSequence(dir() + "/out", "").exitCode, 0);
+    EXPECT_NE(readText(out("mesh_0001.obj")), "# kept\n");
+}
+
+TEST_F(CliSequenceTest, FirstBadFrameStopsTheRun)
+{
+    makeFrames({kFree, kFree, kFree});
+    makeCorruptFrame(2);
+    const RunResult r = meshSequence(dir() + "/out", "");
+    EXPECT_EQ(r.exitCode, 1);
+    EXPECT_EQ(r.err, "nonbloppy: truncated POINTS section (" + in("fluid_0002.vtk") + ")\n");
+    EXPECT_EQ(listDir(dir() + "/out"), (std::vector<std::string>{"density_0001.vdb", "mesh_0001.obj"}));
+}
+
+TEST_F(CliSequenceTest, KeepGoingListsFailedFrames)
+{
+    makeFrames({kFree, kFree, kFree, kFree});
+    makeCorruptFrame(2);
+    const RunResult r = meshSequence(dir() + "/out", "--keep-going --log " + quote(dir() + "/run.jsonl"));
+    EXPECT_EQ(r.exitCode, 1);
+    EXPECT_EQ(lines(r.err), (std::vector<std::string>{
+        "nonbloppy: frame 2: truncated POINTS section (" + in("fluid_0002.vtk") + ")",
+        "nonbloppy: 1 of 4 frames failed: 2"}));
+    EXPECT_EQ(listDir(dir() + "/out"),
+              (std::vector<std::string>{"density_0001.vdb", "density_0003.vdb", "density_0004.vdb",
+                                        "mesh_0001.obj", "mesh_0003.obj", "mesh_0004.obj"}));
+    const std::string log = readText(dir() + "/run.jsonl");
+    EXPECT_NE(log.find("\"frame\": 2, \"status\": \"failed\""), std::string::npos) << log;
+    EXPECT_NE(log.find("\"frames_failed\": 1, "), std::string::npos) << log;
+    EXPECT_NE(log.find("\"failed\": [2]"), std::string::npos) << log;
+}
+
+TEST_F(CliSequenceTest, SplitRangesGiveTheSameFiles)
+{
+    makeFrames({kFree, kCube, kFree, kFree});
+    ASSERT_EQ(meshSequence(dir() + "/whole", "-q --frames 1-4").exitCode, 0);
+    ASSERT_EQ(meshSequence(dir() + "/split", "-q --frames 1-2").exitCode, 0);
+    ASSERT_EQ(meshSequence(dir() + "/split", "-q --frames 3-4").exitCode, 0);
+    ASSERT_EQ(meshSequence(dir() + "/jobs", "-q --frame-jobs 3 --threads 2").exitCode, 0);
+    const std::vector<std::string> names = listDir(dir() + "/whole");
+    ASSERT_EQ(names.size(), 8u);
+    for (const char* other : {"/split", "/jobs"}) {
+        ASSERT_EQ(listDir(dir() + other), names) << other;
+        for (const std::string& name : names) {
+            EXPECT_TRUE(readText(dir() + "/whole/" + name) == readText(dir() + other + "/" + name))
+                << other << "/" << name << " differs";
+        }
+    }
+}
+
+TEST_F(CliSequenceTest, LogHasOneObjectPerFrameAndASummary)
+{
+    makeFrames({kCube, kCube});
+    const std::string logPath = dir() + "/run.jsonl";
+    const RunResult r = meshSequence(dir() + "/out", "-q --log " + quote(logPath) + " --radius 0.1");
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    const std::vector<std::string> logLines = lines(readText(logPath));
+    ASSERT_EQ(logLines.size(), 3u);
+    const std::string& frame2 = logLines[1];
+    for (const std::string& field :
+         {"{\"frame\": 2, \"status\": \"done\", \"input\": \"" + in("fluid_0002.vtk") + "\"",
+          "\"output\": \"" + dir() + "/out/mesh_0002.obj\"",
+          "\"outputs\": [\"" + dir() + "/out/mesh_0002.obj\", \"" + dir() + "/out/density_0002.vdb\"]",
+          std::string("\"particles\": 2366, "), std::string("\"vertices\": "),
+          std::string("\"faces\": "), std::string("\"seconds\": {\"read particles\": "),
+          std::string("\"rasterize density\": "), std::string("\"write vdb\": "),
+          std::string("\"peak_rss_bytes\": "), std::string("\"parameters\": {\"spacing\": "),
+          std::string("\"effective_radius\": 0.1, "), std::string("\"iterations\": 2, ")}) {
+        EXPECT_NE(frame2.find(field), std::string::npos) << field << "\n" << frame2;
+    }
+    EXPECT_EQ(frame2.back(), '}');
+    const std::string& summary = logLines[2];
+    for (const char* field : {"{\"summary\": true, ", "\"frames_done\": 2, ", "\"frames_failed\": 0, ",
+                              "\"frames_skipped\": 0, ", "\"frames_missing\": 0, ",
+                              "\"interrupted\": false", "\"total_seconds\": ",
+                              "\"particles\": 4732, ", "\"particles_per_second\": "}) {
+        EXPECT_NE(summary.find(field), std::string::npos) << field << "\n" << summary;
+    }
+}
+
+TEST_F(CliSequenceTest, InterruptedRunLeavesNoPartialFile)
+{
+    // Frame 1 is quick; frame 2, the dam break on a fine grid, takes long enough to be caught.
+    makeFrames({kCube, kData + "/dam_break_frame_23_24389_particles.vtk", kCube});
+    const std::string errFile = dir() + "/stderr.txt";
+    const std::vector<std::string> args = {
+        kCli, "mesh", in("fluid_{}.vtk"), "-o", out("mesh_{}.obj"), "--vdb", out("d_{}.vdb"),
+        "--voxel-size", "0.005", "-v", "--log", dir() + "/run.jsonl"};
+    std::vector<char*> argv;
+    for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+    argv.push_back(nullptr);
+    posix_spawn_file_actions_t actions;
+    posix_spawn_file_actions_init(&actions);
+    posix_spawn_file_actions_addopen(&actions, 1, "/dev/null", O_WRONLY, 0);
+    posix_spawn_file_actions_addopen(&actions, 2, errFile.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    pid_t pid = 0;
+    ASSERT_EQ(posix_spawn(&pid, kCli.c_str(), &actions, nullptr, argv.data(), environ), 0);
+    posix_spawn_file_actions_destroy(&actions);
+
+    // Interrupt once the second frame's density is being computed.
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+    while (count(readText(errFile), "[progress] rasterize density ...") < 2
+           && std::chrono::steady_clock::now() < deadline) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    }
+    ::kill(pid, SIGTERM);
+    int status = 0;
+    ASSERT_EQ(::waitpid(pid, &status, 0), pid);
+    ASSERT_TRUE(WIFEXITED(status)) << "killed by signal " << WTERMSIG(status);
+    EXPECT_EQ(WEXITSTATUS(status), 130);
+    const std::vector<std::string> errLines = lines(readText(errFile));
+    ASSERT_FALSE(errLines.empty());
+    EXPECT_EQ(errLines.back(), "nonbloppy: interrupted; finished frames: 1 (1 of 3)");
+    EXPECT_EQ(listDir(dir() + "/out"), (std::vector<std::string>{"d_0001.vdb", "mesh_0001.obj"}));
+    const std::string log = readText(dir() + "/run.jsonl");
+    EXPECT_NE(log.find("\"interrupted\": true"), std::string::npos) << log;
+    EXPECT_NE(log.find("\"frames_done\": 1, "), std::string::npos) << log;
+}
+
+TEST_F(CliSequenceTest, VerbosePrintsBytesPerParticle)
+{
+    const RunResult r = run("mesh " + quote(kCube) + " -o " + quote(out("cube.obj")) + " -v");
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    for (const char* stage : {"read particles", "rasterize density", "relax vertices", "write mesh"}) {
+        const size_t at = r.err.find("[memory]   " + std::string(stage));
+        ASSERT_NE(at, std::string::npos) << stage << "\n" << r.err;
+        EXPECT_NE(r.err.find("bytes/particle", at), std::string::npos) << r.err;
+    }
+    EXPECT_NE(r.err.find("getrusage ru_maxrss"), std::string::npos) << r.err;
+}

@@ -1,0 +1,298 @@
+// SPDX-License-Identifier: Apache-2.0
+/// @file FrameSequence.cc
+/// @brief Frame-number placeholders, `--frames` lists and the plan of a sequence run.
+
+#include "FrameSequence.h"
+
+#include <nonbloppy/Error.h>
+
+#include <algorithm>
+#include <cctype>
+#include <climits>
+#include <cstdio>
+#include <filesystem>
+#include <map>
+#include <system_error>
+
+namespace nonbloppy_tool {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+/// A --frames list may name at most this many frames (a typo like 1-1000000000 would
+/// otherwise allocate gigabytes before anything is checked).
+constexpr long long kMaxListedFrames = 10000000;
+
+bool isDigits(const std::string& s)
+{
+    return !s.empty() && std::all_of(s.begin(), s.end(),
+                                     [](char c) { return c >= '0' && c <= '9'; });
+}
+
+/// @a number zero-padded to @a width digits.
+std::string padded(int number, int width)
+{
+    char buffer[32];
+    std::snprintf(buffer, sizeof(buffer), "%0*d", width, number);
+    return buffer;
+}
+
+/// A non-negative frame number; nullopt if @a s is not one or does not fit an int.
+std::optional<int> parseNumber(const std::string& s)
+{
+    if (!isDigits(s) || s.size() > 10) return std::nullopt;
+    const long long value = std::stoll(s);
+    if (value > INT_MAX) return std::nullopt;
+    return static_cast<int>(value);
+}
+
+std::string trim(const std::string& s)
+{
+    size_t a = 0, b = s.size();
+    while (a < b && std::isspace(static_cast<unsigned char>(s[a]))) ++a;
+    while (b > a && std::isspace(static_cast<unsigned char>(s[b - 1]))) --b;
+    return s.substr(a, b - a);
+}
+
+struct Placeholder
+{
+    size_t begin = 0, end = 0;   // [begin, end) in the text
+    FramePattern::Kind kind = FramePattern::Kind::None;
+    int width = 0;
+};
+
+/// Every placeholder in @a text, left to right.
+std::vector<Placeholder> findPlaceholders(const std::string& text)
+{
+    std::vector<Placeholder> found;
+    for (size_t i = 0; i < text.size();) {
+        if (text.compare(i, 2, "{}") == 0) {
+            found.push_back({i, i + 2, FramePattern::Kind::Braces, 0});
+            i += 2;
+        } else if (text[i] == '#') {
+            size_t j = i;
+            while (j < text.size() && text[j] == '#') ++j;
+            found.push_back({i, j, FramePattern::Kind::Hashes, int(j - i)});
+            i = j;
+        } else if (text[i] == '%') {
+            // %d or %0Nd; anything else after '%' is part of the name.
+            size_t j = i + 1;
+            int width = 0;
+            if (j < text.size() && text[j] == '0') {
+                ++j;
+                size_t k = j;
+                while (k < text.size() && std::isdigit(static_cast<unsigned char>(text[k]))) ++k;
+                if (k == j || k - j > 2) { ++i; continue; }
+                width = std::stoi(text.substr(j, k - j));
+                j = k;
+            }
+            if (j < text.size() && text[j] == 'd') {
+                found.push_back({i, j + 1, FramePattern::Kind::Printf, width});
+                i = j + 1;
+            } else {
+                ++i;
+            }
+        } else {
+            ++i;
+        }
+    }
+    return found;
+}
+
+} // namespace
+
+FramePattern parseFramePattern(const std::string& text, const std::string& what)
+{
+    FramePattern pattern;
+    pattern.mText = text;
+    const std::vector<Placeholder> found = findPlaceholders(text);
+    if (found.size() > 1) {
+        throw nonbloppy::ParameterError(what + ": more than one frame placeholder in '" + text
+                                        + "'");
+    }
+    if (found.empty()) return pattern;
+    pattern.mKind = found[0].kind;
+    pattern.mWidth = found[0].width;
+    pattern.mPrefix = text.substr(0, found[0].begin);
+    pattern.mSuffix = text.substr(found[0].end);
+    return pattern;
+}
+
+std::string FramePattern::path(int number) const
+{
+    switch (mKind) {
+    case Kind::None: return mText;
+    case Kind::Braces: return mPrefix + std::to_string(number) + mSuffix;
+    case Kind::Hashes:
+    case Kind::Printf: return mPrefix + padded(number, mWidth) + mSuffix;
+    }
+    return mText;
+}
+
+std::string FramePattern::path(const Frame& frame) const
+{
+    if (mKind == Kind::Braces) return mPrefix + frame.digits + mSuffix;
+    return path(frame.number);
+}
+
+std::string FramePattern::directory() const
+{
+    if (mKind == Kind::None) return fs::path(mText).parent_path().string();
+    return fs::path(mPrefix + "0").parent_path().string();
+}
+
+std::optional<std::string> FramePattern::matchFileName(const std::string& fileName) const
+{
+    if (mKind == Kind::None) return std::nullopt;
+    const std::string prefix = fs::path(mPrefix + "0").filename().string();
+    const std::string namePrefix = prefix.substr(0, prefix.size() - 1);
+    if (fileName.size() < namePrefix.size() + mSuffix.size() + 1) return std::nullopt;
+    if (fileName.compare(0, namePrefix.size(), namePrefix) != 0) return std::nullopt;
+    if (fileName.compare(fileName.size() - mSuffix.size(), mSuffix.size(), mSuffix) != 0) {
+        return std::nullopt;
+    }
+    const std::string digits = fileName.substr(namePrefix.size(),
+                                               fileName.size() - namePrefix.size() - mSuffix.size());
+    const std::optional<int> number = parseNumber(digits);
+    if (!number) return std::nullopt;
+    // A fixed-width pattern names each frame one way only.
+    if (mKind != Kind::Braces && padded(*number, mWidth) != digits) return std::nullopt;
+    return digits;
+}
+
+std::vector<int> parseFrameList(const std::string& text, const std::string& what)
+{
+    if (trim(text).empty()) throw nonbloppy::ParameterError(what + ": empty frame list");
+    std::vector<int> frames;
+    long long listed = 0;
+    size_t start = 0;
+    while (true) {
+        const size_t comma = text.find(',', start);
+        const std::string item = trim(text.substr(start, comma == std::string::npos
+                                                             ? std::string::npos : comma - start));
+        if (item.empty()) {
+            throw nonbloppy::ParameterError(what + ": empty item in '" + text + "'");
+        }
+
+        // item = A | A-B | A-B:S
+        std::string range = item, stepText;
+        const size_t colon = item.find(':');
+        if (colon != std::string::npos) {
+            range = trim(item.substr(0, colon));
+            stepText = trim(item.substr(colon + 1));
+        }
+        const size_t dash = range.find('-');
+        if (dash == std::string::npos && colon != std::string::npos) {
+            throw nonbloppy::ParameterError(what + ": a step needs a range, as in 1-10:2, got '"
+                                            + item + "'");
+        }
+        const std::optional<int> first = parseNumber(trim(range.substr(0, dash)));
+        const std::optional<int> last =
+            dash == std::string::npos ? first : parseNumber(trim(range.substr(dash + 1)));
+        if (!first || !last) {
+            throw nonbloppy::ParameterError(what + ": bad " + std::string(dash == std::string::npos
+                                            ? "frame number '" : "range '") + item
+                                            + "' (expected N, A-B or A-B:STEP with A, B >= 0)");
+        }
+        if (*last < *first) {
+            throw nonbloppy::ParameterError(what + ": bad range '" + item + "' (end before start)");
+        }
+        int step = 1;
+        if (colon != std::string::npos) {
+            const std::optional<int> s = parseNumber(stepText);
+            if (!s || *s < 1) {
+                throw nonbloppy::ParameterError(what + ": bad step in '" + item
+                                                + "' (must be an integer >= 1)");
+            }
+            step = *s;
+        }
+        listed += (static_cast<long long>(*last) - *first) / step + 1;
+        if (listed > kMaxListedFrames) {
+            throw nonbloppy::ParameterError(what + ": more than "
+                                            + std::to_string(kMaxListedFrames) + " frames in '"
+                                            + text + "'");
+        }
+        for (long long f = *first; f <= *last; f += step) frames.push_back(static_cast<int>(f));
+
+        if (comma == std::string::npos) break;
+        start = comma + 1;
+    }
+    std::sort(frames.begin(), frames.end());
+    frames.erase(std::unique(frames.begin(), frames.end()), frames.end());
+    return frames;
+}
+
+std::string formatFrameList(std::vector<int> frames)
+{
+    std::sort(frames.begin(), frames.end());
+    frames.erase(std::unique(frames.begin(), frames.end()), frames.end());
+    std::string out;
+    for (size_t i = 0; i < frames.size();) {
+        size_t j = i;
+        while (j + 1 < frames.size() && frames[j + 1] == frames[j] + 1) ++j;
+        if (!out.empty()) out += ", ";
+        out += std::to_string(frames[i]);
+        if (j > i) out += "-" + std::to_string(frames[j]);
+        i = j + 1;
+    }
+    return out;
+}
+
+std::vector<Frame> findFrames(const FramePattern& input)
+{
+    const std::string dir = input.directory();
+    if (!input.placeholderInFileName()) {
+        throw nonbloppy::ParameterError("IN: the frame placeholder must be in the file name, "
+                                        "not in a directory ('" + input.text() + "')");
+    }
+    std::error_code ec;
+    fs::directory_iterator it(dir.empty() ? fs::path(".") : fs::path(dir), ec);
+    if (ec) {
+        throw nonbloppy::FileError("cannot read directory " + (dir.empty() ? "." : dir) + ": "
+                                   + ec.message());
+    }
+    std::map<int, Frame> byNumber;
+    for (const fs::directory_entry& entry : it) {
+        const std::string name = entry.path().filename().string();
+        const std::optional<std::string> digits = input.matchFileName(name);
+        if (!digits) continue;
+        std::error_code statError;
+        if (entry.is_directory(statError)) continue;
+        Frame frame;
+        frame.number = *parseNumber(*digits);
+        frame.digits = *digits;
+        frame.input = (dir.empty() ? fs::path(name) : fs::path(dir) / name).string();
+        const auto [at, inserted] = byNumber.emplace(frame.number, frame);
+        if (!inserted) {
+            std::string a = at->second.input, b = frame.input;
+            if (b < a) std::swap(a, b);
+            throw nonbloppy::FileError(a + " and " + b + " are both frame "
+                                       + std::to_string(frame.number));
+        }
+    }
+    std::vector<Frame> frames;
+    frames.reserve(byNumber.size());
+    for (auto& [number, frame] : byNumber) frames.push_back(std::move(frame));
+    return frames;
+}
+
+FramePlan planFrames(const FramePattern& input, const std::optional<std::vector<int>>& requested)
+{
+    FramePlan plan;
+    std::vector<Frame> found = findFrames(input);
+    if (!requested) {
+        plan.frames = std::move(found);
+        return plan;
+    }
+    std::map<int, Frame> byNumber;
+    for (Frame& f : found) byNumber.emplace(f.number, std::move(f));
+    for (int number : *requested) {
+        auto it = byNumber.find(number);
+        if (it == byNumber.end()) plan.missing.push_back(number);
+        else plan.frames.push_back(it->second);
+    }
+    return plan;
+}
+
+} // namespace nonbloppy_tool
