@@ -391,3 +391,17 @@ TEST_F(CliSequenceTest, VerbosePrintsBytesPerParticle)
     }
     EXPECT_NE(r.err.find("getrusage ru_maxrss"), std::string::npos) << r.err;
 }
+
+TEST_F(CliSequenceTest, MeshWithoutVdbIsTheSameMesh)
+{
+    // Without --vdb the tool lets the library drop the grid early (less memory); the mesh
+    // must not change by a bit.
+    const std::string dam = kData + "/bunny_frame_14_7705_particles.vtk";
+    const RunResult without = run("mesh " + quote(dam) + " -o " + quote(out("a.obj")));
+    ASSERT_EQ(without.exitCode, 0) << without.err;
+    EXPECT_NE(without.out.find("(density grid not kept without --vdb)"), std::string::npos)
+        << without.out;
+    ASSERT_EQ(run("mesh " + quote(dam) + " -o " + quote(out("b.obj")) + " --vdb "
+                  + quote(out("b.vdb")) + " -q").exitCode, 0);
+    EXPECT_TRUE(readText(out("a.obj")) == readText(out("b.obj"))) << "meshes differ";
+}

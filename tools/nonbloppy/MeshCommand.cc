@@ -335,8 +335,13 @@ void printSummary(const MeshOptions& o, const nonbloppy::SurfaceResult& result,
     row("threads", std::to_string(threads), origin(o.threadsOpt->count() > 0, "(default)"));
 
     out << "result\n";
-    const uint64_t activeVoxels = result.density ? result.density->activeVoxelCount() : 0;
-    row("active voxels", std::to_string(activeVoxels), "(" + formatCount(activeVoxels) + ", density grid)");
+    if (result.density) {
+        const uint64_t activeVoxels = result.density->activeVoxelCount();
+        row("active voxels", std::to_string(activeVoxels),
+            "(" + formatCount(activeVoxels) + ", density grid)");
+    } else {
+        row("active voxels", "-", "(density grid not kept without --vdb)");
+    }
     row("vertices", std::to_string(mesh.points.size()), "");
     if (o.quads) {
         row("polygons", std::to_string(mesh.polygonCount()),
@@ -413,6 +418,10 @@ FrameOutcome meshFrame(const MeshOptions& o, ProgressInterrupter& interrupter)
     params.blend = o.blend;
     params.iterations = o.iterations;
     params.adaptivity = o.adaptivity;
+    // Without --vdb nothing needs the grid: the library then turns the fluid's deep interior
+    // into tiles before extraction (the same mesh, bit for bit) and frees the grid before
+    // relaxing, which lowers the peak memory of large frames.
+    params.keepDensity = !o.vdbPath.empty();
 
     // The particles are handed over; their attributes are not needed for meshing.
     FrameOutcome outcome;
