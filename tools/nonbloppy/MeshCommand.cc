@@ -35,6 +35,9 @@
 #include <vector>
 
 #include <sys/stat.h>
+#ifdef __GLIBC__
+#include <malloc.h>
+#endif
 #include <unistd.h>
 
 namespace nonbloppy_tool {
@@ -93,6 +96,12 @@ public:
 
     void start(const char* name = nullptr) override
     {
+#ifdef __GLIBC__
+        // By now the library has freed the density grid (without --vdb) and the extraction's
+        // temporaries, but glibc keeps those pages; hand them back before the mesh grows, or
+        // they add to the peak of large frames (12.5M particles: 6.6 GiB -> 5.5 GiB).
+        if (name && std::strcmp(name, "relax vertices") == 0) malloc_trim(0);
+#endif
         std::lock_guard<std::mutex> lock(mMutex);
         mStages.push_back({name ? name : "working", std::chrono::steady_clock::now()});
         mNextQuarter = 1;
