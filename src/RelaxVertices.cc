@@ -94,6 +94,7 @@ struct RelaxStepOp
     std::vector<openvdb::Vec3s>& next;
     float effectiveRadius;
     float blend;
+    float maxStep;  ///< cap on one step's length, world units; 0: no cap (the paper)
     openvdb::util::NullInterrupter* interrupter;
     std::atomic<bool>& cancelled;
 
@@ -162,7 +163,15 @@ struct RelaxStepOp
                 }
                 if (weightSum > 0.0f) {
                     const float scale = blend / weightSum;
-                    next[i] = openvdb::Vec3s(v[0] + scale * mx, v[1] + scale * my, v[2] + scale * mz);
+                    float dx = scale * mx, dy = scale * my, dz = scale * mz;
+                    const float length2 = dx * dx + dy * dy + dz * dz;
+                    if (maxStep > 0.0f && length2 > maxStep * maxStep) {
+                        const float shrink = maxStep / std::sqrt(length2);
+                        dx *= shrink;
+                        dy *= shrink;
+                        dz *= shrink;
+                    }
+                    next[i] = openvdb::Vec3s(v[0] + dx, v[1] + dy, v[2] + dz);
                 } else {
                     next[i] = v;  // no particle within r_e: stays put
                 }
@@ -226,6 +235,10 @@ void relaxVertices(SurfaceMesh& mesh, const ParticleIndex& particles, const Rela
         msg << "--iterations must be >= 0, got " << settings.iterations;
         throw ParameterError(msg.str());
     }
+    if (!(settings.maxStep >= 0.0) || !std::isfinite(settings.maxStep)) {
+        msg << "--max-step must be >= 0, got " << settings.maxStep;
+        throw ParameterError(msg.str());
+    }
     if (settings.iterations == 0 || settings.blend == 0.0 || mesh.points.empty()) return;
 
     if (interrupter) interrupter->start("relax vertices");
@@ -237,7 +250,7 @@ void relaxVertices(SurfaceMesh& mesh, const ParticleIndex& particles, const Rela
         groupVerticesByCell(mesh.points, kGroupCells * particles.cellSize(), order, groupStart);
         tbb::parallel_for(tbb::blocked_range<size_t>(0, groupStart.size() - 1, 64),
             RelaxStepOp{particles, order, groupStart, mesh.points, next, float(settings.effectiveRadius),
-                        float(settings.blend), interrupter, cancelled});
+                        float(settings.blend), float(settings.maxStep), interrupter, cancelled});
         mesh.points.swap(next);
         if (interrupter && interrupter->wasInterrupted(100 * (iteration + 1) / settings.iterations)) {
             cancelled = true;

@@ -19,6 +19,10 @@ struct RelaxSettings
     double effectiveRadius = 0.0;  ///< r_e, world units, > 0 (the kernel's support)
     double blend = 0.3;            ///< c in [0,1]: 0 leaves vertices alone, 1 jumps to the mean
     int iterations = 2;            ///< t ≥ 0
+    /// Cap on how far one iteration may move a vertex, world units: a longer step keeps its
+    /// direction and is shortened to maxStep. 0 (the default) is the paper's uncapped step.
+    /// Guards against spikes where a vertex sees only a few particles.
+    double maxStep = 0.0;
 };
 
 /// Apply t times, to every vertex v_i of @a mesh:
@@ -27,7 +31,7 @@ struct RelaxSettings
 /// depend on thread count or order. A vertex with no particle within r_e stays put.
 /// Normals are not updated (call computeNormals() afterwards).
 /// Cost: t · V · (particles within r_e) kernel evaluations, parallel over vertices.
-/// @throw ParameterError for r_e ≤ 0, c outside [0,1] or t < 0; CancelledError on interrupt.
+/// @throw ParameterError for r_e ≤ 0, c outside [0,1], t < 0 or maxStep < 0; CancelledError on interrupt.
 void relaxVertices(SurfaceMesh& mesh, const ParticleIndex& particles,
                    const RelaxSettings& settings,
                    openvdb::util::NullInterrupter* interrupter = nullptr);
