@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 #include <nonbloppy/BuildSurface.h>
 #include <nonbloppy/ComputeNormals.h>
+#include <nonbloppy/CorrectSurface.h>
 #include <nonbloppy/Error.h>
 #include <nonbloppy/ExtractSurface.h>
 #include <nonbloppy/ParticleIndex.h>
@@ -58,6 +59,7 @@ SurfaceResult buildSurface(std::vector<openvdb::Vec3f> positions, const SurfaceP
         grid.insertMeta("voxel_size", openvdb::DoubleMetadata(p.voxelSize));
         grid.insertMeta("spacing", openvdb::DoubleMetadata(p.spacing));
         grid.insertMeta("adaptivity", openvdb::DoubleMetadata(p.adaptivity));
+        grid.insertMeta("method", openvdb::StringMetadata(p.method == Method::Paper ? "paper" : "faithful"));
         grid.insertMeta("particle_count", openvdb::Int64Metadata(int64_t(result.particleCount)));
         grid.insertMeta("nonbloppy_version", openvdb::StringMetadata(version()));
     }
@@ -70,17 +72,32 @@ SurfaceResult buildSurface(std::vector<openvdb::Vec3f> positions, const SurfaceP
         if (interrupter) interrupter->end();
     }
     checkCancelled(interrupter, "extract surface");
+    std::vector<openvdb::Vec3s> unrelaxed;  // positions before relaxation, for fold repair
     {
         ScopedStageTimer timer(result.timings, "relax vertices");
         RelaxSettings settings;
         settings.effectiveRadius = p.effectiveRadius;
         settings.blend = p.blend;
         settings.iterations = p.iterations;
+        settings.maxStep = p.maxStep;
+        if (p.repairFolds) unrelaxed = result.mesh.points;
         relaxVertices(result.mesh, index, settings, interrupter);
+    }
+    if (p.repairFolds) {
+        ScopedStageTimer timer(result.timings, "correct surface");
+        repairFolds(result.mesh, unrelaxed);
+        std::vector<openvdb::Vec3s>().swap(unrelaxed);
     }
     {
         ScopedStageTimer timer(result.timings, "compute normals");
         computeNormals(result.mesh);
+    }
+    if (p.preserveVolume) {
+        // Each particle stands for s³ of fluid; preserveVolume() recomputes the normals.
+        ScopedStageTimer timer(result.timings, "correct surface");
+        const double s = p.spacing;
+        preserveVolume(result.mesh, double(result.particleCount) * s * s * s,
+                       kMaxVolumeOffsetOverSpacing * s);
     }
     return result;
 }

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "ParticleIndexImpl.h"
 
+#include <nonbloppy/CorrectSurface.h>
 #include <nonbloppy/Error.h>
 #include <nonbloppy/EstimateParameters.h>
 #include <nonbloppy/Kernel.h>
@@ -167,8 +168,22 @@ ResolvedParameters resolveParameters(const SurfaceParameters& params,
     out.effectiveRadius = params.effectiveRadius ? *params.effectiveRadius
                                                  : kDefaultRadiusOverSpacing * out.spacing;
     out.voxelSize = params.voxelSize ? *params.voxelSize : kDefaultVoxelOverSpacing * out.spacing;
-    out.threshold = params.threshold ? *params.threshold
-                                     : calibrateThreshold(out.effectiveRadius / out.spacing);
+    out.method = params.method;
+    const bool faithful = params.method == Method::Faithful;
+    if (params.threshold) out.threshold = *params.threshold;
+    else if (faithful) out.threshold = calibrateRelaxedThreshold(out.effectiveRadius / out.spacing,
+                                                                 out.blend, out.iterations);
+    else out.threshold = calibrateThreshold(out.effectiveRadius / out.spacing);
+    if (faithful) {
+        if (params.maxStep && (!(*params.maxStep >= 0.0) || !std::isfinite(*params.maxStep))) {
+            throw ParameterError("--max-step must be >= 0, got " + formatNumber(*params.maxStep));
+        }
+        out.maxStep = params.maxStep ? *params.maxStep : kDefaultMaxStepOverSpacing * out.spacing;
+        out.preserveVolume = params.preserveVolume ? *params.preserveVolume : out.spacingGiven;
+        out.repairFolds = params.repairFolds;
+        // The volume target N·s³ needs s even when r_e, r_0 and h were all given.
+        if (out.preserveVolume && !(out.spacing > 0.0)) out.spacing = estimateSpacing(positions);
+    }
 
     // The grid holds (2 r_e / h)³ voxels per particle: refuse sizes that would exhaust memory.
     constexpr double kMaxVoxelsPerRadius = 32.0;

@@ -2,6 +2,7 @@
 #include "TestUtil.h"
 
 #include <nonbloppy/BuildSurface.h>
+#include <nonbloppy/CorrectSurface.h>
 #include <nonbloppy/Error.h>
 #include <nonbloppy/EstimateParameters.h>
 
@@ -84,7 +85,12 @@ TEST(EstimateParameters, ResolveReportsWhatWasGivenAndChecksRanges)
     EXPECT_FALSE(resolved.thresholdGiven);
     EXPECT_DOUBLE_EQ(resolved.effectiveRadius, 0.2);
     EXPECT_NEAR(resolved.voxelSize, 0.025, 1e-7);
-    EXPECT_DOUBLE_EQ(resolved.threshold, calibrateThreshold(0.2 / resolved.spacing));
+    // The default (Method::Faithful) calibrates r_0 for the relaxed surface, the paper's for the blob.
+    EXPECT_DOUBLE_EQ(resolved.threshold,
+                     calibrateRelaxedThreshold(0.2 / resolved.spacing, kDefaultBlend, kDefaultIterations));
+    SurfaceParameters paper = params;
+    paper.method = Method::Paper;
+    EXPECT_DOUBLE_EQ(resolveParameters(paper, ball).threshold, calibrateThreshold(0.2 / resolved.spacing));
 
     const auto expectMessage = [&](SurfaceParameters bad, const char* message) {
         try {

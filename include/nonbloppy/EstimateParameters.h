@@ -35,13 +35,34 @@ constexpr double kDefaultBlend = 0.3;              ///< c
 constexpr int kDefaultIterations = 2;              ///< t
 constexpr double kDefaultAdaptivity = 0.0;         ///< volumeToMesh adaptivity, in [0,1]
 
+/// Method::Faithful: one relaxation step moves a vertex at most s/2 (RelaxSettings::maxStep).
+/// With c ≤ 0.5 and r_e = 2 s a step is shorter than c·r_e ≤ s anyway; the cap matters for
+/// larger blends, where vertices that see only a few particles would jump onto them.
+constexpr double kDefaultMaxStepOverSpacing = 0.5;
+/// Method::Faithful: the volume correction moves the surface at most s/4 along its normals.
+constexpr double kMaxVolumeOffsetOverSpacing = 0.25;
+
+/// Which variant of the method buildSurface() runs.
+enum class Method
+{
+    /// The paper's plain method, exactly: extract φ = r_0 (r_0 calibrated for the unrelaxed
+    /// surface), relax t times, nothing else. Reproduces the paper's behaviour, including
+    /// the shrinking and the rounding it warns about.
+    Paper,
+    /// The default: the paper's method with the corrections of CorrectSurface.h, tuned so
+    /// that the surface lies within 0.1 s of the fluid's true surface (docs/fidelity.md).
+    Faithful,
+};
+
 /// What the user asks for; every unset optional is derived from the particle spacing.
 /// All lengths are absolute, in world units (not multiples of the spacing).
 struct SurfaceParameters
 {
     std::optional<double> spacing;          ///< s; default: estimateSpacing()
     std::optional<double> effectiveRadius;  ///< r_e; default: 2 s
-    std::optional<double> threshold;        ///< r_0 (dimensionless); default: calibrateThreshold(r_e/s)
+    /// r_0 (dimensionless); default: calibrateRelaxedThreshold(r_e/s, c, t) (Faithful) or
+    /// calibrateThreshold(r_e/s) (Paper)
+    std::optional<double> threshold;
     std::optional<double> voxelSize;        ///< h; default: s / 2
     double blend = kDefaultBlend;           ///< c in [0,1]
     int iterations = kDefaultIterations;    ///< t ≥ 0
@@ -50,6 +71,19 @@ struct SurfaceParameters
     /// replace leaves deep inside the fluid by tiles before extraction and return no grid:
     /// the same mesh, bit for bit, with less memory and a faster extraction.
     bool keepDensity = true;
+    Method method = Method::Faithful;       ///< Paper: the plain method; see Method
+    /// Faithful only: cap on how far one relaxation step moves a vertex, world units
+    /// (RelaxSettings::maxStep), ≥ 0; default kDefaultMaxStepOverSpacing·s, 0 for no cap
+    /// (also when every length was given and s is unknown).
+    std::optional<double> maxStep;
+    /// Faithful only: offset the relaxed surface along its normals, by at most
+    /// kMaxVolumeOffsetOverSpacing·s, so that it encloses N·s³ (preserveVolume()).
+    /// Default: on when the spacing is given, off when it is estimated (the median
+    /// nearest-neighbour distance of a disordered fluid is below its true spacing, and
+    /// N·s³ would then shrink the fluid).
+    std::optional<bool> preserveVolume;
+    /// Faithful only: unfold triangles relaxation folded over (repairFolds()).
+    bool repairFolds = true;
 };
 
 /// Every parameter's value as used, and whether the user gave it.
@@ -61,6 +95,10 @@ struct ResolvedParameters
     double adaptivity = kDefaultAdaptivity;
     bool spacingGiven = false, effectiveRadiusGiven = false, thresholdGiven = false,
          voxelSizeGiven = false;
+    Method method = Method::Faithful;       ///< the variant run
+    double maxStep = 0.0;                   ///< cap on one relaxation step, world units; 0: none
+    bool preserveVolume = false;            ///< the volume correction runs
+    bool repairFolds = false;               ///< fold repair runs
 };
 
 /// Check @a params and fill in what is missing. @a positions is only read when the spacing

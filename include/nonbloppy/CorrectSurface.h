@@ -1,0 +1,78 @@
+// SPDX-License-Identifier: Apache-2.0
+/// @file CorrectSurface.h
+/// @brief Stage "correct surface": what the paper's relaxation needs to stay faithful to the
+///        fluid's true surface (the particles grown by s/2): an iso-value calibrated for the
+///        relaxed surface, repair of folded triangles, and an optional volume correction.
+///
+/// Relaxing pulls every vertex towards the particle centres: with c = 0.3, t = 2 a flat face
+/// ends 0.32 s inside the true surface, and the fluid loses that much all around
+/// (docs/fidelity.md, row "paper"). buildSurface() with Method::Faithful extracts at
+/// calibrateRelaxedThreshold() instead, so that relaxation ends on the true surface, then
+/// calls repairFolds(); Method::Paper calls none of this.
+
+#ifndef NONBLOPPY_CORRECT_SURFACE_H
+#define NONBLOPPY_CORRECT_SURFACE_H
+
+#include <nonbloppy/Mesh.h>
+
+#include <openvdb/openvdb.h>
+
+#include <cstddef>
+#include <limits>
+#include <vector>
+
+namespace nonbloppy {
+
+/// The iso-value r_0 for which the surface of a flat, uniform half-space of particles on a
+/// cubic lattice of spacing s ends, after @a iterations relaxation steps of blend @a blend,
+/// s/2 outside the outer particle layer (averaged over the lattice cell), so the relaxed
+/// fluid's volume is about N·s³. With t = 0 or c = 0 it equals calibrateThreshold().
+/// The start height is limited to min(1.5 s, 0.75 r_e): relaxations so strong that they
+/// would need to start farther out (c = 0.5, t = 2 would start 1.9 s out and merge fluid
+/// bodies 4 s apart) get the threshold of that limit and end inside the true surface.
+/// The result depends only on r_e/s, c and t. Cost: about 10⁶ kernel evaluations (~10 ms).
+/// Thread-safety: reentrant.
+/// @throw ParameterError if @a effectiveRadiusOverSpacing ≤ 0.5, c outside [0,1] or t < 0.
+double calibrateRelaxedThreshold(double effectiveRadiusOverSpacing, double blend,
+                                 int iterations);
+
+/// Number of triangles (quads split along the 0–2 diagonal) of @a mesh whose normal points
+/// against the normal the same triangle had with the vertex positions @a before (same
+/// polygons): the triangles relaxation folded over.
+/// Cost: O(P). Thread-safety: reentrant.
+/// @throw ParameterError if @a before and mesh.points differ in size.
+size_t countFoldedTriangles(const SurfaceMesh& mesh, const std::vector<openvdb::Vec3s>& before);
+
+/// Unfold triangles folded over by relaxation: every vertex of a folded triangle (see
+/// countFoldedTriangles()) is moved halfway back to its position in @a before, and this is
+/// repeated until no triangle is folded or @a maxRounds rounds have run; the vertices of
+/// triangles still folded then go all the way back. Vertices of unfolded triangles are not
+/// touched, so a mesh without folds is returned bit for bit.
+/// @return the number of folded triangles found in the first round
+/// Cost: O(rounds · P). Deterministic. Normals are not updated.
+/// @throw ParameterError if @a before and mesh.points differ in size.
+size_t repairFolds(SurfaceMesh& mesh, const std::vector<openvdb::Vec3s>& before,
+                   int maxRounds = 4);
+
+/// Move every vertex by @a distance (world units, > 0 outwards) along its unit normal, which
+/// must have been computed (computeNormals()); vertices with a zero normal stay put.
+/// @throw ParameterError if mesh.normals and mesh.points differ in size.
+void offsetSurface(SurfaceMesh& mesh, double distance);
+
+/// Offset the surface along its normals (offsetSurface()) so that its enclosed volume becomes
+/// @a targetVolume (world units³), to first order: distance = (target − volume) / area,
+/// applied twice to absorb the curvature term. Needs normals; recomputes them afterwards.
+/// Only meaningful for a closed mesh whose target is known (e.g. N·s³ for an incompressible
+/// fluid of N particles at spacing s); a wrong target shifts the whole surface.
+/// @return the total distance moved along the normals (world units)
+/// @throw ParameterError if targetVolume is not > 0 or normals are missing.
+/// @param mesh         closed mesh with normals; vertices moved, normals recomputed
+/// @param targetVolume volume to enclose, world units³, > 0
+/// @param maxDistance  largest distance moved in total, world units (the correction is
+///                     clamped to ±maxDistance, so a wrong target cannot move the surface far)
+double preserveVolume(SurfaceMesh& mesh, double targetVolume,
+                      double maxDistance = std::numeric_limits<double>::infinity());
+
+} // namespace nonbloppy
+
+#endif // NONBLOPPY_CORRECT_SURFACE_H

@@ -1,0 +1,228 @@
+// SPDX-License-Identifier: Apache-2.0
+/// @file CorrectSurface.cc
+/// @brief Relaxed-surface threshold calibration, fold repair, normal offset and volume correction.
+
+#include <nonbloppy/CorrectSurface.h>
+#include <nonbloppy/Error.h>
+#include <nonbloppy/EstimateParameters.h>
+#include <nonbloppy/Kernel.h>
+#include <nonbloppy/MeasureMesh.h>
+#include <nonbloppy/ComputeNormals.h>
+
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+namespace nonbloppy {
+
+namespace {
+
+/// Lattice cell sampled on a kSamples × kSamples grid, as calibrateThreshold() does.
+constexpr int kSamples = 8;
+
+/// MPS weight in double precision, with the library's clamp near d = 0.
+double weight(double d, double ratio)
+{
+    if (!(d < ratio)) return 0.0;
+    return ratio / std::max(d, double(kMinDistanceFraction) * ratio) - 1.0;
+}
+
+/// Unit lattice filling z ≤ 0 (spacing 1, r_e = ratio): density at (x, y, z).
+double latticeDensity(double ratio, const openvdb::Vec3d& x)
+{
+    const int reach = int(std::ceil(ratio)) + 1;
+    const int i0 = int(std::floor(x[0])), j0 = int(std::floor(x[1]));
+    double sum = 0.0;
+    for (int i = i0 - reach; i <= i0 + reach + 1; ++i)
+        for (int j = j0 - reach; j <= j0 + reach + 1; ++j)
+            for (int k = std::min(0, int(std::ceil(x[2])) + reach); k >= int(std::floor(x[2])) - reach - 1; --k) {
+                sum += weight((x - openvdb::Vec3d(i, j, k)).length(), ratio);
+            }
+    return sum;
+}
+
+/// One relaxation step of vertex @a x against the unit lattice filling z ≤ 0.
+openvdb::Vec3d relaxOnLattice(double ratio, double blend, const openvdb::Vec3d& x)
+{
+    const int reach = int(std::ceil(ratio)) + 1;
+    const int i0 = int(std::floor(x[0])), j0 = int(std::floor(x[1]));
+    double sw = 0.0;
+    openvdb::Vec3d mean(0.0);
+    for (int i = i0 - reach; i <= i0 + reach + 1; ++i)
+        for (int j = j0 - reach; j <= j0 + reach + 1; ++j)
+            for (int k = std::min(0, int(std::ceil(x[2])) + reach); k >= int(std::floor(x[2])) - reach - 1; --k) {
+                const openvdb::Vec3d r(i, j, k);
+                const double w = weight((x - r).length(), ratio);
+                sw += w;
+                mean += w * r;
+            }
+    if (!(sw > 0.0)) return x;
+    return x + blend * (mean / sw - x);
+}
+
+/// Mean height, over the lattice cell, of vertices that start at height @a z0 after
+/// @a iterations relaxation steps.
+double relaxedHeight(double ratio, double blend, int iterations, double z0)
+{
+    double sum = 0.0;
+    for (int a = 0; a < kSamples; ++a)
+        for (int b = 0; b < kSamples; ++b) {
+            openvdb::Vec3d x((a + 0.5) / kSamples, (b + 0.5) / kSamples, z0);
+            for (int t = 0; t < iterations; ++t) x = relaxOnLattice(ratio, blend, x);
+            sum += x[2];
+        }
+    return sum / (kSamples * kSamples);
+}
+
+double planeDensity(double ratio, double z)
+{
+    double sum = 0.0;
+    for (int a = 0; a < kSamples; ++a)
+        for (int b = 0; b < kSamples; ++b) {
+            sum += latticeDensity(ratio, openvdb::Vec3d((a + 0.5) / kSamples, (b + 0.5) / kSamples, z));
+        }
+    return sum / (kSamples * kSamples);
+}
+
+/// Twice the area-weighted normal of triangle abc.
+inline openvdb::Vec3d triangleNormal(const openvdb::Vec3s& a, const openvdb::Vec3s& b, const openvdb::Vec3s& c)
+{
+    const openvdb::Vec3d pa(a), pb(b), pc(c);
+    return (pb - pa).cross(pc - pa);
+}
+
+/// Call @a op(i, j, k) for every triangle of the mesh (quads split along 0–2).
+template<typename OpT>
+void forEachTriangle(const SurfaceMesh& mesh, OpT&& op)
+{
+    for (const openvdb::Vec3I& t : mesh.triangles) op(t[0], t[1], t[2]);
+    for (const openvdb::Vec4I& q : mesh.quads) {
+        op(q[0], q[1], q[2]);
+        op(q[0], q[2], q[3]);
+    }
+}
+
+void requireSameSize(const SurfaceMesh& mesh, const std::vector<openvdb::Vec3s>& before)
+{
+    if (before.size() != mesh.points.size()) {
+        throw ParameterError("fold repair needs the positions before relaxation of all " +
+                             std::to_string(mesh.points.size()) + " vertices, got " +
+                             std::to_string(before.size()));
+    }
+}
+
+/// Mark the vertices of folded triangles; return how many triangles are folded.
+size_t markFolded(const SurfaceMesh& mesh, const std::vector<openvdb::Vec3s>& before,
+                  std::vector<char>& marked)
+{
+    std::fill(marked.begin(), marked.end(), 0);
+    size_t folded = 0;
+    forEachTriangle(mesh, [&](unsigned i, unsigned j, unsigned k) {
+        const openvdb::Vec3d now = triangleNormal(mesh.points[i], mesh.points[j], mesh.points[k]);
+        const openvdb::Vec3d then = triangleNormal(before[i], before[j], before[k]);
+        if (now.dot(then) < 0.0) {
+            ++folded;
+            marked[i] = marked[j] = marked[k] = 1;
+        }
+    });
+    return folded;
+}
+
+} // namespace
+
+double calibrateRelaxedThreshold(double effectiveRadiusOverSpacing, double blend, int iterations)
+{
+    const double ratio = effectiveRadiusOverSpacing;
+    if (!(blend >= 0.0 && blend <= 1.0)) {
+        std::ostringstream msg;
+        msg << "--blend must lie in [0,1], got " << blend;
+        throw ParameterError(msg.str());
+    }
+    if (iterations < 0) {
+        throw ParameterError("--iterations must be >= 0, got " + std::to_string(iterations));
+    }
+    const double blobThreshold = calibrateThreshold(ratio);  // checks the ratio
+    if (iterations == 0 || blend == 0.0) return blobThreshold;
+
+    // Far from the particles few of them are in reach and relaxation jumps towards them, so
+    // the relaxed height is not monotone in the start height over all of [1/2, r_e]: take the
+    // first start height, scanning outwards from 1/2, that relaxes to 1/2 or beyond, and
+    // bisect within that step. Starting farther out than kMaxStart (or 3/4 r_e) would merge
+    // fluid bodies 2·kMaxStart apart before relaxation could separate them: strong
+    // relaxations (large c·t) stop there and end inside (preserveVolume() can finish).
+    constexpr double kScanStep = 0.05, kMaxStart = 1.5;
+    const double limit = std::min(kMaxStart, 0.75 * ratio);
+    double low = 0.5, high = 0.5;
+    while (relaxedHeight(ratio, blend, iterations, high) < 0.5) {
+        low = high;
+        high += kScanStep;
+        if (high >= limit) return planeDensity(ratio, limit);
+    }
+    for (int step = 0; step < 24; ++step) {
+        const double middle = 0.5 * (low + high);
+        (relaxedHeight(ratio, blend, iterations, middle) < 0.5 ? low : high) = middle;
+    }
+    return planeDensity(ratio, 0.5 * (low + high));
+}
+
+size_t countFoldedTriangles(const SurfaceMesh& mesh, const std::vector<openvdb::Vec3s>& before)
+{
+    requireSameSize(mesh, before);
+    std::vector<char> marked(mesh.points.size());
+    return markFolded(mesh, before, marked);
+}
+
+size_t repairFolds(SurfaceMesh& mesh, const std::vector<openvdb::Vec3s>& before, int maxRounds)
+{
+    requireSameSize(mesh, before);
+    std::vector<char> marked(mesh.points.size());
+    const size_t first = markFolded(mesh, before, marked);
+    size_t folded = first;
+    for (int round = 0; folded > 0; ++round) {
+        const bool last = round >= maxRounds;
+        for (size_t i = 0; i < marked.size(); ++i) {
+            if (!marked[i]) continue;
+            mesh.points[i] = last ? before[i] : 0.5f * (mesh.points[i] + before[i]);
+        }
+        if (last) break;
+        folded = markFolded(mesh, before, marked);
+    }
+    return first;
+}
+
+void offsetSurface(SurfaceMesh& mesh, double distance)
+{
+    if (mesh.normals.size() != mesh.points.size()) {
+        throw ParameterError("offsetting a surface needs its normals (computeNormals())");
+    }
+    const float d = float(distance);
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, mesh.points.size()),
+        [&](const tbb::blocked_range<size_t>& range) {
+            for (size_t i = range.begin(); i < range.end(); ++i) mesh.points[i] += d * mesh.normals[i];
+        });
+}
+
+double preserveVolume(SurfaceMesh& mesh, double targetVolume, double maxDistance)
+{
+    if (!(targetVolume > 0.0) || !std::isfinite(targetVolume)) {
+        std::ostringstream msg;
+        msg << "target volume must be > 0, got " << targetVolume;
+        throw ParameterError(msg.str());
+    }
+    double total = 0.0;
+    for (int pass = 0; pass < 2; ++pass) {
+        const MeshMeasures measures = measureMesh(mesh);
+        if (!(measures.area > 0.0)) break;
+        const double distance = std::clamp((targetVolume - measures.volume) / measures.area,
+                                           -maxDistance - total, maxDistance - total);
+        if (distance == 0.0) break;
+        offsetSurface(mesh, distance);
+        computeNormals(mesh);
+        total += distance;
+    }
+    return total;
+}
+
+} // namespace nonbloppy
