@@ -14,6 +14,7 @@
 #ifndef NONBLOPPY_BUILD_SURFACE_H
 #define NONBLOPPY_BUILD_SURFACE_H
 
+#include <nonbloppy/Export.h>
 #include <nonbloppy/EstimateParameters.h>
 #include <nonbloppy/Mesh.h>
 #include <nonbloppy/Timing.h>
@@ -32,19 +33,29 @@ struct SurfaceResult
     SurfaceMesh mesh;                   ///< relaxed, counter-clockwise, with vertex normals
     openvdb::FloatGrid::Ptr density;    ///< the "density" grid, metadata holds the parameters
     ResolvedParameters parameters;      ///< every value used, and which were given
-    size_t particleCount = 0;
+    size_t particleCount = 0;           ///< number of input particles
     StageTimings timings;               ///< seconds per stage
 };
 
 /// Run the whole pipeline on @a positions (world units), which it takes over.
+/// @param positions    particle positions, world units; moved into the particle index
+/// @param params       method parameters; lengths absolute, in world units (see SurfaceParameters)
+/// @param interrupter  optional; asked between stages and, during rasterization and
+///                     relaxation, once per parallel task, so a cancel takes effect quickly
+/// Cost: dominated by "rasterize density", O(N·(r_e/h)³), and "relax vertices",
+/// O(t·V·particles within r_e); memory about the density grid plus 16 bytes per particle.
+/// Runs in parallel (TBB); the result does not depend on the thread count.
+/// Thread-safety: reentrant; concurrent calls on different inputs are safe.
 /// @throw ParameterError for bad parameters or non-finite positions, CancelledError when
 ///        @a interrupter asks to stop.
-SurfaceResult buildSurface(std::vector<openvdb::Vec3f> positions,
+NONBLOPPY_API SurfaceResult buildSurface(std::vector<openvdb::Vec3f> positions,
                            const SurfaceParameters& params = SurfaceParameters(),
                            openvdb::util::NullInterrupter* interrupter = nullptr);
 
 /// Run the whole pipeline on any ParticleList (see Particles.h); the caller's particles are
 /// read once through getPos() into the index's own float array, never modified.
+/// Parameters, cost, thread-safety and exceptions as for the overload above; getPos() is
+/// called concurrently from several threads.
 template<typename ParticleListT>
 SurfaceResult buildSurface(const ParticleListT& particles,
                            const SurfaceParameters& params = SurfaceParameters(),

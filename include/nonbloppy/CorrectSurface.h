@@ -13,6 +13,7 @@
 #ifndef NONBLOPPY_CORRECT_SURFACE_H
 #define NONBLOPPY_CORRECT_SURFACE_H
 
+#include <nonbloppy/Export.h>
 #include <nonbloppy/Mesh.h>
 
 #include <openvdb/openvdb.h>
@@ -33,15 +34,15 @@ namespace nonbloppy {
 /// The result depends only on r_e/s, c and t. Cost: about 10⁶ kernel evaluations (~10 ms).
 /// Thread-safety: reentrant.
 /// @throw ParameterError if @a effectiveRadiusOverSpacing ≤ 0.5, c outside [0,1] or t < 0.
-double calibrateRelaxedThreshold(double effectiveRadiusOverSpacing, double blend,
-                                 int iterations);
+NONBLOPPY_API double calibrateRelaxedThreshold(double effectiveRadiusOverSpacing, double blend,
+                                               int iterations);
 
 /// Number of triangles (quads split along the 0–2 diagonal) of @a mesh whose normal points
 /// against the normal the same triangle had with the vertex positions @a before (same
 /// polygons): the triangles relaxation folded over.
 /// Cost: O(P). Thread-safety: reentrant.
 /// @throw ParameterError if @a before and mesh.points differ in size.
-size_t countFoldedTriangles(const SurfaceMesh& mesh, const std::vector<openvdb::Vec3s>& before);
+NONBLOPPY_API size_t countFoldedTriangles(const SurfaceMesh& mesh, const std::vector<openvdb::Vec3s>& before);
 
 /// Unfold triangles folded over by relaxation: every vertex of a folded triangle (see
 /// countFoldedTriangles()) is moved halfway back to its position in @a before, and this is
@@ -51,13 +52,13 @@ size_t countFoldedTriangles(const SurfaceMesh& mesh, const std::vector<openvdb::
 /// @return the number of folded triangles found in the first round
 /// Cost: O(rounds · P). Deterministic. Normals are not updated.
 /// @throw ParameterError if @a before and mesh.points differ in size.
-size_t repairFolds(SurfaceMesh& mesh, const std::vector<openvdb::Vec3s>& before,
-                   int maxRounds = 4);
+NONBLOPPY_API size_t repairFolds(SurfaceMesh& mesh, const std::vector<openvdb::Vec3s>& before,
+                                 int maxRounds = 4);
 
 /// Move every vertex by @a distance (world units, > 0 outwards) along its unit normal, which
 /// must have been computed (computeNormals()); vertices with a zero normal stay put.
 /// @throw ParameterError if mesh.normals and mesh.points differ in size.
-void offsetSurface(SurfaceMesh& mesh, double distance);
+NONBLOPPY_API void offsetSurface(SurfaceMesh& mesh, double distance);
 
 /// Offset the surface along its normals (offsetSurface()) so that its enclosed volume becomes
 /// @a targetVolume (world units³), to first order: distance = (target − volume) / area,
@@ -70,8 +71,8 @@ void offsetSurface(SurfaceMesh& mesh, double distance);
 /// @param targetVolume volume to enclose, world units³, > 0
 /// @param maxDistance  largest distance moved in total, world units (the correction is
 ///                     clamped to ±maxDistance, so a wrong target cannot move the surface far)
-double preserveVolume(SurfaceMesh& mesh, double targetVolume,
-                      double maxDistance = std::numeric_limits<double>::infinity());
+NONBLOPPY_API double preserveVolume(SurfaceMesh& mesh, double targetVolume,
+                                    double maxDistance = std::numeric_limits<double>::infinity());
 
 } // namespace nonbloppy
 

@@ -10,20 +10,22 @@
 #ifndef NONBLOPPY_ERROR_H
 #define NONBLOPPY_ERROR_H
 
+#include <nonbloppy/Export.h>
+
 #include <stdexcept>
 #include <string>
 
 namespace nonbloppy {
 
 /// Base of every exception nonbloppy throws on purpose.
-class Error : public std::runtime_error
+class NONBLOPPY_API Error : public std::runtime_error
 {
 public:
     using std::runtime_error::runtime_error;
 };
 
 /// A file could not be opened, read, parsed or written.
-class FileError : public Error
+class NONBLOPPY_API FileError : public Error
 {
 public:
     using Error::Error;
@@ -31,14 +33,14 @@ public:
 
 /// A parameter lies outside its allowed range, or input data (e.g. NaN coordinates)
 /// make the requested computation meaningless.
-class ParameterError : public Error
+class NONBLOPPY_API ParameterError : public Error
 {
 public:
     using Error::Error;
 };
 
 /// The caller's interrupter asked to stop; no result was produced.
-class CancelledError : public Error
+class NONBLOPPY_API CancelledError : public Error
 {
 public:
     using Error::Error;

@@ -6,6 +6,8 @@
 #ifndef NONBLOPPY_ESTIMATE_PARAMETERS_H
 #define NONBLOPPY_ESTIMATE_PARAMETERS_H
 
+#include <nonbloppy/Export.h>
+
 #include <openvdb/openvdb.h>
 
 #include <optional>
@@ -18,7 +20,7 @@ namespace nonbloppy {
 /// Cost: O(N) to bucket the particles plus O(samples) neighbour searches.
 /// @throw ParameterError with fewer than two particles, or when the median is 0
 ///        (half the particles sit on top of another one).
-double estimateSpacing(const std::vector<openvdb::Vec3f>& positions, size_t maxSamples = 20000);
+NONBLOPPY_API double estimateSpacing(const std::vector<openvdb::Vec3f>& positions, size_t maxSamples = 20000);
 
 /// The iso-value r_0 for which a flat, uniform half-space of particles on a cubic lattice of
 /// spacing s has its unrelaxed (t = 0) surface s/2 outside the outer particle layer, so the
@@ -26,7 +28,7 @@ double estimateSpacing(const std::vector<openvdb::Vec3f>& positions, size_t maxS
 /// The result depends only on the ratio r_e/s. Cost: a few thousand kernel evaluations.
 /// @throw ParameterError if @a effectiveRadiusOverSpacing ≤ 0.5 (the density at s/2 outside
 ///        would be 0 and no threshold could place the surface there).
-double calibrateThreshold(double effectiveRadiusOverSpacing);
+NONBLOPPY_API double calibrateThreshold(double effectiveRadiusOverSpacing);
 
 /// Defaults of the method relative to the particle spacing s.
 constexpr double kDefaultRadiusOverSpacing = 2.0;  ///< r_e = 2 s
@@ -89,12 +91,17 @@ struct SurfaceParameters
 /// Every parameter's value as used, and whether the user gave it.
 struct ResolvedParameters
 {
-    double spacing = 0, effectiveRadius = 0, threshold = 0, voxelSize = 0;
-    double blend = kDefaultBlend;
-    int iterations = kDefaultIterations;
-    double adaptivity = kDefaultAdaptivity;
-    bool spacingGiven = false, effectiveRadiusGiven = false, thresholdGiven = false,
-         voxelSizeGiven = false;
+    double spacing = 0;                     ///< s, world units
+    double effectiveRadius = 0;             ///< r_e, world units
+    double threshold = 0;                   ///< r_0, dimensionless
+    double voxelSize = 0;                   ///< h, world units
+    double blend = kDefaultBlend;           ///< c in [0,1]
+    int iterations = kDefaultIterations;    ///< t ≥ 0
+    double adaptivity = kDefaultAdaptivity; ///< in [0,1]
+    bool spacingGiven = false;              ///< s came from SurfaceParameters, not estimated
+    bool effectiveRadiusGiven = false;      ///< r_e came from SurfaceParameters
+    bool thresholdGiven = false;            ///< r_0 came from SurfaceParameters
+    bool voxelSizeGiven = false;            ///< h came from SurfaceParameters
     Method method = Method::Faithful;       ///< the variant run
     double maxStep = 0.0;                   ///< cap on one relaxation step, world units; 0: none
     bool preserveVolume = false;            ///< the volume correction runs
@@ -105,7 +112,9 @@ struct ResolvedParameters
 /// must be estimated (spacing unset and effectiveRadius, threshold or voxelSize unset).
 /// @throw ParameterError naming the parameter, e.g. "--blend must lie in [0,1], got 1.5"
 ///        (parameters are named by their command-line spelling).
-ResolvedParameters resolveParameters(const SurfaceParameters& params,
+/// Cost: that of estimateSpacing() when it is needed, else O(1).
+/// Thread-safety (all functions of this header): reentrant, no shared state.
+NONBLOPPY_API ResolvedParameters resolveParameters(const SurfaceParameters& params,
                                      const std::vector<openvdb::Vec3f>& positions);
 
 } // namespace nonbloppy

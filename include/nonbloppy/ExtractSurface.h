@@ -6,6 +6,7 @@
 #ifndef NONBLOPPY_EXTRACT_SURFACE_H
 #define NONBLOPPY_EXTRACT_SURFACE_H
 
+#include <nonbloppy/Export.h>
 #include <nonbloppy/Mesh.h>
 
 #include <openvdb/openvdb.h>
@@ -15,14 +16,21 @@ namespace nonbloppy {
 /// Extract the surface φ = @a threshold from a density grid in which the inside is φ > r_0.
 /// volumeToMesh returns such surfaces clockwise seen from outside; every polygon is
 /// reversed here so that the mesh is counter-clockwise (outward normals).
+/// The grid may come from anywhere (rasterizeDensity(), a file, a caller's edit); its
+/// transform places the vertices in world space. The result has no normals.
+/// @param density     scalar grid, larger values inside the fluid (not a level set)
+/// @param threshold   iso-value r_0, in the grid's value units
 /// @param adaptivity  volumeToMesh's adaptivity in [0,1]: 0 keeps every polygon, larger
 ///                    values merge polygons in flat regions.
-/// Cost: O(active voxels), parallel inside OpenVDB; deterministic.
+/// Cost: O(active voxels), parallel inside OpenVDB; deterministic. Not interruptible
+/// (volumeToMesh takes no interrupter): see buildSurface() for the checks around it.
+/// Thread-safety: reentrant; the grid is only read.
 /// @throw ParameterError if adaptivity lies outside [0,1] or threshold is not finite.
-SurfaceMesh extractSurface(const openvdb::FloatGrid& density, double threshold,
+NONBLOPPY_API SurfaceMesh extractSurface(const openvdb::FloatGrid& density, double threshold,
                            double adaptivity = 0.0);
-/// The same for a double-precision density a caller computed or edited.
-SurfaceMesh extractSurface(const openvdb::DoubleGrid& density, double threshold,
+/// The same for a double-precision density a caller computed or edited; parameters, cost,
+/// exceptions and thread-safety as above.
+NONBLOPPY_API SurfaceMesh extractSurface(const openvdb::DoubleGrid& density, double threshold,
                            double adaptivity = 0.0);
 
 /// Replace every leaf of @a density that lies deep inside the fluid by an active tile holding
@@ -31,7 +39,8 @@ SurfaceMesh extractSurface(const openvdb::DoubleGrid& density, double threshold,
 /// a corner in it, so extractSurface() returns the very same mesh from the tiled grid while
 /// scanning, and storing, fewer voxels. The grid's values inside are no longer exact.
 /// Cost: O(leaves · 512) to find leaf minima, parallel. Returns the number of leaves replaced.
-size_t tileDeepInterior(openvdb::FloatGrid& density, double threshold);
+/// Thread-safety: not for the same grid concurrently (it is modified).
+NONBLOPPY_API size_t tileDeepInterior(openvdb::FloatGrid& density, double threshold);
 
 } // namespace nonbloppy
 

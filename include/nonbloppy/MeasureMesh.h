@@ -5,6 +5,7 @@
 #ifndef NONBLOPPY_MEASURE_MESH_H
 #define NONBLOPPY_MEASURE_MESH_H
 
+#include <nonbloppy/Export.h>
 #include <nonbloppy/Mesh.h>
 
 #include <cstddef>
@@ -14,7 +15,7 @@ namespace nonbloppy {
 /// What measureMesh() finds.
 struct MeshMeasures
 {
-    size_t vertices = 0;
+    size_t vertices = 0;          ///< mesh.points.size()
     size_t polygons = 0;          ///< triangles + quads
     size_t unusedVertices = 0;    ///< vertices no polygon references
     size_t boundaryEdges = 0;     ///< edges with one adjacent polygon
@@ -33,8 +34,9 @@ struct MeshMeasures
 /// vertex to itself, from degenerate polygons, are not counted). Edge checks only: two
 /// surfaces touching at a single vertex are not detected as non-manifold.
 /// Cost: O(P log P) for P polygons (edge sort), memory O(P).
+/// Thread-safety: reentrant; the mesh is only read.
 /// @throw ParameterError if a polygon references a vertex index out of range.
-MeshMeasures measureMesh(const SurfaceMesh& mesh);
+NONBLOPPY_API MeshMeasures measureMesh(const SurfaceMesh& mesh);
 
 } // namespace nonbloppy
 

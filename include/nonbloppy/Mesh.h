@@ -22,6 +22,7 @@ struct SurfaceMesh
     std::vector<openvdb::Vec3I> triangles;  ///< vertex indices, counter-clockwise from outside
     std::vector<openvdb::Vec4I> quads;      ///< vertex indices, counter-clockwise from outside
 
+    /// Number of polygons, triangles plus quads.
     size_t polygonCount() const { return triangles.size() + quads.size(); }
     /// Number of triangles after splitting every quad in two.
     size_t triangleCount() const { return triangles.size() + 2 * quads.size(); }

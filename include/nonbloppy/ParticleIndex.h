@@ -11,6 +11,7 @@
 #ifndef NONBLOPPY_PARTICLE_INDEX_H
 #define NONBLOPPY_PARTICLE_INDEX_H
 
+#include <nonbloppy/Export.h>
 #include <nonbloppy/Error.h>
 #include <nonbloppy/Particles.h>
 
@@ -28,14 +29,17 @@ namespace nonbloppy {
 /// Particles bucketed into cubic cells of a PointIndexGrid.
 /// Memory: 16 bytes per particle (float position + uint32 original index) plus the grid.
 /// Thread-safe for concurrent reading once built.
-class ParticleIndex
+class NONBLOPPY_API ParticleIndex
 {
 public:
-    using PosType = openvdb::Vec3R;
+    using PosType = openvdb::Vec3R;  ///< position type of the PointArray concept
 
+    /// An empty index (no particles, no grid); assign the result of build() to it.
     ParticleIndex();
     ~ParticleIndex();
+    /// Move: the source is left empty-handed and must only be assigned to or destroyed.
     ParticleIndex(ParticleIndex&&) noexcept;
+    /// Move assignment; see the move constructor.
     ParticleIndex& operator=(ParticleIndex&&) noexcept;
 
     /// Bucket @a positions (world units, taken over and reordered) into cells of
@@ -59,6 +63,7 @@ public:
 
     /// Internal representation (src/ParticleIndexImpl.h); the stages iterate it directly.
     struct Impl;
+    /// The internal representation; only nonbloppy's own sources can use it.
     const Impl& impl() const { return *mImpl; }
 
 private:

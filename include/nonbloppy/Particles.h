@@ -19,6 +19,8 @@
 #ifndef NONBLOPPY_PARTICLES_H
 #define NONBLOPPY_PARTICLES_H
 
+#include <nonbloppy/Export.h>
+
 #include <openvdb/openvdb.h>
 
 #include <cstddef>
@@ -35,7 +37,7 @@ template<typename ScalarT>
 class PositionArrayView
 {
 public:
-    using PosType = openvdb::Vec3R;
+    using PosType = openvdb::Vec3R;  ///< position type of the ParticleList concept
 
     /// @param data    first coordinate of particle 0
     /// @param count   number of particles
@@ -43,7 +45,9 @@ public:
     PositionArrayView(const ScalarT* data, size_t count, size_t stride = 3)
         : mData(data), mCount(count), mStride(stride) {}
 
+    /// Number of particles.
     size_t size() const { return mCount; }
+    /// Position of particle @a n (world units), converted to double.
     void getPos(size_t n, openvdb::Vec3R& xyz) const
     {
         const ScalarT* p = mData + n * mStride;
@@ -60,16 +64,16 @@ private:
 enum class ScalarType { Int8, UInt8, Int16, UInt16, Int32, UInt32, Int64, UInt64, Float32, Float64 };
 
 /// Size in bytes of one component of @a type.
-size_t scalarSize(ScalarType type);
+NONBLOPPY_API size_t scalarSize(ScalarType type);
 /// Lower-case name of @a type ("float32", "int64", ...), as used by `nonbloppy inspect`.
-const char* scalarTypeName(ScalarType type);
+NONBLOPPY_API const char* scalarTypeName(ScalarType type);
 
 /// One named per-particle attribute (e.g. "velocity", 3 × Float32), stored in its own
 /// type so nothing is lost on the way from reader to writer.
-struct ParticleAttribute
+struct NONBLOPPY_API ParticleAttribute
 {
-    std::string name;
-    ScalarType type = ScalarType::Float32;
+    std::string name;                    ///< as in the file, e.g. "velocity"
+    ScalarType type = ScalarType::Float32;  ///< stored type of each component
     int components = 1;                  ///< 1 for scalars, 3 for vectors, ...
     std::vector<unsigned char> bytes;    ///< native-endian values, particle-major
 
@@ -81,14 +85,16 @@ struct ParticleAttribute
 
 /// Particles read from a file: positions plus every named per-particle attribute.
 /// Models the ParticleList concept, so it can be passed to every stage directly.
-struct ParticleSet
+struct NONBLOPPY_API ParticleSet
 {
-    using PosType = openvdb::Vec3R;
+    using PosType = openvdb::Vec3R;  ///< position type of the ParticleList concept
 
     std::vector<openvdb::Vec3f> positions;      ///< world units
     std::vector<ParticleAttribute> attributes;  ///< each holds positions.size() values
 
+    /// Number of particles.
     size_t size() const { return positions.size(); }
+    /// Position of particle @a n, world units.
     void getPos(size_t n, openvdb::Vec3R& xyz) const { xyz = positions[n]; }
 
     /// The attribute called @a name, or nullptr.

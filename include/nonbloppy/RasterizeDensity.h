@@ -5,6 +5,7 @@
 #ifndef NONBLOPPY_RASTERIZE_DENSITY_H
 #define NONBLOPPY_RASTERIZE_DENSITY_H
 
+#include <nonbloppy/Export.h>
 #include <nonbloppy/ParticleIndex.h>
 
 #include <openvdb/openvdb.h>
@@ -30,8 +31,13 @@ struct DensitySettings
 /// active. Each leaf is filled by one task from the particles whose support overlaps it,
 /// visited in a fixed order, so values are bit-identical for any thread count.
 /// Cost: O(N·(r_e/h)³) kernel evaluations; memory: the grid (≈ 4.5 bytes per active voxel).
+/// @param particles    the particle index (its cell size does not affect the result)
+/// @param settings     r_e and h in world units, or a caller's transform
+/// @param interrupter  optional; start("rasterize density"), then wasInterrupted(percent)
+///                     once per finished leaf task, end()
+/// Thread-safety: reentrant; the index is only read.
 /// @throw ParameterError if r_e ≤ 0 or h ≤ 0; CancelledError if @a interrupter says so.
-openvdb::FloatGrid::Ptr rasterizeDensity(const ParticleIndex& particles,
+NONBLOPPY_API openvdb::FloatGrid::Ptr rasterizeDensity(const ParticleIndex& particles,
                                          const DensitySettings& settings,
                                          openvdb::util::NullInterrupter* interrupter = nullptr);
 

@@ -6,6 +6,7 @@
 #ifndef NONBLOPPY_READ_MESH_H
 #define NONBLOPPY_READ_MESH_H
 
+#include <nonbloppy/Export.h>
 #include <nonbloppy/Mesh.h>
 
 #include <string>
@@ -19,7 +20,8 @@ namespace nonbloppy {
 /// (relative) indices.
 /// @throw FileError for a missing, truncated or corrupt file, an unknown extension, a
 ///        polygon with fewer than three vertices or a vertex index out of range.
-SurfaceMesh readMesh(const std::string& path);
+/// Cost: one pass over the file. Thread-safety: reentrant, no shared state.
+NONBLOPPY_API SurfaceMesh readMesh(const std::string& path);
 
 } // namespace nonbloppy
 

@@ -38,6 +38,7 @@
 #ifndef NONBLOPPY_READ_PARTICLES_H
 #define NONBLOPPY_READ_PARTICLES_H
 
+#include <nonbloppy/Export.h>
 #include <nonbloppy/Particles.h>
 
 #include <string>
@@ -52,10 +53,10 @@ namespace nonbloppy {
 /// @throw ParameterError  for NaN or infinite coordinates, or doubles too large for float:
 ///                   "non-finite position of particle 17 (x.vtk)".
 /// Thread-safe: yes (no shared state).
-ParticleSet readParticles(const std::string& path);
+NONBLOPPY_API ParticleSet readParticles(const std::string& path);
 
 /// True if @a path has an extension readParticles() understands.
-bool isParticleFile(const std::string& path);
+NONBLOPPY_API bool isParticleFile(const std::string& path);
 
 } // namespace nonbloppy
 

@@ -6,6 +6,7 @@
 #ifndef NONBLOPPY_RELAX_VERTICES_H
 #define NONBLOPPY_RELAX_VERTICES_H
 
+#include <nonbloppy/Export.h>
 #include <nonbloppy/Mesh.h>
 #include <nonbloppy/ParticleIndex.h>
 
@@ -30,9 +31,16 @@ struct RelaxSettings
 /// Each iteration reads only the previous iteration's positions, so the result does not
 /// depend on thread count or order. A vertex with no particle within r_e stays put.
 /// Normals are not updated (call computeNormals() afterwards).
-/// Cost: t · V · (particles within r_e) kernel evaluations, parallel over vertices.
+/// Cost: t · V · (particles within r_e) kernel evaluations, parallel over vertices;
+/// scratch memory about 24 bytes per vertex.
+/// @param mesh         vertices moved in place (world units); polygons untouched
+/// @param particles    index of the particles to relax against (any frame's, any mesh's)
+/// @param settings     r_e (world units), c, t
+/// @param interrupter  optional; start("relax vertices"), wasInterrupted() once per task
+///                     of 64 vertex groups and wasInterrupted(percent) after each iteration
+/// Thread-safety: reentrant; the index is only read, the mesh is written.
 /// @throw ParameterError for r_e ≤ 0, c outside [0,1], t < 0 or maxStep < 0; CancelledError on interrupt.
-void relaxVertices(SurfaceMesh& mesh, const ParticleIndex& particles,
+NONBLOPPY_API void relaxVertices(SurfaceMesh& mesh, const ParticleIndex& particles,
                    const RelaxSettings& settings,
                    openvdb::util::NullInterrupter* interrupter = nullptr);
 

@@ -15,8 +15,13 @@ namespace nonbloppy {
 /// Seconds spent in each stage, in the order the stages ran.
 struct StageTimings
 {
-    struct Entry { std::string stage; double seconds = 0.0; };
-    std::vector<Entry> entries;
+    /// One stage's accumulated time.
+    struct Entry
+    {
+        std::string stage;     ///< stage name, e.g. "rasterize density"
+        double seconds = 0.0;  ///< wall-clock seconds
+    };
+    std::vector<Entry> entries;  ///< in the order the stages first ran
 
     /// Add @a seconds to @a stage (appended the first time it is seen).
     void add(const std::string& stage, double seconds)
@@ -26,6 +31,7 @@ struct StageTimings
         }
         entries.push_back({stage, seconds});
     }
+    /// Sum of all entries, seconds.
     double total() const
     {
         double sum = 0.0;
@@ -38,6 +44,7 @@ struct StageTimings
 class ScopedStageTimer
 {
 public:
+    /// Start timing @a stage; the time is added to @a timings on destruction.
     ScopedStageTimer(StageTimings& timings, std::string stage)
         : mTimings(timings), mStage(std::move(stage)), mStart(std::chrono::steady_clock::now()) {}
     ~ScopedStageTimer()

@@ -5,16 +5,22 @@
 #ifndef NONBLOPPY_VERSION_H
 #define NONBLOPPY_VERSION_H
 
+#include <nonbloppy/Export.h>
+
+/// Major version of the headers (incompatible API changes).
 #define NONBLOPPY_VERSION_MAJOR 0
+/// Minor version of the headers (additions; ABI may change while MAJOR is 0).
 #define NONBLOPPY_VERSION_MINOR 1
+/// Patch version of the headers (fixes).
 #define NONBLOPPY_VERSION_PATCH 0
+/// "MAJOR.MINOR.PATCH"; equals the CMake project version (checked by the test suite).
 #define NONBLOPPY_VERSION_STRING "0.1.0"
 
 namespace nonbloppy {
 
 /// The version of the library actually linked, "MAJOR.MINOR.PATCH"; compare with
 /// NONBLOPPY_VERSION_STRING to detect a header/library mismatch.
-const char* version();
+NONBLOPPY_API const char* version();
 
 } // namespace nonbloppy
 

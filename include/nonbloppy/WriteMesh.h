@@ -5,6 +5,7 @@
 #ifndef NONBLOPPY_WRITE_MESH_H
 #define NONBLOPPY_WRITE_MESH_H
 
+#include <nonbloppy/Export.h>
 #include <nonbloppy/Mesh.h>
 
 #include <string>
@@ -28,15 +29,16 @@ struct MeshWriteSettings
 /// text that reads back as the same float (std::to_chars), and nothing depends on time.
 /// Normals are written only when mesh.normals is non-empty.
 /// Cost: one pass; output is formatted into multi-megabyte chunks.
+/// Thread-safety: reentrant; concurrent calls must write different paths.
 /// @throw FileError for an unknown extension or a file that cannot be written, e.g.
 ///        "cannot write out/mesh.obj: No such file or directory"; nothing is left behind.
 /// @throw ParameterError if a polygon references a vertex that does not exist, or
 ///        mesh.normals is non-empty but not one per vertex.
-void writeMesh(const SurfaceMesh& mesh, const std::string& path,
+NONBLOPPY_API void writeMesh(const SurfaceMesh& mesh, const std::string& path,
                const MeshWriteSettings& settings = MeshWriteSettings());
 
 /// True if @a path has an extension writeMesh() understands.
-bool isMeshFile(const std::string& path);
+NONBLOPPY_API bool isMeshFile(const std::string& path);
 
 } // namespace nonbloppy
 

@@ -6,6 +6,8 @@
 #ifndef NONBLOPPY_WRITE_VDB_H
 #define NONBLOPPY_WRITE_VDB_H
 
+#include <nonbloppy/Export.h>
+
 #include <openvdb/openvdb.h>
 
 #include <string>
@@ -15,8 +17,10 @@ namespace nonbloppy {
 /// Write @a grids to @a path (temporary file, then rename), with @a fileMetadata as the
 /// file's metadata. Grids keep their own metadata (names, class, nonbloppy parameters).
 /// Written without compression timestamps, so the same grids give the same bytes.
+/// Cost: one pass over the grids' voxels (hashed for the file UUID, then written).
+/// Thread-safety: reentrant; concurrent calls must write different paths.
 /// @throw FileError naming @a path when it cannot be written.
-void writeVdb(const openvdb::GridCPtrVec& grids, const std::string& path,
+NONBLOPPY_API void writeVdb(const openvdb::GridCPtrVec& grids, const std::string& path,
               const openvdb::MetaMap& fileMetadata = openvdb::MetaMap());
 
 } // namespace nonbloppy

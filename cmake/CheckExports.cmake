@@ -1,0 +1,32 @@
+# ctest: the shared library's dynamic symbol table holds only the nonbloppy:: public API
+# (functions, classes' members, their vtables and typeinfo) — no OpenVDB, TBB or std
+# template instantiations and no internals.   cmake -DLIBRARY=<libnonbloppy.so> -P CheckExports.cmake
+execute_process(COMMAND nm -D --defined-only --demangle "${LIBRARY}"
+                OUTPUT_VARIABLE out RESULT_VARIABLE rc)
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "nm failed on ${LIBRARY}")
+endif()
+string(REPLACE "\n" ";" lines "${out}")
+set(bad "")
+set(count 0)
+foreach(line IN LISTS lines)
+  if(line STREQUAL "")
+    continue()
+  endif()
+  # "<address> <type> <name>"
+  string(REGEX REPLACE "^[0-9a-fA-F]+ . " "" name "${line}")
+  math(EXPR count "${count} + 1")
+  if(name MATCHES "^(_init|_fini|_edata|_end|__bss_start)$")
+    continue()
+  endif()
+  string(REGEX REPLACE "^(typeinfo for |typeinfo name for |vtable for |VTT for |non-virtual thunk to |guard variable for )" "" name "${name}")
+  if(NOT name MATCHES "^nonbloppy::" OR name MATCHES "^nonbloppy::[A-Za-z_]*internal")
+    list(APPEND bad "${line}")
+  endif()
+endforeach()
+list(LENGTH bad nbad)
+message(STATUS "${count} exported symbols, ${nbad} outside the public API")
+if(nbad GREATER 0)
+  string(REPLACE ";" "\n  " badtext "${bad}")
+  message(FATAL_ERROR "symbols exported outside nonbloppy::\n  ${badtext}")
+endif()
