@@ -180,6 +180,8 @@ struct MeshOptions
     double blend = nonbloppy::kDefaultBlend;
     int iterations = nonbloppy::kDefaultIterations;
     double adaptivity = nonbloppy::kDefaultAdaptivity;
+    std::string method = "faithful";  ///< --method: faithful (default) or paper
+    CLI::Option* methodOpt = nullptr;
     int threads = 0;
     bool quads = false, quiet = false, verbose = false;
     // Frame sequences (FrameSequence.h, BatchRun.h).
@@ -341,6 +343,7 @@ void printSummary(const MeshOptions& o, const nonbloppy::SurfaceResult& result,
     row("iterations t", std::to_string(p.iterations),
         origin(o.iterationsOpt->count() > 0, "(default)"));
     row("adaptivity", formatNumber(p.adaptivity), origin(o.adaptivityOpt->count() > 0, "(default)"));
+    row("method", o.method, origin(o.methodOpt->count() > 0, "(default)"));
     row("threads", std::to_string(threads), origin(o.threadsOpt->count() > 0, "(default)"));
 
     out << "result\n";
@@ -427,6 +430,7 @@ FrameOutcome meshFrame(const MeshOptions& o, ProgressInterrupter& interrupter)
     params.blend = o.blend;
     params.iterations = o.iterations;
     params.adaptivity = o.adaptivity;
+    params.method = o.method == "paper" ? nonbloppy::Method::Paper : nonbloppy::Method::Faithful;
     // Without --vdb nothing needs the grid: the library then turns the fluid's deep interior
     // into tiles before extraction (the same mesh, bit for bit) and frees the grid before
     // relaxing, which lowers the peak memory of large frames.
@@ -653,6 +657,10 @@ Command setupMeshCommand(CLI::App& parent)
         "Relaxation blend c in [0,1] (default: 0.3)")->group(kGroupNumerical);
     o.iterationsOpt = cmd->add_option("-t,--iterations", o.iterations,
         "Relaxation iterations t >= 0 (default: 2)")->group(kGroupNumerical);
+    o.methodOpt = cmd->add_option("--method", o.method,
+        "faithful (default): r_0 calibrated for the relaxed surface, steps capped at s/2, folds "
+        "repaired, volume N*s^3 kept when --spacing is given; paper: the paper's plain method")
+        ->check(CLI::IsMember({"faithful", "paper"}))->group(kGroupNumerical);
 
     o.adaptivityOpt = cmd->add_option("--adaptivity", o.adaptivity,
         "Polygon merging in flat regions, in [0,1] (default: 0)")->group(kGroupAdvanced);
