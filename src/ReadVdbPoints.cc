@@ -14,9 +14,13 @@
 
 #include <nonbloppy/Error.h>
 
+// OpenVDB's point templates must keep default visibility, as src/VisibilityPrelude.h
+// explains for the grid types it covers (else openvdb::initialize() crashes).
+#pragma GCC visibility push(default)
 #include <openvdb/io/Stream.h>
 #include <openvdb/openvdb.h>
 #include <openvdb/points/PointDataGrid.h>
+#pragma GCC visibility pop
 
 #include <algorithm>
 #include <cstring>

@@ -133,6 +133,15 @@ validateMesh(const SurfaceMesh& mesh, const std::string& path)
         throw ParameterError("mesh has " + std::to_string(mesh.normals.size()) +
             " normals for " + std::to_string(vertexCount) + " vertices (" + path + ")");
     }
+    for (const MeshAttribute& attribute : mesh.attributes) {
+        if (attribute.components < 1
+            || attribute.values.size() != vertexCount * size_t(attribute.components)) {
+            throw ParameterError("mesh attribute '" + attribute.name + "' has " +
+                std::to_string(attribute.values.size()) + " values for " +
+                std::to_string(vertexCount) + " vertices of " +
+                std::to_string(attribute.components) + " components (" + path + ")");
+        }
+    }
     auto check = [&](size_t polygon, uint32_t index) {
         if (index >= vertexCount) {
             throw ParameterError("polygon " + std::to_string(polygon) + " references vertex " +
@@ -194,6 +203,28 @@ writeObj(const SurfaceMesh& mesh, const PolygonView& polygons, std::ostream& os)
     out.flush();
 }
 
+/// An attribute name as one header word: whitespace and non-printable bytes become '_'.
+std::string
+headerName(const std::string& name)
+{
+    std::string word = name.empty() ? std::string("attribute") : name;
+    for (char& ch : word) {
+        if (static_cast<unsigned char>(ch) <= ' ' || static_cast<unsigned char>(ch) >= 0x7f) ch = '_';
+    }
+    return word;
+}
+
+/// PLY property names of component @a c of @a attribute: "velocity_x" for 3-vectors,
+/// "density" for scalars, "name_<c>" otherwise.
+std::string
+plyPropertyName(const MeshAttribute& attribute, int c)
+{
+    const std::string base = headerName(attribute.name);
+    if (attribute.components == 1) return base;
+    if (attribute.components == 3) return base + "_" + "xyz"[c];
+    return base + "_" + std::to_string(c);
+}
+
 void
 requireInt32(size_t value, const char* what, const std::string& path)
 {
@@ -213,12 +244,21 @@ writePly(const SurfaceMesh& mesh, const PolygonView& polygons, const std::string
     out.text("element vertex " + std::to_string(mesh.points.size()) + "\n");
     out.text("property float x\nproperty float y\nproperty float z\n");
     if (withNormals) out.text("property float nx\nproperty float ny\nproperty float nz\n");
+    for (const MeshAttribute& attribute : mesh.attributes) {
+        for (int c = 0; c < attribute.components; ++c) {
+            out.text("property float " + plyPropertyName(attribute, c) + "\n");
+        }
+    }
     out.text("element face " + std::to_string(polygons.polygonCount()) + "\n");
     out.text("property list uchar int vertex_indices\nend_header\n");
     for (size_t i = 0; i < mesh.points.size(); ++i) {
         for (int axis = 0; axis < 3; ++axis) out.littleEndian(float(mesh.points[i][axis]));
         if (withNormals) {
             for (int axis = 0; axis < 3; ++axis) out.littleEndian(float(mesh.normals[i][axis]));
+        }
+        for (const MeshAttribute& attribute : mesh.attributes) {
+            const float* values = attribute.values.data() + i * size_t(attribute.components);
+            for (int c = 0; c < attribute.components; ++c) out.littleEndian(values[c]);
         }
     }
     polygons.forEach([&](const uint32_t* corners, int n) {
@@ -247,12 +287,29 @@ writeVtk(const SurfaceMesh& mesh, const PolygonView& polygons, const std::string
         for (int i = 0; i < n; ++i) out.bigEndian(int32_t(corners[i]));
     });
     out.text("\n");
+    if (!mesh.normals.empty() || !mesh.attributes.empty()) {
+        out.text("POINT_DATA " + std::to_string(mesh.points.size()) + "\n");
+    }
     if (!mesh.normals.empty()) {
-        out.text("POINT_DATA " + std::to_string(mesh.points.size()) +
-            "\nNORMALS normals float\n");
+        out.text("NORMALS normals float\n");
         for (const openvdb::Vec3s& n : mesh.normals) {
             for (int axis = 0; axis < 3; ++axis) out.bigEndian(float(n[axis]));
         }
+        out.text("\n");
+    }
+    // Vectors as VECTORS, 1, 2 and 4 components as SCALARS, anything else as a FIELD array.
+    for (const MeshAttribute& attribute : mesh.attributes) {
+        const std::string name = headerName(attribute.name);
+        if (attribute.components == 3) {
+            out.text("VECTORS " + name + " float\n");
+        } else if (attribute.components <= 4) {
+            out.text("SCALARS " + name + " float " + std::to_string(attribute.components) +
+                "\nLOOKUP_TABLE default\n");
+        } else {
+            out.text("FIELD FieldData 1\n" + name + " " + std::to_string(attribute.components) +
+                " " + std::to_string(mesh.points.size()) + " float\n");
+        }
+        for (const float value : attribute.values) out.bigEndian(value);
         out.text("\n");
     }
     out.flush();

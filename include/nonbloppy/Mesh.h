@@ -7,9 +7,19 @@
 
 #include <openvdb/openvdb.h>
 
+#include <string>
 #include <vector>
 
 namespace nonbloppy {
+
+/// A per-vertex attribute carried by a mesh (e.g. "velocity" interpolated from the
+/// particles): values[i * components + c] is component c of vertex i.
+struct MeshAttribute
+{
+    std::string name;
+    int components = 1;          ///< 1 for scalars, 3 for vectors, ...
+    std::vector<float> values;   ///< points.size() × components values, vertex-major
+};
 
 /// A polygon mesh of triangles and quads sharing one vertex array, in world units.
 /// Polygons run counter-clockwise seen from outside the fluid, so the right-hand-rule
@@ -21,6 +31,7 @@ struct SurfaceMesh
     std::vector<openvdb::Vec3s> normals;    ///< unit vertex normals; empty until computeNormals()
     std::vector<openvdb::Vec3I> triangles;  ///< vertex indices, counter-clockwise from outside
     std::vector<openvdb::Vec4I> quads;      ///< vertex indices, counter-clockwise from outside
+    std::vector<MeshAttribute> attributes;  ///< per-vertex values; see interpolateAttributes()
 
     /// Number of polygons, triangles plus quads.
     size_t polygonCount() const { return triangles.size() + quads.size(); }

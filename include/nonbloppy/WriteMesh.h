@@ -28,6 +28,10 @@ struct MeshWriteSettings
 /// Output is byte-identical for identical meshes: OBJ coordinates use the shortest decimal
 /// text that reads back as the same float (std::to_chars), and nothing depends on time.
 /// Normals are written only when mesh.normals is non-empty.
+/// Per-vertex attributes (mesh.attributes, see interpolateAttributes()) are written as PLY
+/// float vertex properties ("density"; a 3-vector "velocity" as velocity_x, velocity_y,
+/// velocity_z) and as VTK POINT_DATA (VECTORS for 3 components, SCALARS for 1, 2 or 4, a
+/// FIELD array otherwise). OBJ has no place for them: they are left out.
 /// Cost: one pass; output is formatted into multi-megabyte chunks.
 /// Thread-safety: reentrant; concurrent calls must write different paths.
 /// @throw FileError for an unknown extension or a file that cannot be written, e.g.

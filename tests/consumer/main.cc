@@ -46,6 +46,7 @@ int main()
     params.threshold = r0;
     params.voxelSize = h;
     params.iterations = 0;  // relaxation would shrink the sphere by (1 − c)^t
+    params.method = nonbloppy::Method::Paper;  // the plain method: no volume correction
     const nonbloppy::SurfaceResult result = nonbloppy::buildSurface(one, params);
 
     const double expected = re / (1.0 + r0);

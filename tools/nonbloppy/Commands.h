@@ -39,6 +39,8 @@ struct Command
 Command setupMeshCommand(CLI::App& parent);
 /// Declare `nonbloppy inspect` on @a parent.
 Command setupInspectCommand(CLI::App& parent);
+/// Declare `nonbloppy convert` on @a parent.
+Command setupConvertCommand(CLI::App& parent);
 
 /// "nonbloppy 0.1.0 (OpenVDB 10.0.1)".
 std::string versionLine();

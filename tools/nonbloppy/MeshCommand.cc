@@ -4,6 +4,7 @@
 ///        on request, the density grid; print a one-screen summary.
 
 #include "Commands.h"
+#include "MeshOutputs.h"
 
 #include "BatchRun.h"
 #include "FrameSequence.h"
@@ -184,6 +185,7 @@ struct MeshOptions
     CLI::Option* methodOpt = nullptr;
     int threads = 0;
     bool quads = false, quiet = false, verbose = false;
+    MeshOutputOptions outputs;  ///< --attributes, --vdb-surface, --vdb-points (MeshOutputs.h)
     // Frame sequences (FrameSequence.h, BatchRun.h).
     std::string frames, logPath;
     int frameJobs = 1;
@@ -436,12 +438,19 @@ FrameOutcome meshFrame(const MeshOptions& o, ProgressInterrupter& interrupter)
     // relaxing, which lowers the peak memory of large frames.
     params.keepDensity = !o.vdbPath.empty();
 
-    // The particles are handed over; their attributes are not needed for meshing.
+    // The particles are handed over, unless --attributes or --vdb-points still need them.
+    const bool keepParticles = o.outputs.needParticles();
     FrameOutcome outcome;
-    outcome.result = nonbloppy::buildSurface(std::move(particles.positions), params, &interrupter);
+    outcome.result = nonbloppy::buildSurface(
+        keepParticles ? std::vector<openvdb::Vec3f>(particles.positions) : std::move(particles.positions),
+        params, &interrupter);
     nonbloppy::SurfaceResult& result = outcome.result;
-    particles = nonbloppy::ParticleSet();
+    if (!keepParticles) particles = nonbloppy::ParticleSet();
     throwIfInterrupted();
+    if (!o.outputs.attributes.empty()) {
+        nonbloppy::ScopedStageTimer timer(after, "interpolate attributes");
+        addSurfaceAttributes(result, particles, o.outputs, o.output, &interrupter);
+    }
 
     {
         StageScope stage(interrupter, after, "write mesh");
@@ -458,7 +467,9 @@ FrameOutcome meshFrame(const MeshOptions& o, ProgressInterrupter& interrupter)
         result.density->insertMeta("source_file", openvdb::StringMetadata(o.input));
         openvdb::MetaMap fileMetadata;
         fileMetadata.insertMeta("creator", openvdb::StringMetadata(versionLine()));
-        nonbloppy::writeVdb({result.density}, o.vdbPath, fileMetadata);
+        openvdb::GridCPtrVec grids{result.density};
+        appendVdbGrids(grids, result, particles, o.outputs);
+        nonbloppy::writeVdb(grids, o.vdbPath, fileMetadata);
         cleanup.add(o.vdbPath);
     }
     throwIfInterrupted();
@@ -672,6 +683,7 @@ Command setupMeshCommand(CLI::App& parent)
     o.vdbOpt = cmd->add_option("--vdb", o.vdbPath,
         "Also write the density grid to this .vdb file (vdb_print reads it)")
         ->group(kGroupDebug);
+    addMeshOutputOptions(cmd, o.outputs, o.vdbOpt);
     // Frame sequences: IN and the outputs are patterns such as fluid_{}.vtk.
     constexpr const char* kGroupSequence = "Frame sequences";
     o.framesOpt = cmd->add_option("--frames", o.frames,

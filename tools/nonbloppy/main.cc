@@ -4,6 +4,7 @@
 ///
 ///     nonbloppy mesh IN -o OUT [options]   particles → mesh (and density .vdb)
 ///     nonbloppy inspect FILE [--json]      what a particle, mesh or .vdb file holds
+///     nonbloppy convert IN OUT             particles from one format to another
 ///     nonbloppy help [COMMAND]             the options of a command
 ///
 /// Every error is one line "nonbloppy: <message>" on stderr; exit codes are 0 (success),
@@ -67,10 +68,11 @@ int run(int argc, char** argv)
     std::vector<Command> commands;
     commands.push_back(setupMeshCommand(app));
     commands.push_back(setupInspectCommand(app));
+    commands.push_back(setupConvertCommand(app));
 
     std::string helpTopic;
     CLI::App* help = app.add_subcommand("help", "Print the options of COMMAND, or this list");
-    help->add_option("COMMAND", helpTopic, "mesh or inspect");
+    help->add_option("COMMAND", helpTopic, "mesh, inspect or convert");
     commands.push_back({help, [&]() {
         if (helpTopic.empty()) {
             std::cout << app.help();
@@ -82,7 +84,7 @@ int run(int argc, char** argv)
                 return 0;
             }
         }
-        return fail("unknown command '" + helpTopic + "'; commands are mesh, inspect, help",
+        return fail("unknown command '" + helpTopic + "'; commands are mesh, inspect, convert, help",
                     kExitUsage);
     }});
 

@@ -1,0 +1,48 @@
+// SPDX-License-Identifier: Apache-2.0
+/// @file WriteParticles.h
+/// @brief Stage "write particles": save a ParticleSet with its attributes (for
+///        `nonbloppy convert` and `--vdb-points`), and build an OpenVDB PointDataGrid.
+
+#ifndef NONBLOPPY_WRITE_PARTICLES_H
+#define NONBLOPPY_WRITE_PARTICLES_H
+
+#include <nonbloppy/Export.h>
+#include <nonbloppy/Particles.h>
+
+#include <openvdb/openvdb.h>
+
+#include <string>
+
+namespace nonbloppy {
+
+/// Write @a particles to @a path; the format follows the extension:
+/// - `.ply`  binary little-endian; float x y z, then each attribute component as a vertex
+///           property in its type ("velocity_x/_y/_z" for 3-vectors, "name_<c>" for other
+///           multi-component attributes); 64-bit integers as double (PLY has none).
+/// - `.vtk`  legacy binary UNSTRUCTURED_GRID, float POINTS, one VTK_VERTEX cell per
+///           particle, every attribute as a FIELD array in its type.
+/// - `.vtu`  VTK XML UnstructuredGrid, raw appended data with UInt64 headers, Float32
+///           points, vertex cells, attributes in their types.
+/// - `.xyz`  raw little-endian float32 triples (attributes cannot be stored: dropped).
+/// - `.csv`  header "x,y,z,<name>" (multi-component: "<name>:0,<name>:1,...", as ParaView),
+///           shortest round-trip decimal text.
+/// - `.vdb`  one PointDataGrid named "points" (see makePointDataGrid()).
+/// Written through a temporary file renamed into place; same particles, same bytes.
+/// @throw FileError for an unknown extension or an unwritable path.
+NONBLOPPY_API void writeParticles(const ParticleSet& particles, const std::string& path);
+
+/// True if @a path has an extension writeParticles() understands.
+NONBLOPPY_API bool isParticleOutputFile(const std::string& path);
+
+/// The particles as an openvdb::points::PointDataGrid named "points": position `P`
+/// (world positions, NullCodec) and every attribute in the nearest OpenVDB type (3
+/// components become vec3s/vec3d/vec3i; unsigned integers widen to the next signed type;
+/// other component counts become one scalar attribute per component, "name_<c>").
+/// @a voxelSize ≤ 0 picks one with about 8 points per voxel (points::computeVoxelSize).
+/// Returned as GridBase so this header stays light (cast with
+/// openvdb::gridPtrCast<openvdb::points::PointDataGrid>).
+NONBLOPPY_API openvdb::GridBase::Ptr makePointDataGrid(const ParticleSet& particles, double voxelSize = 0.0);
+
+} // namespace nonbloppy
+
+#endif // NONBLOPPY_WRITE_PARTICLES_H

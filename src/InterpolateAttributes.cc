@@ -1,0 +1,179 @@
+// SPDX-License-Identifier: Apache-2.0
+/// @file InterpolateAttributes.cc
+/// @brief Kernel-weighted particle attributes at mesh vertices, through the particle index.
+
+#include "ParticleIndexImpl.h"
+
+#include <nonbloppy/Error.h>
+#include <nonbloppy/InterpolateAttributes.h>
+#include <nonbloppy/Kernel.h>
+
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <sstream>
+
+namespace nonbloppy {
+
+std::vector<std::string>
+resolveAttributeNames(const ParticleSet& particles, const std::vector<std::string>& requested)
+{
+    std::vector<std::string> names;
+    if (requested.size() == 1 && requested[0] == "all") {
+        for (const ParticleAttribute& attribute : particles.attributes) names.push_back(attribute.name);
+        return names;
+    }
+    for (const std::string& name : requested) {
+        if (!particles.findAttribute(name)) {
+            std::string have;
+            for (const ParticleAttribute& attribute : particles.attributes) {
+                have += (have.empty() ? "" : ", ") + attribute.name;
+            }
+            throw ParameterError("unknown attribute '" + name + "'; the particles have" +
+                                 (have.empty() ? " no attributes" : ": " + have));
+        }
+        if (std::find(names.begin(), names.end(), name) == names.end()) names.push_back(name);
+    }
+    return names;
+}
+
+namespace {
+
+/// One attribute's values in the index's sorted order, so the inner loop streams.
+struct SortedAttribute
+{
+    std::string name;
+    int components = 1;
+    std::vector<double> values;  ///< sorted slot × components
+};
+
+/// Fill the attribute values of a range of vertices.
+struct InterpolateOp
+{
+    const SurfaceMesh& mesh;
+    const ParticleIndex::Impl& index;
+    const std::vector<SortedAttribute>& attributes;
+    std::vector<MeshAttribute>& out;
+    int totalComponents;
+    float effectiveRadius;
+    openvdb::util::NullInterrupter* interrupter;
+    std::atomic<bool>& cancelled;
+
+    void operator()(const tbb::blocked_range<size_t>& range) const
+    {
+        if (cancelled.load(std::memory_order_relaxed)) return;
+        if (interrupter && interrupter->wasInterrupted()) {
+            cancelled = true;
+            return;
+        }
+        openvdb::tree::ValueAccessor<const particle_index_internal::IndexTree> accessor(index.grid->tree());
+        const std::vector<openvdb::Vec3f>& positions = index.sortedPositions;
+        std::vector<double> sums(static_cast<size_t>(totalComponents));
+        const double r = effectiveRadius;
+        for (size_t i = range.begin(); i < range.end(); ++i) {
+            const openvdb::Vec3f v = mesh.points[i];
+            std::fill(sums.begin(), sums.end(), 0.0);
+            double weightSum = 0.0;
+            particle_index_internal::forEachRunInBox(accessor, index.cellSize,
+                openvdb::Vec3d(v) - openvdb::Vec3d(r), openvdb::Vec3d(v) + openvdb::Vec3d(r),
+                [&](uint32_t first, uint32_t end) {
+                    for (uint32_t k = first; k < end; ++k) {
+                        const float w = mpsWeightSquared((v - positions[k]).lengthSqr(), effectiveRadius);
+                        if (w == 0.0f) continue;
+                        weightSum += w;
+                        size_t s = 0;
+                        for (const SortedAttribute& a : attributes) {
+                            const double* value = a.values.data() + size_t(k) * size_t(a.components);
+                            for (int c = 0; c < a.components; ++c) sums[s++] += double(w) * value[c];
+                        }
+                    }
+                });
+            size_t s = 0;
+            for (size_t a = 0; a < attributes.size(); ++a) {
+                float* dst = out[a].values.data() + i * size_t(attributes[a].components);
+                for (int c = 0; c < attributes[a].components; ++c, ++s) {
+                    dst[c] = weightSum > 0.0 ? float(sums[s] / weightSum) : 0.0f;
+                }
+            }
+        }
+    }
+};
+
+} // namespace
+
+void
+interpolateAttributes(SurfaceMesh& mesh, const ParticleSet& particles,
+                      const std::vector<std::string>& names, double effectiveRadius,
+                      openvdb::util::NullInterrupter* interrupter)
+{
+    if (!(effectiveRadius > 0.0) || !std::isfinite(effectiveRadius)) {
+        std::ostringstream message;
+        message << "--radius must be > 0, got " << effectiveRadius;
+        throw ParameterError(message.str());
+    }
+    const std::vector<std::string> resolved = resolveAttributeNames(particles, names);
+    if (resolved.empty() || mesh.points.empty()) {
+        for (const std::string& name : resolved) {
+            const ParticleAttribute* attribute = particles.findAttribute(name);
+            MeshAttribute empty;
+            empty.name = name;
+            empty.components = attribute->components;
+            empty.values.assign(mesh.points.size() * size_t(attribute->components), 0.0f);
+            mesh.attributes.push_back(std::move(empty));
+        }
+        return;
+    }
+    if (interrupter) interrupter->start("interpolate attributes");
+
+    // The index sorts the particles into cells of r_e: a vertex's support spans 3³ cells.
+    const ParticleIndex particleIndex = ParticleIndex::build(particles.positions, effectiveRadius);
+    const ParticleIndex::Impl& index = particleIndex.impl();
+    std::vector<SortedAttribute> sorted(resolved.size());
+    int totalComponents = 0;
+    for (size_t a = 0; a < resolved.size(); ++a) {
+        const ParticleAttribute& attribute = *particles.findAttribute(resolved[a]);
+        if (attribute.size() != particles.size()) {
+            throw ParameterError("attribute '" + attribute.name + "' has " +
+                                 std::to_string(attribute.size()) + " values for " +
+                                 std::to_string(particles.size()) + " particles");
+        }
+        sorted[a].name = attribute.name;
+        sorted[a].components = attribute.components;
+        sorted[a].values.resize(particles.size() * size_t(attribute.components));
+        totalComponents += attribute.components;
+        const std::vector<uint32_t>& original = index.originalIndex;
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, original.size()),
+            [&](const tbb::blocked_range<size_t>& range) {
+                for (size_t k = range.begin(); k < range.end(); ++k) {
+                    for (int c = 0; c < attribute.components; ++c) {
+                        sorted[a].values[k * size_t(attribute.components) + size_t(c)] =
+                            attribute.asDouble(original[k], c);
+                    }
+                }
+            });
+    }
+
+    std::vector<MeshAttribute> out(sorted.size());
+    for (size_t a = 0; a < sorted.size(); ++a) {
+        out[a].name = sorted[a].name;
+        out[a].components = sorted[a].components;
+        out[a].values.resize(mesh.points.size() * size_t(sorted[a].components));
+    }
+    std::atomic<bool> cancelled{false};
+    const InterpolateOp op{mesh, index, sorted, out, totalComponents, float(effectiveRadius),
+                           interrupter, cancelled};
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, mesh.points.size(), 256), op);
+    if (interrupter) interrupter->end();
+    if (cancelled) throw CancelledError("interrupted while interpolating attributes");
+
+    for (MeshAttribute& attribute : out) {
+        auto same = std::find_if(mesh.attributes.begin(), mesh.attributes.end(),
+                                 [&](const MeshAttribute& m) { return m.name == attribute.name; });
+        if (same != mesh.attributes.end()) *same = std::move(attribute);
+        else mesh.attributes.push_back(std::move(attribute));
+    }
+}
+
+} // namespace nonbloppy

@@ -1,0 +1,48 @@
+// SPDX-License-Identifier: Apache-2.0
+/// @file MeshToLevelSet.cc
+/// @brief The surface mesh as a narrow-band level set, via tools::meshToLevelSet.
+
+#include <nonbloppy/Error.h>
+#include <nonbloppy/MeshToLevelSet.h>
+
+#pragma GCC visibility push(default)  // OpenVDB templates: see src/VisibilityPrelude.h
+#include <openvdb/tools/MeshToVolume.h>
+#pragma GCC visibility pop
+
+#include <cmath>
+#include <sstream>
+
+namespace nonbloppy {
+
+openvdb::FloatGrid::Ptr
+meshToLevelSet(const SurfaceMesh& mesh, double voxelSize, float halfWidth)
+{
+    if (!(voxelSize > 0.0) || !std::isfinite(voxelSize)) {
+        std::ostringstream message;
+        message << "--voxel-size must be > 0, got " << voxelSize;
+        throw ParameterError(message.str());
+    }
+    if (!(halfWidth >= 1.0f)) throw ParameterError("level set half width must be >= 1 voxel");
+    openvdb::initialize();
+    const auto transform = openvdb::math::Transform::createLinearTransform(voxelSize);
+    // meshToVolume wants index-space points.
+    std::vector<openvdb::Vec3s> indexPoints(mesh.points.size());
+    for (size_t i = 0; i < indexPoints.size(); ++i) {
+        indexPoints[i] = openvdb::Vec3s(transform->worldToIndex(openvdb::Vec3d(mesh.points[i])));
+    }
+    // Quads are split into two triangles each (the distance field does not care).
+    std::vector<openvdb::Vec3I> triangles = mesh.triangles;
+    triangles.reserve(mesh.triangles.size() + 2 * mesh.quads.size());
+    for (const openvdb::Vec4I& q : mesh.quads) {
+        triangles.emplace_back(q[0], q[1], q[2]);
+        triangles.emplace_back(q[0], q[2], q[3]);
+    }
+    openvdb::FloatGrid::Ptr grid = openvdb::tools::meshToVolume<openvdb::FloatGrid>(
+        openvdb::tools::QuadAndTriangleDataAdapter<openvdb::Vec3s, openvdb::Vec3I>(indexPoints, triangles),
+        *transform, halfWidth, halfWidth);
+    grid->setName("surface");
+    grid->setGridClass(openvdb::GRID_LEVEL_SET);
+    return grid;
+}
+
+} // namespace nonbloppy

@@ -1,0 +1,415 @@
+// SPDX-License-Identifier: Apache-2.0
+/// @file WriteParticles.cc
+/// @brief Particle writers: PLY, legacy VTK, VTU, XYZ, CSV and VDB points.
+
+#include <nonbloppy/WriteParticles.h>
+
+#include <nonbloppy/Error.h>
+#include <nonbloppy/WriteVdb.h>
+
+#include "AtomicFile.h"
+#include "FileFormats.h"
+
+// OpenVDB's point templates must keep default visibility (see src/VisibilityPrelude.h).
+#pragma GCC visibility push(default)
+#include <openvdb/points/PointConversion.h>
+#include <openvdb/points/PointDataGrid.h>
+#pragma GCC visibility pop
+
+#include <charconv>
+#include <cstring>
+#include <ostream>
+
+namespace nonbloppy {
+
+namespace {
+
+using io_internal::lowerExtension;
+
+/// An attribute name as one header word.
+std::string
+headerWord(const std::string& name)
+{
+    std::string word = name.empty() ? std::string("attribute") : name;
+    for (char& ch : word) {
+        if (static_cast<unsigned char>(ch) <= ' ' || static_cast<unsigned char>(ch) >= 0x7f
+            || ch == ',' || ch == '"' || ch == '<' || ch == '>' || ch == '&') {
+            ch = '_';
+        }
+    }
+    return word;
+}
+
+void
+requireSizes(const ParticleSet& particles, const std::string& path)
+{
+    for (const ParticleAttribute& a : particles.attributes) {
+        if (a.components < 1 || a.size() != particles.size()
+            || a.bytes.size() != particles.size() * size_t(a.components) * scalarSize(a.type)) {
+            throw ParameterError("attribute '" + a.name + "' does not hold one value per particle (" +
+                                 path + ")");
+        }
+    }
+}
+
+/// Bytes of @a count values of @a width in the requested byte order.
+void
+appendSwapped(std::string& out, const unsigned char* data, size_t count, size_t width, bool bigEndian)
+{
+    const bool swap = bigEndian != (__BYTE_ORDER__ == __ORDER_BIG_ENDIAN__);
+    const size_t start = out.size();
+    out.append(reinterpret_cast<const char*>(data), count * width);
+    if (swap && width > 1) {
+        for (size_t i = 0; i < count; ++i) {
+            std::reverse(out.begin() + ptrdiff_t(start + i * width),
+                         out.begin() + ptrdiff_t(start + (i + 1) * width));
+        }
+    }
+}
+
+std::string
+positionBytes(const ParticleSet& particles, bool bigEndian)
+{
+    std::string out;
+    out.reserve(particles.size() * 12);
+    appendSwapped(out, reinterpret_cast<const unsigned char*>(particles.positions.data()),
+                  particles.size() * 3, 4, bigEndian);
+    return out;
+}
+
+void
+writeXyz(const ParticleSet& particles, std::ostream& os)
+{
+    const std::string bytes = positionBytes(particles, false);
+    os.write(bytes.data(), std::streamsize(bytes.size()));
+}
+
+const char*
+plyTypeName(ScalarType type)
+{
+    switch (type) {
+    case ScalarType::Int8: return "char";
+    case ScalarType::UInt8: return "uchar";
+    case ScalarType::Int16: return "short";
+    case ScalarType::UInt16: return "ushort";
+    case ScalarType::Int32: return "int";
+    case ScalarType::UInt32: return "uint";
+    case ScalarType::Float32: return "float";
+    default: return "double";  // Float64, and 64-bit integers (PLY has none)
+    }
+}
+
+std::string
+componentName(const ParticleAttribute& a, int c)
+{
+    const std::string base = headerWord(a.name);
+    if (a.components == 1) return base;
+    if (a.components == 3) return base + "_" + "xyz"[c];
+    return base + "_" + std::to_string(c);
+}
+
+void
+writePly(const ParticleSet& particles, std::ostream& os)
+{
+    std::string header = "ply\nformat binary_little_endian 1.0\ncomment written by nonbloppy\n";
+    header += "element vertex " + std::to_string(particles.size()) + "\n";
+    header += "property float x\nproperty float y\nproperty float z\n";
+    for (const ParticleAttribute& a : particles.attributes) {
+        for (int c = 0; c < a.components; ++c) {
+            header += std::string("property ") + plyTypeName(a.type) + " " + componentName(a, c) + "\n";
+        }
+    }
+    header += "end_header\n";
+    os.write(header.data(), std::streamsize(header.size()));
+    std::string row;
+    for (size_t n = 0; n < particles.size(); ++n) {
+        row.clear();
+        appendSwapped(row, reinterpret_cast<const unsigned char*>(&particles.positions[n]), 3, 4, false);
+        for (const ParticleAttribute& a : particles.attributes) {
+            const size_t width = scalarSize(a.type);
+            const unsigned char* values = a.bytes.data() + n * size_t(a.components) * width;
+            if (a.type == ScalarType::Int64 || a.type == ScalarType::UInt64) {
+                for (int c = 0; c < a.components; ++c) {
+                    const double value = a.asDouble(n, c);
+                    appendSwapped(row, reinterpret_cast<const unsigned char*>(&value), 1, 8, false);
+                }
+            } else {
+                appendSwapped(row, values, size_t(a.components), width, false);
+            }
+        }
+        os.write(row.data(), std::streamsize(row.size()));
+    }
+}
+
+const char*
+vtkTypeName(ScalarType type)
+{
+    switch (type) {
+    case ScalarType::Int8: return "char";
+    case ScalarType::UInt8: return "unsigned_char";
+    case ScalarType::Int16: return "short";
+    case ScalarType::UInt16: return "unsigned_short";
+    case ScalarType::Int32: return "int";
+    case ScalarType::UInt32: return "unsigned_int";
+    case ScalarType::Int64: return "vtktypeint64";
+    case ScalarType::UInt64: return "vtktypeuint64";
+    case ScalarType::Float32: return "float";
+    case ScalarType::Float64: return "double";
+    }
+    return "double";
+}
+
+void
+writeVtk(const ParticleSet& particles, std::ostream& os)
+{
+    const size_t n = particles.size();
+    std::string out = "# vtk DataFile Version 4.2\nparticles written by nonbloppy\nBINARY\n"
+                      "DATASET UNSTRUCTURED_GRID\nPOINTS " + std::to_string(n) + " float\n";
+    out += positionBytes(particles, true);
+    out += "\nCELLS " + std::to_string(n) + " " + std::to_string(2 * n) + "\n";
+    for (size_t i = 0; i < n; ++i) {
+        const int32_t cell[2] = {1, int32_t(i)};
+        appendSwapped(out, reinterpret_cast<const unsigned char*>(cell), 2, 4, true);
+    }
+    out += "\nCELL_TYPES " + std::to_string(n) + "\n";
+    const int32_t vertex = 1;  // VTK_VERTEX
+    for (size_t i = 0; i < n; ++i) appendSwapped(out, reinterpret_cast<const unsigned char*>(&vertex), 1, 4, true);
+    out += "\n";
+    if (!particles.attributes.empty()) {
+        out += "POINT_DATA " + std::to_string(n) + "\nFIELD FieldData " +
+               std::to_string(particles.attributes.size()) + "\n";
+        for (const ParticleAttribute& a : particles.attributes) {
+            out += headerWord(a.name) + " " + std::to_string(a.components) + " " + std::to_string(n) +
+                   " " + vtkTypeName(a.type) + "\n";
+            appendSwapped(out, a.bytes.data(), n * size_t(a.components), scalarSize(a.type), true);
+            out += "\n";
+        }
+    }
+    os.write(out.data(), std::streamsize(out.size()));
+}
+
+const char*
+vtuTypeName(ScalarType type)
+{
+    switch (type) {
+    case ScalarType::Int8: return "Int8";
+    case ScalarType::UInt8: return "UInt8";
+    case ScalarType::Int16: return "Int16";
+    case ScalarType::UInt16: return "UInt16";
+    case ScalarType::Int32: return "Int32";
+    case ScalarType::UInt32: return "UInt32";
+    case ScalarType::Int64: return "Int64";
+    case ScalarType::UInt64: return "UInt64";
+    case ScalarType::Float32: return "Float32";
+    case ScalarType::Float64: return "Float64";
+    }
+    return "Float64";
+}
+
+void
+writeVtu(const ParticleSet& particles, std::ostream& os)
+{
+    const size_t n = particles.size();
+    std::string appended, xml;
+    auto array = [&](const char* type, const std::string& name, int components, const std::string& bytes) {
+        xml += std::string("        <DataArray type=\"") + type + "\" Name=\"" + headerWord(name) +
+               "\" NumberOfComponents=\"" + std::to_string(components) +
+               "\" format=\"appended\" offset=\"" + std::to_string(appended.size()) + "\"/>\n";
+        const uint64_t size = bytes.size();
+        appendSwapped(appended, reinterpret_cast<const unsigned char*>(&size), 1, 8, false);
+        appended += bytes;
+    };
+    xml = "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" "
+          "byte_order=\"LittleEndian\" header_type=\"UInt64\">\n  <UnstructuredGrid>\n"
+          "    <Piece NumberOfPoints=\"" + std::to_string(n) + "\" NumberOfCells=\"" +
+          std::to_string(n) + "\">\n      <Points>\n";
+    array("Float32", "Points", 3, positionBytes(particles, false));
+    xml += "      </Points>\n      <Cells>\n";
+    std::string connectivity, offsets, types(n, char(1));  // VTK_VERTEX
+    for (size_t i = 0; i < n; ++i) {
+        const int64_t index = int64_t(i), offset = int64_t(i + 1);
+        appendSwapped(connectivity, reinterpret_cast<const unsigned char*>(&index), 1, 8, false);
+        appendSwapped(offsets, reinterpret_cast<const unsigned char*>(&offset), 1, 8, false);
+    }
+    array("Int64", "connectivity", 1, connectivity);
+    array("Int64", "offsets", 1, offsets);
+    array("UInt8", "types", 1, types);
+    xml += "      </Cells>\n      <PointData>\n";
+    for (const ParticleAttribute& a : particles.attributes) {
+        std::string bytes;
+        appendSwapped(bytes, a.bytes.data(), n * size_t(a.components), scalarSize(a.type), false);
+        array(vtuTypeName(a.type), a.name, a.components, bytes);
+    }
+    xml += "      </PointData>\n    </Piece>\n  </UnstructuredGrid>\n  <AppendedData encoding=\"raw\">\n   _";
+    os.write(xml.data(), std::streamsize(xml.size()));
+    os.write(appended.data(), std::streamsize(appended.size()));
+    const std::string tail = "\n  </AppendedData>\n</VTKFile>\n";
+    os.write(tail.data(), std::streamsize(tail.size()));
+}
+
+/// Shortest text that reads back as the same value of @a type.
+void
+appendNumber(std::string& out, const ParticleAttribute& a, size_t n, int c)
+{
+    char buffer[64];
+    const size_t width = scalarSize(a.type);
+    const unsigned char* p = a.bytes.data() + (n * size_t(a.components) + size_t(c)) * width;
+    std::to_chars_result result{};
+    switch (a.type) {
+    case ScalarType::Float32: { float v; std::memcpy(&v, p, 4); result = std::to_chars(buffer, buffer + 64, v); break; }
+    case ScalarType::Float64: { double v; std::memcpy(&v, p, 8); result = std::to_chars(buffer, buffer + 64, v); break; }
+    case ScalarType::UInt64: { uint64_t v; std::memcpy(&v, p, 8); result = std::to_chars(buffer, buffer + 64, v); break; }
+    case ScalarType::Int64: { int64_t v; std::memcpy(&v, p, 8); result = std::to_chars(buffer, buffer + 64, v); break; }
+    default: result = std::to_chars(buffer, buffer + 64, int64_t(a.asDouble(n, c))); break;
+    }
+    out.append(buffer, result.ptr);
+}
+
+void
+writeCsv(const ParticleSet& particles, std::ostream& os)
+{
+    std::string out = "x,y,z";
+    for (const ParticleAttribute& a : particles.attributes) {
+        for (int c = 0; c < a.components; ++c) {
+            out += "," + headerWord(a.name);
+            if (a.components > 1) out += ":" + std::to_string(c);
+        }
+    }
+    out += "\n";
+    char buffer[64];
+    for (size_t n = 0; n < particles.size(); ++n) {
+        for (int axis = 0; axis < 3; ++axis) {
+            if (axis > 0) out += ',';
+            out.append(buffer, std::to_chars(buffer, buffer + 64, particles.positions[n][axis]).ptr);
+        }
+        for (const ParticleAttribute& a : particles.attributes) {
+            for (int c = 0; c < a.components; ++c) {
+                out += ',';
+                appendNumber(out, a, n, c);
+            }
+        }
+        out += '\n';
+        if (out.size() > (size_t(4) << 20)) {
+            os.write(out.data(), std::streamsize(out.size()));
+            out.clear();
+        }
+    }
+    os.write(out.data(), std::streamsize(out.size()));
+}
+
+// --- PointDataGrid ------------------------------------------------------------------------
+
+using PointDataGrid = openvdb::points::PointDataGrid;
+using PointIndexGrid = openvdb::tools::PointIndexGrid;
+
+template<typename ValueT>
+void
+addVdbAttribute(PointDataGrid& grid, const PointIndexGrid& index, const std::string& name,
+                const std::vector<ValueT>& values)
+{
+    openvdb::points::appendAttribute<ValueT>(grid.tree(), name);
+    openvdb::points::populateAttribute<openvdb::points::PointDataTree, openvdb::tools::PointIndexTree,
+        openvdb::points::PointAttributeVector<ValueT>>(grid.tree(), index.tree(), name,
+            openvdb::points::PointAttributeVector<ValueT>(values));
+}
+
+template<typename ScalarT>
+void
+addScalarAttribute(PointDataGrid& grid, const PointIndexGrid& index, const ParticleAttribute& a, int c,
+                   const std::string& name)
+{
+    std::vector<ScalarT> values(a.size());
+    for (size_t n = 0; n < values.size(); ++n) values[n] = static_cast<ScalarT>(a.asDouble(n, c));
+    addVdbAttribute(grid, index, name, values);
+}
+
+template<typename VecT>
+void
+addVectorAttribute(PointDataGrid& grid, const PointIndexGrid& index, const ParticleAttribute& a)
+{
+    using ScalarT = typename VecT::value_type;
+    std::vector<VecT> values(a.size());
+    for (size_t n = 0; n < values.size(); ++n) {
+        values[n] = VecT(static_cast<ScalarT>(a.asDouble(n, 0)), static_cast<ScalarT>(a.asDouble(n, 1)),
+                         static_cast<ScalarT>(a.asDouble(n, 2)));
+    }
+    addVdbAttribute(grid, index, a.name, values);
+}
+
+} // namespace
+
+openvdb::GridBase::Ptr
+makePointDataGrid(const ParticleSet& particles, double voxelSize)
+{
+    openvdb::initialize();
+    std::vector<openvdb::Vec3R> positions(particles.positions.begin(), particles.positions.end());
+    const openvdb::points::PointAttributeVector<openvdb::Vec3R> wrapper(positions);
+    if (!(voxelSize > 0.0)) {
+        voxelSize = positions.size() > 1 ? double(openvdb::points::computeVoxelSize(wrapper, 8)) : 1.0;
+    }
+    const auto transform = openvdb::math::Transform::createLinearTransform(voxelSize);
+    const auto index = openvdb::tools::createPointIndexGrid<PointIndexGrid>(wrapper, *transform);
+    auto grid = openvdb::points::createPointDataGrid<openvdb::points::NullCodec, PointDataGrid>(
+        *index, wrapper, *transform);
+    grid->setName("points");
+    for (const ParticleAttribute& a : particles.attributes) {
+        if (a.name == "P" || a.size() != particles.size()) continue;
+        if (a.components == 3) {
+            if (a.type == ScalarType::Float32) addVectorAttribute<openvdb::Vec3f>(*grid, *index, a);
+            else if (a.type == ScalarType::Float64) addVectorAttribute<openvdb::Vec3d>(*grid, *index, a);
+            else addVectorAttribute<openvdb::Vec3i>(*grid, *index, a);
+            continue;
+        }
+        for (int c = 0; c < a.components; ++c) {
+            const std::string name = a.components == 1 ? a.name : a.name + "_" + std::to_string(c);
+            switch (a.type) {
+            case ScalarType::Int8: addScalarAttribute<int8_t>(*grid, *index, a, c, name); break;
+            case ScalarType::UInt8:
+            case ScalarType::Int16: addScalarAttribute<int16_t>(*grid, *index, a, c, name); break;
+            case ScalarType::UInt16:
+            case ScalarType::Int32: addScalarAttribute<int32_t>(*grid, *index, a, c, name); break;
+            case ScalarType::UInt32:
+            case ScalarType::Int64:
+            case ScalarType::UInt64: addScalarAttribute<int64_t>(*grid, *index, a, c, name); break;
+            case ScalarType::Float32: addScalarAttribute<float>(*grid, *index, a, c, name); break;
+            case ScalarType::Float64: addScalarAttribute<double>(*grid, *index, a, c, name); break;
+            }
+        }
+    }
+    return grid;
+}
+
+void
+writeParticles(const ParticleSet& particles, const std::string& path)
+{
+    const std::string ext = lowerExtension(path);
+    if (!isParticleOutputFile(path)) {
+        throw FileError((ext.empty() ? "particle file name has no extension ("
+                                     : "unknown particle output extension '" + ext + "' (") +
+                        path + "); expected .ply, .vtk, .vtu, .xyz, .csv or .vdb");
+    }
+    requireSizes(particles, path);
+    if (ext == ".vdb") {
+        openvdb::MetaMap metadata;
+        metadata.insertMeta("creator", openvdb::StringMetadata("nonbloppy"));
+        writeVdb({makePointDataGrid(particles)}, path, metadata);
+        return;
+    }
+    writeFileAtomically(path, [&](std::ostream& os) {
+        if (ext == ".ply") writePly(particles, os);
+        else if (ext == ".vtk") writeVtk(particles, os);
+        else if (ext == ".vtu") writeVtu(particles, os);
+        else if (ext == ".xyz") writeXyz(particles, os);
+        else writeCsv(particles, os);
+    });
+}
+
+bool
+isParticleOutputFile(const std::string& path)
+{
+    const std::string ext = lowerExtension(path);
+    return ext == ".ply" || ext == ".vtk" || ext == ".vtu" || ext == ".xyz" || ext == ".csv" ||
+           ext == ".vdb";
+}
+
+} // namespace nonbloppy

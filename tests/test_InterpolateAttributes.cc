@@ -1,0 +1,199 @@
+// SPDX-License-Identifier: Apache-2.0
+// Tests for interpolateAttributes(): a constant field comes back exactly, a linear field
+// f(r) = A·r + b comes back as A·t_i + b with t_i the kernel-weighted mean position
+// (computed here by brute force over every particle), the result does not depend on the
+// thread count, and the attributes reach PLY and VTK files.
+
+#include "TestUtil.h"
+
+#include <nonbloppy/BuildSurface.h>
+#include <nonbloppy/Error.h>
+#include <nonbloppy/InterpolateAttributes.h>
+#include <nonbloppy/Kernel.h>
+#include <nonbloppy/ReadParticles.h>
+#include <nonbloppy/WriteMesh.h>
+
+#include <gtest/gtest.h>
+#include <tbb/global_control.h>
+
+#include <cstdlib>
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include <unistd.h>
+
+namespace {
+
+using namespace nonbloppy;
+
+template<typename T>
+ParticleAttribute
+makeAttribute(const std::string& name, ScalarType type, int components, const std::vector<T>& values)
+{
+    ParticleAttribute attribute;
+    attribute.name = name;
+    attribute.type = type;
+    attribute.components = components;
+    attribute.bytes.resize(values.size() * sizeof(T));
+    std::memcpy(attribute.bytes.data(), values.data(), attribute.bytes.size());
+    return attribute;
+}
+
+const openvdb::Mat3d kA(0.5, -1.0, 2.0, 3.0, 0.25, -0.75, 1.5, 1.0, -2.0);
+const openvdb::Vec3d kB(0.1, -0.2, 0.3);
+constexpr double kSpacing = 0.1;
+
+/// A jittered ball of particles with a constant scalar "c" = 2.5 (float32), a linear
+/// vector field "f" = A·r + b (float64) and an int32 "id".
+ParticleSet
+ballWithFields()
+{
+    ParticleSet particles;
+    particles.positions = nonbloppy_test::latticeParticles(kSpacing, 0.6,
+        [](const openvdb::Vec3d& x) { return x.length() < 0.5; }, 0.2);
+    std::vector<float> c(particles.size(), 2.5f);
+    std::vector<double> f;
+    std::vector<int32_t> id;
+    for (size_t j = 0; j < particles.size(); ++j) {
+        const openvdb::Vec3d v = kA * openvdb::Vec3d(particles.positions[j]) + kB;
+        f.insert(f.end(), {v[0], v[1], v[2]});
+        id.push_back(int32_t(j));
+    }
+    particles.attributes.push_back(makeAttribute("c", ScalarType::Float32, 1, c));
+    particles.attributes.push_back(makeAttribute("f", ScalarType::Float64, 3, f));
+    particles.attributes.push_back(makeAttribute("id", ScalarType::Int32, 1, id));
+    return particles;
+}
+
+struct Fixture
+{
+    ParticleSet particles = ballWithFields();
+    SurfaceMesh mesh;
+    double radius = 0;
+
+    Fixture()
+    {
+        SurfaceParameters params;
+        params.spacing = kSpacing;
+        SurfaceResult result = buildSurface(particles.positions, params);
+        mesh = std::move(result.mesh);
+        radius = result.parameters.effectiveRadius;
+        mesh.points.push_back(openvdb::Vec3s(5.0f, 5.0f, 5.0f));  // no particle in reach
+        if (!mesh.normals.empty()) mesh.normals.push_back(openvdb::Vec3s(0.0f, 0.0f, 1.0f));
+    }
+};
+
+TEST(InterpolateAttributes, ConstantFieldComesBackExactly)
+{
+    Fixture fx;
+    ASSERT_GT(fx.mesh.points.size(), 100u);
+    interpolateAttributes(fx.mesh, fx.particles, {"c"}, fx.radius);
+    ASSERT_EQ(fx.mesh.attributes.size(), 1u);
+    const MeshAttribute& c = fx.mesh.attributes[0];
+    EXPECT_EQ(c.name, "c");
+    EXPECT_EQ(c.components, 1);
+    ASSERT_EQ(c.values.size(), fx.mesh.points.size());
+    for (size_t i = 0; i + 1 < c.values.size(); ++i) ASSERT_EQ(c.values[i], 2.5f) << "vertex " << i;
+    EXPECT_EQ(c.values.back(), 0.0f);  // the far vertex
+}
+
+TEST(InterpolateAttributes, LinearFieldGivesTheFieldAtTheWeightedMean)
+{
+    Fixture fx;
+    interpolateAttributes(fx.mesh, fx.particles, {"f"}, fx.radius);
+    const MeshAttribute& f = fx.mesh.attributes.at(0);
+    ASSERT_EQ(f.components, 3);
+    const float re = float(fx.radius);
+    size_t checked = 0;
+    for (size_t i = 0; i < fx.mesh.points.size(); ++i) {
+        // t_i by brute force over every particle, with the kernel's weights.
+        const openvdb::Vec3f v = fx.mesh.points[i];
+        openvdb::Vec3d sum(0.0);
+        double weights = 0.0;
+        for (const openvdb::Vec3f& p : fx.particles.positions) {
+            const float w = mpsWeightSquared((v - p).lengthSqr(), re);
+            sum += double(w) * openvdb::Vec3d(p);
+            weights += w;
+        }
+        if (weights == 0.0) {
+            for (int a = 0; a < 3; ++a) EXPECT_EQ(f.values[3 * i + a], 0.0f);
+            continue;
+        }
+        const openvdb::Vec3d expected = kA * (sum / weights) + kB;
+        for (int a = 0; a < 3; ++a) {
+            ASSERT_NEAR(f.values[3 * i + a], expected[a], 2e-5) << "vertex " << i << " axis " << a;
+        }
+        ++checked;
+    }
+    EXPECT_EQ(checked, fx.mesh.points.size() - 1);
+}
+
+TEST(InterpolateAttributes, SameBytesForAnyThreadCount)
+{
+    Fixture fx;
+    SurfaceMesh one = fx.mesh, many = fx.mesh;
+    {
+        tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 1);
+        interpolateAttributes(one, fx.particles, {"all"}, fx.radius);
+    }
+    interpolateAttributes(many, fx.particles, {"all"}, fx.radius);
+    ASSERT_EQ(one.attributes.size(), 3u);
+    for (size_t a = 0; a < 3; ++a) {
+        EXPECT_EQ(one.attributes[a].name, many.attributes[a].name);
+        EXPECT_TRUE(one.attributes[a].values == many.attributes[a].values) << one.attributes[a].name;
+    }
+}
+
+TEST(InterpolateAttributes, NamesAndErrors)
+{
+    Fixture fx;
+    EXPECT_EQ(resolveAttributeNames(fx.particles, {"all"}), (std::vector<std::string>{"c", "f", "id"}));
+    EXPECT_EQ(resolveAttributeNames(fx.particles, {"id", "c", "id"}), (std::vector<std::string>{"id", "c"}));
+    try {
+        interpolateAttributes(fx.mesh, fx.particles, {"velocity"}, fx.radius);
+        FAIL() << "no exception";
+    } catch (const ParameterError& e) {
+        EXPECT_STREQ(e.what(), "unknown attribute 'velocity'; the particles have: c, f, id");
+    }
+    ParticleSet bare;
+    bare.positions = fx.particles.positions;
+    try {
+        interpolateAttributes(fx.mesh, bare, {"velocity"}, fx.radius);
+        FAIL() << "no exception";
+    } catch (const ParameterError& e) {
+        EXPECT_STREQ(e.what(), "unknown attribute 'velocity'; the particles have no attributes");
+    }
+    EXPECT_THROW(interpolateAttributes(fx.mesh, fx.particles, {"c"}, 0.0), ParameterError);
+}
+
+TEST(InterpolateAttributes, WrittenAsPlyPropertiesAndVtkPointData)
+{
+    Fixture fx;
+    interpolateAttributes(fx.mesh, fx.particles, {"c", "f"}, fx.radius);
+    std::string dir = ::testing::TempDir() + "nonbloppy_attr_XXXXXX";
+    ASSERT_NE(mkdtemp(dir.data()), nullptr);
+    writeMesh(fx.mesh, dir + "/m.ply");
+    writeMesh(fx.mesh, dir + "/m.vtk");
+
+    // Both files read back as particle files, whose attributes are the vertex data.
+    const ParticleSet ply = readParticles(dir + "/m.ply");
+    ASSERT_EQ(ply.size(), fx.mesh.points.size());
+    const char* plyNames[] = {"c", "f_x", "f_y", "f_z"};
+    for (const char* name : plyNames) ASSERT_NE(ply.findAttribute(name), nullptr) << name;
+    const ParticleSet vtk = readParticles(dir + "/m.vtk");
+    const ParticleAttribute* f = vtk.findAttribute("f");
+    ASSERT_NE(f, nullptr);
+    EXPECT_EQ(f->components, 3);
+    const MeshAttribute& meshF = fx.mesh.attributes[1];
+    for (size_t i = 0; i < fx.mesh.points.size(); ++i) {
+        EXPECT_EQ(float(ply.findAttribute("c")->asDouble(i)), fx.mesh.attributes[0].values[i]);
+        for (int a = 0; a < 3; ++a) {
+            EXPECT_EQ(float(ply.findAttribute(plyNames[1 + a])->asDouble(i)), meshF.values[3 * i + a]);
+            EXPECT_EQ(float(f->asDouble(i, a)), meshF.values[3 * i + a]);
+        }
+    }
+    EXPECT_EQ(std::system(("rm -rf '" + dir + "'").c_str()), 0);
+}
+
+} // namespace

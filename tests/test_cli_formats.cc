@@ -1,0 +1,267 @@
+// SPDX-License-Identifier: Apache-2.0
+// CLI tests for issue 5: `nonbloppy convert` round trips between every particle writer and
+// the readers, `mesh --attributes` (PLY/VTK vertex data, OBJ warning), and the extra grids
+// --vdb-surface and --vdb-points.
+
+#include <nonbloppy/ReadMesh.h>
+#include <nonbloppy/ReadParticles.h>
+
+#include <openvdb/openvdb.h>
+#include <openvdb/points/PointCount.h>
+#include <openvdb/points/PointDataGrid.h>
+#include <openvdb/tools/Interpolation.h>
+
+#include <gtest/gtest.h>
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <map>
+#include <string>
+#include <vector>
+
+namespace {
+
+namespace fs = std::filesystem;
+using nonbloppy::ParticleAttribute;
+using nonbloppy::ParticleSet;
+
+const std::string kCli = NONBLOPPY_CLI_PATH;
+const std::string kData = NONBLOPPY_TEST_DATA_DIR;
+
+std::string quote(const std::string& s) { return "'" + s + "'"; }
+
+std::string readText(const std::string& path)
+{
+    std::ifstream is(path, std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(is), std::istreambuf_iterator<char>());
+}
+
+struct RunResult
+{
+    int exitCode = -1;
+    std::string out, err;
+};
+
+class CliFormatsTest : public ::testing::Test
+{
+protected:
+    void SetUp() override
+    {
+        const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+        mDir = (fs::path(::testing::TempDir()) / ("nonbloppy_clifmt_" + std::string(info->name()) +
+                                                  "_" + std::to_string(::getpid()))).string();
+        fs::remove_all(mDir);
+        fs::create_directories(mDir);
+    }
+    void TearDown() override
+    {
+        std::error_code ec;
+        fs::remove_all(mDir, ec);
+    }
+    RunResult run(const std::string& args) const
+    {
+        const std::string outFile = mDir + "/stdout.txt", errFile = mDir + "/stderr.txt";
+        const std::string command = quote(kCli) + " " + args + " >" + quote(outFile) + " 2>" +
+                                    quote(errFile) + " </dev/null";
+        const int status = std::system(command.c_str());
+        RunResult result;
+        result.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+        result.out = readText(outFile);
+        result.err = readText(errFile);
+        return result;
+    }
+    std::string path(const std::string& name) const { return mDir + "/" + name; }
+
+    std::string mDir;
+};
+
+/// The values of attribute @a name (component @a c) per particle, keyed by the "id"
+/// attribute, so files that reorder the particles (VDB points) can be compared.
+std::map<int64_t, std::vector<double>> byId(const ParticleSet& particles)
+{
+    std::map<int64_t, std::vector<double>> rows;
+    const ParticleAttribute* id = particles.findAttribute("id");
+    if (!id) throw std::runtime_error("no id");
+    for (size_t n = 0; n < particles.size(); ++n) {
+        std::vector<double>& row = rows[int64_t(id->asDouble(n))];
+        for (int a = 0; a < 3; ++a) row.push_back(particles.positions[n][a]);
+        for (const ParticleAttribute& attribute : particles.attributes) {
+            if (attribute.name == "id") continue;
+            for (int c = 0; c < attribute.components; ++c) row.push_back(float(attribute.asDouble(n, c)));
+        }
+    }
+    return rows;
+}
+
+TEST_F(CliFormatsTest, ConvertRoundTripsThroughEveryWriter)
+{
+    const std::string source = kData + "/dam_break_frame_9_6859_particles.bgeo";
+    const ParticleSet original = nonbloppy::readParticles(source);
+    const auto expected = byId(original);
+    ASSERT_EQ(expected.size(), 6859u);
+    for (const std::string ext : {"vtk", "vtu", "csv", "vdb"}) {
+        SCOPED_TRACE(ext);
+        const std::string file = path("frame." + ext);
+        const RunResult r = run("convert " + quote(source) + " " + quote(file));
+        ASSERT_EQ(r.exitCode, 0) << r.err;
+        EXPECT_EQ(r.out, "converted 6859 particles with 3 attributes: " + source + " -> " + file + "\n");
+        const ParticleSet back = nonbloppy::readParticles(file);
+        ASSERT_EQ(back.size(), original.size());
+        ASSERT_EQ(back.attributes.size(), 3u);
+        EXPECT_EQ(back.findAttribute("velocity")->components, 3);
+        const auto actual = byId(back);
+        ASSERT_EQ(actual.size(), expected.size());
+        for (const auto& [id, row] : expected) {
+            const std::vector<double>& got = actual.at(id);
+            ASSERT_EQ(got.size(), row.size());
+            for (size_t k = 0; k < row.size(); ++k) {
+                if (ext == "vdb" && k < 3) {
+                    ASSERT_NEAR(got[k], row[k], 1e-5) << "id " << id;  // voxel-relative offsets
+                } else {
+                    ASSERT_EQ(got[k], row[k]) << "id " << id << " value " << k;
+                }
+            }
+        }
+    }
+    // PLY keeps each component as a property of its own.
+    const std::string ply = path("frame.ply");
+    ASSERT_EQ(run("convert " + quote(source) + " " + quote(ply)).exitCode, 0);
+    const ParticleSet back = nonbloppy::readParticles(ply);
+    ASSERT_EQ(back.size(), original.size());
+    for (size_t n = 0; n < back.size(); ++n) {
+        ASSERT_EQ(back.positions[n], original.positions[n]);
+        ASSERT_EQ(back.findAttribute("velocity_z")->asDouble(n), original.findAttribute("velocity")->asDouble(n, 2));
+        ASSERT_EQ(back.findAttribute("id")->asDouble(n), original.findAttribute("id")->asDouble(n));
+    }
+    // A chain through three formats ends where it began.
+    ASSERT_EQ(run("convert " + quote(path("frame.vtu")) + " " + quote(path("chain.csv"))).exitCode, 0);
+    ASSERT_EQ(run("convert " + quote(path("chain.csv")) + " " + quote(path("chain.vtk"))).exitCode, 0);
+    const ParticleSet chain = nonbloppy::readParticles(path("chain.vtk"));
+    ASSERT_EQ(chain.size(), original.size());
+    for (size_t n = 0; n < chain.size(); ++n) ASSERT_EQ(chain.positions[n], original.positions[n]);
+}
+
+TEST_F(CliFormatsTest, ConvertToXyzWarnsAndErrorsAreOneLine)
+{
+    const std::string source = kData + "/fluid_250_particles.vtu";
+    const RunResult r = run("convert -q " + quote(source) + " " + quote(path("p.xyz")));
+    EXPECT_EQ(r.exitCode, 0);
+    EXPECT_EQ(r.out, "");
+    EXPECT_EQ(r.err, "nonbloppy: warning: .xyz holds positions only; attributes dropped: velocity, "
+                     "pressure, density, index\n");
+    const ParticleSet xyz = nonbloppy::readParticles(path("p.xyz"));
+    const ParticleSet vtu = nonbloppy::readParticles(source);
+    ASSERT_EQ(xyz.size(), 250u);
+    for (size_t n = 0; n < 250; ++n) EXPECT_EQ(xyz.positions[n], vtu.positions[n]);
+
+    RunResult bad = run("convert " + quote(source) + " " + quote(path("p.obj")));
+    EXPECT_EQ(bad.exitCode, 1);
+    EXPECT_EQ(bad.err, "nonbloppy: unknown particle output extension '.obj' (" + path("p.obj") +
+                       "); expected .ply, .vtk, .vtu, .xyz, .csv or .vdb\n");
+    bad = run("convert " + quote(source) + " " + quote(source));
+    EXPECT_EQ(bad.err, "nonbloppy: cannot write " + source + ": it is the input file\n");
+    const std::string density = path("density.vdb");
+    ASSERT_EQ(run("mesh " + quote(source) + " -q -o " + quote(path("m.ply")) + " --vdb " + quote(density)).exitCode, 0);
+    bad = run("convert " + quote(density) + " " + quote(path("p.csv")));
+    EXPECT_EQ(bad.exitCode, 1);
+    EXPECT_EQ(bad.err, "nonbloppy: no PointDataGrid in this .vdb file (grids: density float); a density "
+                       "cache cannot be meshed as particles (" + density + ")\n");
+    EXPECT_FALSE(fs::exists(path("p.csv")));
+}
+
+TEST_F(CliFormatsTest, MeshAttributesReachPlyAndVtk)
+{
+    const std::string source = kData + "/fluid_250_particles.vtu";
+    for (const std::string ext : {"ply", "vtk"}) {
+        const std::string mesh = path("m." + ext);
+        const RunResult r = run("mesh -q " + quote(source) + " -o " + quote(mesh) +
+                                " --attributes velocity,pressure");
+        ASSERT_EQ(r.exitCode, 0) << r.err;
+        EXPECT_EQ(r.err, "");
+        const nonbloppy::SurfaceMesh polygons = nonbloppy::readMesh(mesh);
+        const ParticleSet vertices = nonbloppy::readParticles(mesh);
+        ASSERT_GT(polygons.points.size(), 100u);
+        ASSERT_EQ(vertices.size(), polygons.points.size());
+        const std::vector<std::string> names = ext == "ply"
+            ? std::vector<std::string>{"velocity_x", "velocity_y", "velocity_z", "pressure"}
+            : std::vector<std::string>{"velocity", "pressure"};
+        for (const std::string& name : names) {
+            const ParticleAttribute* a = vertices.findAttribute(name);
+            ASSERT_NE(a, nullptr) << name;
+            EXPECT_EQ(a->size(), vertices.size());
+        }
+        // Pressure is non-negative on every particle, so its weighted mean is too, and not
+        // zero everywhere.
+        const ParticleAttribute* pressure = vertices.findAttribute("pressure");
+        double maxPressure = 0;
+        for (size_t i = 0; i < vertices.size(); ++i) {
+            ASSERT_GE(pressure->asDouble(i), 0.0);
+            maxPressure = std::max(maxPressure, pressure->asDouble(i));
+        }
+        EXPECT_GT(maxPressure, 0.0);
+    }
+    const RunResult obj = run("mesh -q " + quote(source) + " -o " + quote(path("m.obj")) + " --attributes all");
+    EXPECT_EQ(obj.exitCode, 0);
+    EXPECT_EQ(obj.err, "nonbloppy: warning: OBJ cannot store vertex attributes; write .ply or .vtk "
+                       "to keep --attributes\n");
+    const RunResult unknown = run("mesh -q " + quote(source) + " -o " + quote(path("u.ply")) + " --attributes speed");
+    EXPECT_EQ(unknown.exitCode, 1);
+    EXPECT_EQ(unknown.err, "nonbloppy: unknown attribute 'speed'; the particles have: velocity, "
+                           "pressure, density, index\n");
+    EXPECT_FALSE(fs::exists(path("u.ply")));
+}
+
+TEST_F(CliFormatsTest, VdbSurfaceAndPointsGrids)
+{
+    openvdb::initialize();
+    const std::string source = kData + "/fluid_250_particles.vtu";
+    const std::string vdb = path("all.vdb"), ply = path("m.ply");
+    const RunResult r = run("mesh -q " + quote(source) + " -o " + quote(ply) + " --vdb " + quote(vdb) +
+                            " --vdb-surface --vdb-points");
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    openvdb::io::File file(vdb);
+    file.open();
+    openvdb::GridPtrVecPtr grids = file.getGrids();
+    file.close();
+    ASSERT_EQ(grids->size(), 3u);
+    std::map<std::string, openvdb::GridBase::Ptr> byName;
+    for (const auto& grid : *grids) byName[grid->getName()] = grid;
+    ASSERT_EQ(byName.size(), 3u);
+    ASSERT_TRUE(byName.count("density") && byName.count("surface") && byName.count("points"));
+    EXPECT_EQ(byName["surface"]->getGridClass(), openvdb::GRID_LEVEL_SET);
+    const auto points = openvdb::gridPtrCast<openvdb::points::PointDataGrid>(byName["points"]);
+    ASSERT_TRUE(points);
+    EXPECT_EQ(openvdb::points::pointCount(points->tree()), 250u);
+    EXPECT_EQ(nonbloppy::readParticles(vdb).attributes.size(), 4u);
+
+    // The level set is ~0 at the mesh's vertices.
+    const auto surface = openvdb::gridPtrCast<openvdb::FloatGrid>(byName["surface"]);
+    const double h = surface->voxelSize()[0];
+    const nonbloppy::SurfaceMesh mesh = nonbloppy::readMesh(ply);
+    openvdb::tools::GridSampler<openvdb::FloatGrid, openvdb::tools::BoxSampler> sampler(*surface);
+    for (size_t i = 0; i < mesh.points.size(); i += 7) {
+        ASSERT_LT(std::abs(sampler.wsSample(openvdb::Vec3d(mesh.points[i]))), 1.0 * h) << "vertex " << i;
+    }
+
+    // Same bytes with one thread.
+    const RunResult one = run("mesh -q --threads 1 " + quote(source) + " -o " + quote(path("one.ply")) +
+                              " --vdb " + quote(path("one.vdb")) + " --vdb-surface --vdb-points --attributes all");
+    ASSERT_EQ(one.exitCode, 0) << one.err;
+    const RunResult many = run("mesh -q " + quote(source) + " -o " + quote(path("many.ply")) +
+                               " --vdb " + quote(path("many.vdb")) + " --vdb-surface --vdb-points --attributes all");
+    ASSERT_EQ(many.exitCode, 0) << many.err;
+    EXPECT_TRUE(readText(path("one.vdb")) == readText(path("many.vdb")));
+    EXPECT_TRUE(readText(path("one.ply")) == readText(path("many.ply")));
+
+    const RunResult needsVdb = run("mesh " + quote(source) + " -o " + quote(path("x.ply")) + " --vdb-surface");
+    EXPECT_EQ(needsVdb.exitCode, 2);
+    EXPECT_EQ(needsVdb.err, "nonbloppy: --vdb-surface requires --vdb\n");
+}
+
+} // namespace

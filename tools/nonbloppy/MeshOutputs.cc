@@ -1,0 +1,81 @@
+// SPDX-License-Identifier: Apache-2.0
+/// @file MeshOutputs.cc
+/// @brief --attributes, --vdb-surface and --vdb-points of `nonbloppy mesh`.
+
+#include "MeshOutputs.h"
+
+#include "Commands.h"
+
+#include <nonbloppy/Error.h>
+#include <nonbloppy/InterpolateAttributes.h>
+#include <nonbloppy/MeshToLevelSet.h>
+#include <nonbloppy/WriteParticles.h>
+
+#include <atomic>
+#include <cctype>
+#include <filesystem>
+#include <iostream>
+#include <vector>
+
+namespace nonbloppy_tool {
+
+namespace {
+
+std::vector<std::string> splitNames(const std::string& list)
+{
+    std::vector<std::string> names;
+    std::string current;
+    for (const char c : list + ",") {
+        if (c == ',') {
+            if (!current.empty()) names.push_back(current);
+            current.clear();
+        } else if (!std::isspace(static_cast<unsigned char>(c))) {
+            current += c;
+        }
+    }
+    return names;
+}
+
+std::atomic<bool> gObjWarningPrinted{false};
+
+} // namespace
+
+void addMeshOutputOptions(CLI::App* cmd, MeshOutputOptions& o, CLI::Option* vdbOption)
+{
+    cmd->add_option("--attributes", o.attributes,
+        "Particle attributes to carry to the mesh vertices, e.g. velocity,id, or all "
+        "(PLY properties, VTK point data; OBJ cannot store them)")
+        ->group(kGroupInputOutput);
+    cmd->add_flag("--vdb-surface", o.vdbSurface,
+        "Also store the final surface as a level set grid 'surface' in the --vdb file")
+        ->needs(vdbOption)->group(kGroupInputOutput);
+    cmd->add_flag("--vdb-points", o.vdbPoints,
+        "Also store the input particles as a PointDataGrid 'points' in the --vdb file")
+        ->needs(vdbOption)->group(kGroupInputOutput);
+}
+
+void addSurfaceAttributes(nonbloppy::SurfaceResult& result, const nonbloppy::ParticleSet& particles,
+                          const MeshOutputOptions& o, const std::string& meshPath,
+                          openvdb::util::NullInterrupter* interrupter)
+{
+    if (o.attributes.empty()) return;
+    const std::vector<std::string> names = splitNames(o.attributes);
+    if (names.empty()) throw nonbloppy::ParameterError("--attributes names no attribute");
+    nonbloppy::interpolateAttributes(result.mesh, particles, names,
+                                     result.parameters.effectiveRadius, interrupter);
+    std::string ext = std::filesystem::path(meshPath).extension().string();
+    for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    if (ext == ".obj" && !result.mesh.attributes.empty() && !gObjWarningPrinted.exchange(true)) {
+        std::cerr << "nonbloppy: warning: OBJ cannot store vertex attributes; write .ply or .vtk "
+                     "to keep --attributes" << std::endl;
+    }
+}
+
+void appendVdbGrids(openvdb::GridCPtrVec& grids, const nonbloppy::SurfaceResult& result,
+                    const nonbloppy::ParticleSet& particles, const MeshOutputOptions& o)
+{
+    if (o.vdbSurface) grids.push_back(nonbloppy::meshToLevelSet(result.mesh, result.parameters.voxelSize));
+    if (o.vdbPoints) grids.push_back(nonbloppy::makePointDataGrid(particles));
+}
+
+} // namespace nonbloppy_tool

@@ -1,0 +1,50 @@
+// SPDX-License-Identifier: Apache-2.0
+/// @file MeshOutputs.h
+/// @brief The extra outputs of `nonbloppy mesh`: particle attributes on the surface
+///        (--attributes), the surface as a level set and the particles as points in the
+///        --vdb file (--vdb-surface, --vdb-points). MeshCommand.cc declares them through
+///        addMeshOutputOptions() and calls the two functions below per frame.
+
+#ifndef NONBLOPPY_TOOL_MESH_OUTPUTS_H
+#define NONBLOPPY_TOOL_MESH_OUTPUTS_H
+
+#include <CLI/CLI.hpp>
+
+#include <nonbloppy/BuildSurface.h>
+#include <nonbloppy/Particles.h>
+
+#include <openvdb/openvdb.h>
+#include <openvdb/util/NullInterrupter.h>
+
+#include <string>
+
+namespace nonbloppy_tool {
+
+struct MeshOutputOptions
+{
+    std::string attributes;  ///< --attributes: comma-separated names, or "all"
+    bool vdbSurface = false, vdbPoints = false;
+
+    /// True if the particles (positions and attributes) are needed after meshing.
+    bool needParticles() const { return !attributes.empty() || vdbPoints; }
+};
+
+/// Declare --attributes, --vdb-surface and --vdb-points on @a cmd (the last two need
+/// @a vdbOption, the --vdb FILE option).
+void addMeshOutputOptions(CLI::App* cmd, MeshOutputOptions& options, CLI::Option* vdbOption);
+
+/// With --attributes, interpolate the named attributes of @a particles to the final
+/// vertices of result.mesh (see nonbloppy::interpolateAttributes). Warns once on stderr
+/// when @a meshPath is an OBJ file, which cannot store them.
+void addSurfaceAttributes(nonbloppy::SurfaceResult& result, const nonbloppy::ParticleSet& particles,
+                          const MeshOutputOptions& options, const std::string& meshPath,
+                          openvdb::util::NullInterrupter* interrupter);
+
+/// Append to @a grids what --vdb-surface ("surface" level set at the density's voxel
+/// size) and --vdb-points ("points" PointDataGrid) ask for.
+void appendVdbGrids(openvdb::GridCPtrVec& grids, const nonbloppy::SurfaceResult& result,
+                    const nonbloppy::ParticleSet& particles, const MeshOutputOptions& options);
+
+} // namespace nonbloppy_tool
+
+#endif // NONBLOPPY_TOOL_MESH_OUTPUTS_H
