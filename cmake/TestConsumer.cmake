@@ -2,7 +2,8 @@
 #   install the built project into a fresh prefix, configure and build tests/consumer against
 #   it, run the shared and static consumers, then compile the same main.cc with pkg-config.
 # Inputs: -DBUILD_DIR=<nonbloppy build> -DSOURCE_DIR=<nonbloppy source> -DWORK_DIR=<scratch>
-#         -DCXX=<compiler> -DBUILD_TYPE=<Release|...>
+#         -DCXX=<compiler> -DBUILD_TYPE=<Release|...> and the project's -DCXX_FLAGS and
+#         -DEXE_LINKER_FLAGS (e.g. sanitizers: the consumer must be built the same way)
 cmake_minimum_required(VERSION 3.18)
 
 function(run)
@@ -24,7 +25,8 @@ endforeach()
 
 run(${CMAKE_COMMAND} -S "${SOURCE_DIR}/tests/consumer" -B "${WORK_DIR}/build"
     -DCMAKE_BUILD_TYPE=${BUILD_TYPE} -DCMAKE_CXX_COMPILER=${CXX}
-    -DCMAKE_PREFIX_PATH=${prefix} -DCMAKE_FIND_PACKAGE_NO_PACKAGE_REGISTRY=ON)
+    -DCMAKE_PREFIX_PATH=${prefix} -DCMAKE_FIND_PACKAGE_NO_PACKAGE_REGISTRY=ON
+    "-DCMAKE_CXX_FLAGS=${CXX_FLAGS}" "-DCMAKE_EXE_LINKER_FLAGS=${EXE_LINKER_FLAGS}")
 run(${CMAKE_COMMAND} --build "${WORK_DIR}/build" -j1)
 run("${WORK_DIR}/build/consumer_shared")
 run("${WORK_DIR}/build/consumer_static")
@@ -41,6 +43,7 @@ if(NOT rc EQUAL 0 OR flags STREQUAL "")
 endif()
 message(STATUS "pkg-config flags: ${flags}")
 separate_arguments(flags UNIX_COMMAND "${flags}")
-run(${CXX} -O1 "${SOURCE_DIR}/tests/consumer/main.cc" -o "${WORK_DIR}/consumer_pkgconfig"
+separate_arguments(extra UNIX_COMMAND "${CXX_FLAGS} ${EXE_LINKER_FLAGS}")
+run(${CXX} -O1 ${extra} "${SOURCE_DIR}/tests/consumer/main.cc" -o "${WORK_DIR}/consumer_pkgconfig"
     ${flags} "-Wl,-rpath,${libdir}")
 run("${WORK_DIR}/consumer_pkgconfig")
