@@ -16,7 +16,7 @@ namespace nonbloppy {
 /// particles): values[i * components + c] is component c of vertex i.
 struct MeshAttribute
 {
-    std::string name;
+    std::string name;            ///< as the particles' attribute, e.g. "velocity"
     int components = 1;          ///< 1 for scalars, 3 for vectors, ...
     std::vector<float> values;   ///< points.size() × components values, vertex-major
 };

@@ -1,0 +1,6 @@
+// SPDX-License-Identifier: Apache-2.0
+// libFuzzer target: io_internal::readJsonParticles on arbitrary bytes.
+#include "FuzzReader.h"
+#include "ParticleReaders.h"
+
+NONBLOPPY_FUZZ_READER(nonbloppy::io_internal::readJsonParticles(data, size, "fuzz"))
