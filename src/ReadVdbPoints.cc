@@ -5,9 +5,11 @@
 ///        attribute of a numeric or vector type, by name. Group and string attributes have
 ///        no ParticleAttribute counterpart and are skipped.
 ///
-/// The bytes are read through openvdb::io::Stream from memory, so the reader never opens
-/// the file twice and the fuzz target can feed it bytes. Points are visited leaf by leaf in
-/// tree order, so the particle order is the same on every run.
+/// The bytes are read from memory the way openvdb::io::Stream reads them, grid by grid, so
+/// the reader never opens the file twice and the fuzz target can feed it bytes; before
+/// OpenVDB reads a header, metadata or grid descriptor, every size in it is checked against
+/// the bytes present (VdbSizeCheck). Points are visited leaf by leaf in tree order, so the
+/// particle order is the same on every run.
 
 #include "FileFormats.h"
 #include "ParticleReaders.h"
@@ -17,13 +19,19 @@
 // OpenVDB's point templates must keep default visibility, as src/VisibilityPrelude.h
 // explains for the grid types it covers (else openvdb::initialize() crashes).
 #pragma GCC visibility push(default)
-#include <openvdb/io/Stream.h>
+#include <openvdb/io/Archive.h>
+#include <openvdb/io/DelayedLoadMetadata.h>
+#include <openvdb/io/GridDescriptor.h>
+#include <openvdb/io/io.h>
+#include <openvdb/math/Maps.h>
 #include <openvdb/openvdb.h>
 #include <openvdb/points/PointDataGrid.h>
 #pragma GCC visibility pop
 
 #include <algorithm>
+#include <cctype>
 #include <cstring>
+#include <limits>
 #include <sstream>
 
 namespace nonbloppy {
@@ -126,21 +134,266 @@ convertGrid(const PointDataGrid& grid, const std::string& path)
     return particles;
 }
 
+// ------------------------------------------------------------------------------------------
+// Reading the stream with every size OpenVDB would trust checked first
+
+/// Checks the parts of a .vdb stream in which OpenVDB (io::Stream, MetaMap, GridDescriptor,
+/// math::Transform) allocates as much as a number in the file says before reading the bytes:
+/// string lengths (util/Name.h readString), metadata values (StringMetadata, UnknownMetadata,
+/// io::DelayedLoadMetadata) and the grid count. Each size must fit in the bytes left, so a
+/// crafted header cannot make libopenvdb allocate gigabytes before it fails. It walks the same
+/// bytes OpenVDB will read next; the caller positions it from the stream (seek()).
+///
+/// It cannot check a grid's tree (node masks, compressed value blocks, point attribute
+/// arrays): that would mean reimplementing OpenVDB's tree and points I/O (tests/fuzz/README.md).
+class VdbSizeCheck
+{
+public:
+    VdbSizeCheck(const unsigned char* data, size_t size, const std::string& path)
+        : mData(data), mSize(size), mPath(path) {}
+
+    void seek(size_t pos) { mPos = std::min(pos, mSize); }
+    size_t pos() const { return mPos; }
+
+    /// The header io::Archive::readHeader() reads; returns the file format version.
+    uint32_t header()
+    {
+        static const unsigned char kMagic[8] = {0x20, 0x42, 0x44, 0x56, 0, 0, 0, 0};
+        if (mSize < 8 || std::memcmp(mData, kMagic, 8) != 0) corrupt("not a VDB file");
+        mPos = 8;
+        const uint32_t version = u32("header");
+        // PointDataGrids came with file format 223 or later; the per-grid compression
+        // flags (222) are the oldest layout walked here.
+        if (version < openvdb::OPENVDB_FILE_VERSION_NODE_MASK_COMPRESSION) {
+            corrupt("unsupported file format version " + std::to_string(version) +
+                    " (point data grids need 223 or later)");
+        }
+        skip(4 + 4 + 1, "header");  // library major, minor; has-grid-offsets flag
+        // The UUID as text, 8-4-4-4-12 hex digits (boost::uuids' stream format).
+        need(36, "header");
+        for (size_t i = 0; i < 36; ++i) {
+            const char c = char(mData[mPos + i]);
+            const bool dash = i == 8 || i == 13 || i == 18 || i == 23;
+            if (dash ? c != '-' : !std::isxdigit(static_cast<unsigned char>(c))) corrupt("bad UUID in header");
+        }
+        mPos += 36;
+        return version;
+    }
+
+    /// A MetaMap (MetaMap::readMeta): count, then name, type name and value per item.
+    /// @a owner is "the file" or "grid '<name>'".
+    void metaMap(const std::string& owner)
+    {
+        const uint32_t count = u32("metadata of " + owner);
+        // An item takes at least 12 bytes (two string lengths and a value size).
+        if (count > left() / 12) {
+            corrupt("metadata of " + owner + " claims " + std::to_string(count) + " items");
+        }
+        for (uint32_t i = 0; i < count; ++i) {
+            const std::string name = string("a metadata name of " + owner);
+            const std::string item = "metadata '" + printable(name) + "' of " + owner;
+            const std::string type = string("type name of " + item);
+            const uint32_t bytes = u32(item);
+            if (bytes > left()) {
+                corrupt(item + " claims " + std::to_string(bytes) + " bytes, " +
+                        std::to_string(left()) + " left");
+            }
+            const size_t valueStart = mPos;
+            if (type == openvdb::io::DelayedLoadMetadata::staticTypeName()) {
+                delayedLoadValue(bytes, item);
+            } else if (type != openvdb::StringMetadata::staticTypeName()
+                       && openvdb::Metadata::isRegisteredType(type)) {
+                // TypedMetadata<T> reads sizeof(T) bytes whatever the size says.
+                const uint32_t expected = openvdb::Metadata::createMetadata(type)->size();
+                if (bytes != expected) {
+                    corrupt(item + " of type " + printable(type) + " has " + std::to_string(bytes) +
+                            " bytes, expected " + std::to_string(expected));
+                }
+            }
+            // Strings and unknown types are read as the size says.
+            mPos = std::max(mPos, valueStart + bytes);
+        }
+    }
+
+    /// A GridDescriptor (GridDescriptor::read): unique name, type, instance parent, offsets.
+    void gridDescriptor(uint32_t version)
+    {
+        const std::string name = string("grid name");
+        const std::string grid = "grid '" + printable(name) + "'";
+        string("type name of " + grid);
+        if (version >= openvdb::OPENVDB_FILE_VERSION_GRID_INSTANCING) string("instance parent of " + grid);
+        skip(3 * 8, grid + " descriptor");
+    }
+
+    /// What io::Archive::readGrid() reads before the tree: compression flags, the grid's
+    /// MetaMap, and the transform's map type names (a frustum map nests a second map).
+    void gridHeader(const std::string& name)
+    {
+        const std::string grid = "grid '" + printable(name) + "'";
+        skip(4, grid + " compression flags");
+        metaMap(grid);
+        std::string map = string("transform of " + grid);
+        while (map == openvdb::math::NonlinearFrustumMap::mapType()) {
+            skip(6 * 8 + 2 * 8, "frustum transform of " + grid);  // bbox, taper, depth
+            map = string("transform of " + grid);
+        }
+    }
+
+    /// Also used for the grid count.
+    uint32_t u32(const std::string& what)
+    {
+        need(4, what);
+        uint32_t value;
+        std::memcpy(&value, mData + mPos, 4);
+        mPos += 4;
+        return value;
+    }
+
+    size_t left() const { return mSize - mPos; }
+
+    [[noreturn]] void corrupt(const std::string& what) const
+    {
+        fail(mPath, "cannot read .vdb file: " + what);
+    }
+
+private:
+    void need(uint64_t bytes, const std::string& what) const
+    {
+        if (bytes > left()) corrupt("truncated " + what);
+    }
+    void skip(uint64_t bytes, const std::string& what)
+    {
+        need(bytes, what);
+        mPos += size_t(bytes);
+    }
+    std::string string(const std::string& what)
+    {
+        const uint32_t length = u32(what);
+        if (length > left()) {
+            corrupt(what + " claims " + std::to_string(length) + " bytes, " +
+                    std::to_string(left()) + " left");
+        }
+        std::string text(reinterpret_cast<const char*>(mData + mPos), length);
+        mPos += length;
+        return text;
+    }
+
+    /// io::DelayedLoadMetadata::readValue(): a leaf count, then a mask of one byte per leaf
+    /// and optionally a compressed size of 8 bytes per leaf, each raw or Blosc-compressed.
+    /// OpenVDB sizes its arrays from the count and from the Blosc headers.
+    void delayedLoadValue(uint32_t bytes, const std::string& item)
+    {
+        if (bytes == 0) return;
+        const uint32_t count = u32(item);
+        // A leaf takes far more than one byte of the file.
+        if (count > mSize) corrupt(item + " claims " + std::to_string(count) + " leaves");
+        for (int array = 0; array < 2; ++array) {
+            const uint64_t width = array == 0 ? 1 : 8;
+            const uint32_t compressed = u32(item);
+            if (array == 1 && compressed == std::numeric_limits<uint32_t>::max()) break;
+            if (compressed == 0) {
+                skip(uint64_t(count) * width, item);
+                continue;
+            }
+            // A Blosc chunk starts with a 16-byte header whose bytes 4..7 hold the
+            // uncompressed size (little-endian).
+            if (compressed < 16 || compressed > left()) corrupt("bad compressed array in " + item);
+            uint32_t uncompressed;
+            std::memcpy(&uncompressed, mData + mPos + 4, 4);
+            if (uncompressed != uint64_t(count) * width) corrupt("bad compressed array in " + item);
+            mPos += compressed;
+        }
+    }
+
+    const unsigned char* mData;
+    size_t mSize;
+    size_t mPos = 0;
+    const std::string& mPath;
+};
+
+/// io::Stream's reading, grid by grid, with VdbSizeCheck run on each part before OpenVDB
+/// reads it; stops at the first PointDataGrid. (io::Archive's protected readers are the
+/// same ones io::Stream uses.)
+class CheckedVdbStream : public openvdb::io::Archive
+{
+public:
+    /// The grids read, the last of them the first PointDataGrid if there is one.
+    openvdb::GridPtrVec read(const char* data, size_t size, const std::string& path)
+    {
+        VdbSizeCheck check(reinterpret_cast<const unsigned char*>(data), size, path);
+        std::istringstream is(std::string(data, size), std::ios::in | std::ios::binary);
+        // OpenVDB does not check its reads: past the end it would go on with uninitialised
+        // sizes. A short read throws instead.
+        is.exceptions(std::ios::failbit | std::ios::badbit);
+        auto position = [&]() -> size_t {
+            const std::streamoff pos = is ? std::streamoff(is.tellg()) : std::streamoff(-1);
+            if (pos < 0 || size_t(pos) > size) check.corrupt("truncated stream");
+            return size_t(pos);
+        };
+        auto expectAt = [&](size_t pos, const char* what) {
+            if (position() != pos) check.corrupt(std::string("unexpected layout of ") + what);
+        };
+
+        const uint32_t version = check.header();
+        readHeader(is);
+        expectAt(check.pos(), "the header");
+        openvdb::io::StreamMetadata::Ptr streamMetadata(new openvdb::io::StreamMetadata);
+        openvdb::io::setStreamMetadataPtr(is, streamMetadata, /*transfer=*/false);
+        openvdb::io::setVersion(is, libraryVersion(), fileVersion());
+        openvdb::io::setDataCompression(is, compression());
+
+        check.metaMap("the file");
+        openvdb::MetaMap fileMetadata;
+        fileMetadata.readMeta(is);
+        expectAt(check.pos(), "the file metadata");
+
+        const uint32_t gridCount = check.u32("grid count");
+        // A grid takes at least its descriptor (three strings and three offsets).
+        if (gridCount > check.left() / 36) {
+            check.corrupt("grid count " + std::to_string(int32_t(gridCount)) + " does not fit in the file");
+        }
+        readGridCount(is);
+
+        openvdb::GridPtrVec grids;
+        NamedGridMap namedGrids;
+        for (uint32_t i = 0; i < gridCount; ++i) {
+            check.seek(position());
+            check.gridDescriptor(version);
+            openvdb::io::GridDescriptor descriptor;
+            descriptor.read(is);
+            expectAt(check.pos(), "a grid descriptor");
+            check.gridHeader(descriptor.uniqueName());
+
+            if (!openvdb::GridBase::isRegistered(descriptor.gridType())) {
+                check.corrupt("unknown grid type '" + printable(descriptor.gridType()) + "'");
+            }
+            openvdb::GridBase::Ptr grid = openvdb::GridBase::createGrid(descriptor.gridType());
+            grid->setSaveFloatAsHalf(descriptor.saveFloatAsHalf());
+            readGrid(grid, descriptor, is);
+            grids.push_back(grid);
+            namedGrids[descriptor.uniqueName()] = grid;
+            connectInstance(descriptor, namedGrids);
+            if (openvdb::gridConstPtrCast<PointDataGrid>(grid)) break;
+        }
+        return grids;
+    }
+};
+
 } // namespace
 
 ParticleSet
 readVdbPointsParticles(const char* data, size_t size, const std::string& path)
 {
     openvdb::initialize();
-    openvdb::GridPtrVecPtr grids;
+    openvdb::GridPtrVec grids;
     try {
-        std::istringstream stream(std::string(data, size), std::ios::in | std::ios::binary);
-        openvdb::io::Stream vdbStream(stream, /*delayLoad=*/false);
-        grids = vdbStream.getGrids();
+        grids = CheckedVdbStream().read(data, size, path);
     } catch (const Error&) {
         throw;
     } catch (const std::bad_alloc&) {
         fail(path, "corrupt .vdb file: it asks for more memory than there is");
+    } catch (const std::ios_base::failure&) {
+        fail(path, "cannot read .vdb file: truncated stream");
     } catch (const std::exception& e) {
         std::string message = e.what();
         for (char& ch : message) {
@@ -148,21 +401,17 @@ readVdbPointsParticles(const char* data, size_t size, const std::string& path)
         }
         fail(path, "cannot read .vdb file: " + message);
     }
-    if (grids) {
-        for (const openvdb::GridBase::Ptr& grid : *grids) {
-            if (const auto points = openvdb::gridConstPtrCast<PointDataGrid>(grid)) {
-                return convertGrid(*points, path);
-            }
+    for (const openvdb::GridBase::Ptr& grid : grids) {
+        if (const auto points = openvdb::gridConstPtrCast<PointDataGrid>(grid)) {
+            return convertGrid(*points, path);
         }
     }
     fail(path, "no PointDataGrid in this .vdb file (grids: " +
          [&] {
              std::string names;
-             if (grids) {
-                 for (const auto& grid : *grids) {
-                     if (!names.empty()) names += ", ";
-                     names += printable(grid->getName()) + " " + grid->valueType();
-                 }
+             for (const auto& grid : grids) {
+                 if (!names.empty()) names += ", ";
+                 names += printable(grid->getName()) + " " + grid->valueType();
              }
              return names.empty() ? std::string("none") : names;
          }() + "); a density cache cannot be meshed as particles");

@@ -105,6 +105,7 @@ struct VtuFile
     const unsigned char* appended = nullptr;  ///< after the '_'
     size_t appendedSize = 0;
     size_t fileSize = 0;
+    uint64_t decodedBytes = 0;  ///< all arrays decoded so far
 };
 
 uint64_t
@@ -252,12 +253,15 @@ readAsciiArray(std::string_view text, size_t values, ScalarType type, const VtuF
 /// The values of one DataArray, native byte order: tuples × components × type size bytes.
 std::vector<unsigned char>
 readDataArray(const pugi::xml_node& node, size_t tuples, ScalarType type, int components,
-              const VtuFile& file, const std::string& what)
+              VtuFile& file, const std::string& what)
 {
     const size_t width = scalarSize(type);
     const uint64_t expected = uint64_t(tuples) * uint64_t(components) * width;
-    // No encoding packs data tighter than deflate's ratio.
-    if (expected > uint64_t(file.fileSize) * kMaxInflateRatio + 1024) {
+    // No encoding packs data tighter than deflate's ratio; that bounds all arrays together
+    // too, since pieces could otherwise decode the same appended bytes again and again.
+    file.decodedBytes += expected;
+    if (expected > uint64_t(file.fileSize) * kMaxInflateRatio + 1024
+        || file.decodedBytes > uint64_t(file.fileSize) * kMaxInflateRatio + 1024) {
         fail(file.path, "truncated " + what + ": the file is too small for " +
              std::to_string(tuples) + " tuples");
     }
