@@ -7,9 +7,10 @@
 ///
 /// The bytes are read from memory the way openvdb::io::Stream reads them, grid by grid, so
 /// the reader never opens the file twice and the fuzz target can feed it bytes; before
-/// OpenVDB reads a header, metadata or grid descriptor, every size in it is checked against
-/// the bytes present (VdbSizeCheck). Points are visited leaf by leaf in tree order, so the
-/// particle order is the same on every run.
+/// OpenVDB reads a header, metadata, grid descriptor, transform or a PointDataGrid's tree
+/// topology, every size in it is checked against the bytes present (VdbSizeCheck), and grids
+/// that are not needed are skipped unread when the file says where they end. Points are
+/// visited leaf by leaf in tree order, so the particle order is the same on every run.
 
 #include "FileFormats.h"
 #include "ParticleReaders.h"
@@ -144,8 +145,11 @@ convertGrid(const PointDataGrid& grid, const std::string& path)
 /// crafted header cannot make libopenvdb allocate gigabytes before it fails. It walks the same
 /// bytes OpenVDB will read next; the caller positions it from the stream (seek()).
 ///
-/// It cannot check a grid's tree (node masks, compressed value blocks, point attribute
-/// arrays): that would mean reimplementing OpenVDB's tree and points I/O (tests/fuzz/README.md).
+/// For a PointDataGrid it also walks the tree's topology (root, internal and leaf nodes),
+/// where every node's values come as a chunk whose size io::bloscFromStream/unzipFromStream
+/// allocate before reading. It cannot check the leaves' buffers (attribute descriptors,
+/// paged attribute arrays, voxel offsets): that would mean reimplementing OpenVDB's points
+/// I/O (tests/fuzz/README.md).
 class VdbSizeCheck
 {
 public:
@@ -168,7 +172,9 @@ public:
             corrupt("unsupported file format version " + std::to_string(version) +
                     " (point data grids need 223 or later)");
         }
-        skip(4 + 4 + 1, "header");  // library major, minor; has-grid-offsets flag
+        skip(4 + 4, "header");  // library major, minor
+        need(1, "header");
+        mHasGridOffsets = mData[mPos++] != 0;
         // The UUID as text, 8-4-4-4-12 hex digits (boost::uuids' stream format).
         need(36, "header");
         for (size_t i = 0; i < 36; ++i) {
@@ -225,18 +231,124 @@ public:
         skip(3 * 8, grid + " descriptor");
     }
 
+    bool hasGridOffsets() const { return mHasGridOffsets; }
+
     /// What io::Archive::readGrid() reads before the tree: compression flags, the grid's
-    /// MetaMap, and the transform's map type names (a frustum map nests a second map).
-    void gridHeader(const std::string& name)
+    /// MetaMap and transform; then, for a PointDataGrid, the tree's topology.
+    void grid(const std::string& name, bool pointDataGrid)
     {
         const std::string grid = "grid '" + printable(name) + "'";
-        skip(4, grid + " compression flags");
+        const uint32_t compression = u32(grid + " compression flags");
         metaMap(grid);
-        std::string map = string("transform of " + grid);
-        while (map == openvdb::math::NonlinearFrustumMap::mapType()) {
-            skip(6 * 8 + 2 * 8, "frustum transform of " + grid);  // bbox, taper, depth
-            map = string("transform of " + grid);
+        transform(grid);
+        if (pointDataGrid) pointTreeTopology(compression, "tree of " + grid);
+    }
+
+    /// math::Transform::read(): the map's type name, then its fields (a frustum map nests
+    /// a second map).
+    void transform(const std::string& grid)
+    {
+        using namespace openvdb::math;
+        const std::string what = "transform of " + grid;
+        for (;;) {
+            const std::string map = string(what);
+            if (map == NonlinearFrustumMap::mapType()) {
+                skip(6 * 8 + 2 * 8, what);  // bounding box, taper, depth
+                continue;
+            }
+            // The fields each map type's read() reads: Mat4d, or Vec3d translation and the
+            // five Vec3d of a scale.
+            const uint64_t bytes =
+                (map == AffineMap::mapType() || map == UnitaryMap::mapType()) ? 16 * 8
+                : (map == ScaleMap::mapType() || map == UniformScaleMap::mapType()) ? 5 * 24
+                : (map == ScaleTranslateMap::mapType() || map == UniformScaleTranslateMap::mapType()) ? 6 * 24
+                : map == TranslationMap::mapType() ? 24 : 0;
+            if (bytes == 0) corrupt("unknown map type '" + printable(map) + "' in " + what);
+            skip(bytes, what);
+            return;
         }
+    }
+
+    /// Tree::readTopology() of a PointDataGrid (5-4-3 tree of 4-byte PointDataIndex32):
+    /// buffer count, root background, tiles, then each child's subtree.
+    void pointTreeTopology(uint32_t compression, const std::string& what)
+    {
+        skip(4 + 4, what);  // buffer count, background
+        const uint32_t tiles = u32(what);
+        const uint32_t children = u32(what);
+        if (tiles > left() / 17) {
+            corrupt(what + " claims " + std::to_string(tiles) + " root tiles in " +
+                    std::to_string(left()) + " bytes");
+        }
+        skip(uint64_t(tiles) * 17, what);  // origin, value, active flag
+        // A root child takes its origin and two 4096-byte masks at least.
+        if (children > left() / (12 + 8192)) {
+            corrupt(what + " claims " + std::to_string(children) + " root children in " +
+                    std::to_string(left()) + " bytes");
+        }
+        for (uint32_t i = 0; i < children; ++i) {
+            skip(12, what);
+            internalNode(5, compression, what);
+        }
+    }
+
+    /// InternalNode::readTopology(): child and value masks, the values, then the children
+    /// (level 4 nodes below a level 5 node; leaves, of which the topology is a 64-byte
+    /// value mask, below a level 4 node).
+    void internalNode(int log2Dim, uint32_t compression, const std::string& what)
+    {
+        const size_t maskBytes = (size_t(1) << (3 * log2Dim)) / 8;
+        need(2 * maskBytes, what);
+        const size_t childCount = bitCount(mData + mPos, maskBytes);
+        const size_t activeCount = bitCount(mData + mPos + maskBytes, maskBytes);
+        mPos += 2 * maskBytes;
+        compressedValues(size_t(1) << (3 * log2Dim), activeCount, maskBytes, compression, what);
+        for (size_t c = 0; c < childCount; ++c) {
+            if (log2Dim == 5) internalNode(4, compression, what);
+            else skip(64, what);
+        }
+    }
+
+    /// io::readCompressedValues() of @a count 4-byte values: a flag saying what follows,
+    /// up to two inactive values, a selection mask, then the (active) values as one chunk.
+    void compressedValues(size_t count, size_t activeCount, size_t maskBytes,
+                          uint32_t compression, const std::string& what)
+    {
+        need(1, what);
+        const int8_t flag = static_cast<int8_t>(mData[mPos++]);
+        if (flag == 2 || flag == 4 || flag == 5) skip(flag == 5 ? 8 : 4, what);
+        if (flag == 3 || flag == 4 || flag == 5) skip(maskBytes, what);
+        if ((compression & openvdb::io::COMPRESS_ACTIVE_MASK) && flag != 6) count = activeCount;
+        const uint64_t bytes = uint64_t(count) * 4;
+        if (!(compression & (openvdb::io::COMPRESS_BLOSC | openvdb::io::COMPRESS_ZIP))) {
+            skip(bytes, what);
+            return;
+        }
+        // io::bloscFromStream / unzipFromStream: an int64 size, negative for raw bytes.
+        need(8, what);
+        int64_t chunk;
+        std::memcpy(&chunk, mData + mPos, 8);
+        mPos += 8;
+        if (chunk <= 0) {
+            if (uint64_t(0) - uint64_t(chunk) != bytes) {
+                corrupt("uncompressed chunk of " + std::to_string(uint64_t(0) - uint64_t(chunk)) +
+                        " bytes in " + what + ", expected " + std::to_string(bytes));
+            }
+            skip(bytes, what);
+            return;
+        }
+        if (uint64_t(chunk) > left()) {
+            corrupt("compressed chunk in " + what + " claims " + std::to_string(chunk) +
+                    " bytes, " + std::to_string(left()) + " left");
+        }
+        mPos += size_t(chunk);
+    }
+
+    static size_t bitCount(const unsigned char* bytes, size_t size)
+    {
+        size_t n = 0;
+        for (size_t i = 0; i < size; ++i) n += size_t(__builtin_popcount(bytes[i]));
+        return n;
     }
 
     /// Also used for the grid count.
@@ -309,6 +421,7 @@ private:
     size_t mSize;
     size_t mPos = 0;
     const std::string& mPath;
+    bool mHasGridOffsets = false;
 };
 
 /// io::Stream's reading, grid by grid, with VdbSizeCheck run on each part before OpenVDB
@@ -362,12 +475,23 @@ public:
             openvdb::io::GridDescriptor descriptor;
             descriptor.read(is);
             expectAt(check.pos(), "a grid descriptor");
-            check.gridHeader(descriptor.uniqueName());
-
             if (!openvdb::GridBase::isRegistered(descriptor.gridType())) {
                 check.corrupt("unknown grid type '" + printable(descriptor.gridType()) + "'");
             }
             openvdb::GridBase::Ptr grid = openvdb::GridBase::createGrid(descriptor.gridType());
+            const bool pointDataGrid = descriptor.gridType() == PointDataGrid::gridType();
+            // Other grids are not needed: where the file says where they end, skip them
+            // unread (only their names and types are kept, for the error message).
+            if (!pointDataGrid && check.hasGridOffsets() && descriptor.getEndPos() > 0
+                && uint64_t(descriptor.getEndPos()) >= check.pos()
+                && uint64_t(descriptor.getEndPos()) <= size) {
+                grid->setName(descriptor.gridName());
+                grids.push_back(grid);
+                is.seekg(descriptor.getEndPos());
+                continue;
+            }
+            // An instance shares its parent's tree; the file stores none for it.
+            check.grid(descriptor.uniqueName(), pointDataGrid && !descriptor.isInstance());
             grid->setSaveFloatAsHalf(descriptor.saveFloatAsHalf());
             readGrid(grid, descriptor, is);
             grids.push_back(grid);
