@@ -1,34 +1,52 @@
 // SPDX-License-Identifier: Apache-2.0
 #include <nonbloppy/ComputeNormals.h>
 
+#include "Cancellation.h"
+
 #include <tbb/parallel_for.h>
 
 namespace nonbloppy {
 
-void computeNormals(SurfaceMesh& mesh)
+namespace cancellation_internal {
+
+void computeNormals(SurfaceMesh& mesh, CancelPoll& poll)
 {
     const std::vector<openvdb::Vec3s>& p = mesh.points;
     // Accumulate in double and in polygon order, so the result is deterministic; twice the
     // area-weighted normal is the cross product of a triangle's edges, or of a quad's diagonals.
     std::vector<openvdb::Vec3d> sums(p.size(), openvdb::Vec3d(0.0));
-    for (const openvdb::Vec3I& t : mesh.triangles) {
+    for (size_t n = 0; n < mesh.triangles.size(); ++n) {
+        if (poll.stoppedAt(n)) poll.throwIfStopped();
+        const openvdb::Vec3I& t = mesh.triangles[n];
         const openvdb::Vec3d a(p[t[0]]), b(p[t[1]]), c(p[t[2]]);
-        const openvdb::Vec3d n = (b - a).cross(c - a);
-        sums[t[0]] += n; sums[t[1]] += n; sums[t[2]] += n;
+        const openvdb::Vec3d normal = (b - a).cross(c - a);
+        sums[t[0]] += normal; sums[t[1]] += normal; sums[t[2]] += normal;
     }
-    for (const openvdb::Vec4I& q : mesh.quads) {
+    for (size_t n = 0; n < mesh.quads.size(); ++n) {
+        if (poll.stoppedAt(n)) poll.throwIfStopped();
+        const openvdb::Vec4I& q = mesh.quads[n];
         const openvdb::Vec3d a(p[q[0]]), b(p[q[1]]), c(p[q[2]]), d(p[q[3]]);
-        const openvdb::Vec3d n = (c - a).cross(d - b);
-        sums[q[0]] += n; sums[q[1]] += n; sums[q[2]] += n; sums[q[3]] += n;
+        const openvdb::Vec3d normal = (c - a).cross(d - b);
+        sums[q[0]] += normal; sums[q[1]] += normal; sums[q[2]] += normal; sums[q[3]] += normal;
     }
     mesh.normals.resize(p.size());
     tbb::parallel_for(tbb::blocked_range<size_t>(0, p.size()),
         [&](const tbb::blocked_range<size_t>& range) {
             for (size_t i = range.begin(); i < range.end(); ++i) {
+                if (poll.stoppedAt(i - range.begin())) return;
                 const double length = sums[i].length();
                 mesh.normals[i] = length > 0.0 ? openvdb::Vec3s(sums[i] / length) : openvdb::Vec3s(0.0f);
             }
         });
+    poll.throwIfStopped();
+}
+
+} // namespace cancellation_internal
+
+void computeNormals(SurfaceMesh& mesh, openvdb::util::NullInterrupter* interrupter)
+{
+    cancellation_internal::CancelPoll poll(interrupter, "compute normals");
+    cancellation_internal::computeNormals(mesh, poll);
 }
 
 } // namespace nonbloppy

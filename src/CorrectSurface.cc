@@ -9,6 +9,8 @@
 #include <nonbloppy/MeasureMesh.h>
 #include <nonbloppy/ComputeNormals.h>
 
+#include "Cancellation.h"
+
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
@@ -18,6 +20,8 @@
 namespace nonbloppy {
 
 namespace {
+
+using cancellation_internal::CancelPoll;
 
 /// Lattice cell sampled on a kSamples × kSamples grid, as calibrateThreshold() does.
 constexpr int kSamples = 8;
@@ -93,12 +97,19 @@ inline openvdb::Vec3d triangleNormal(const openvdb::Vec3s& a, const openvdb::Vec
     return (pb - pa).cross(pc - pa);
 }
 
-/// Call @a op(i, j, k) for every triangle of the mesh (quads split along 0–2).
+/// Call @a op(i, j, k) for every triangle of the mesh (quads split along 0–2); asks @a poll
+/// every kItemsPerPoll polygons and throws its CancelledError on a stop.
 template<typename OpT>
-void forEachTriangle(const SurfaceMesh& mesh, OpT&& op)
+void forEachTriangle(const SurfaceMesh& mesh, CancelPoll& poll, OpT&& op)
 {
-    for (const openvdb::Vec3I& t : mesh.triangles) op(t[0], t[1], t[2]);
-    for (const openvdb::Vec4I& q : mesh.quads) {
+    for (size_t n = 0; n < mesh.triangles.size(); ++n) {
+        if (poll.stoppedAt(n)) poll.throwIfStopped();
+        const openvdb::Vec3I& t = mesh.triangles[n];
+        op(t[0], t[1], t[2]);
+    }
+    for (size_t n = 0; n < mesh.quads.size(); ++n) {
+        if (poll.stoppedAt(n)) poll.throwIfStopped();
+        const openvdb::Vec4I& q = mesh.quads[n];
         op(q[0], q[1], q[2]);
         op(q[0], q[2], q[3]);
     }
@@ -115,11 +126,11 @@ void requireSameSize(const SurfaceMesh& mesh, const std::vector<openvdb::Vec3s>&
 
 /// Mark the vertices of folded triangles; return how many triangles are folded.
 size_t markFolded(const SurfaceMesh& mesh, const std::vector<openvdb::Vec3s>& before,
-                  std::vector<char>& marked)
+                  std::vector<char>& marked, CancelPoll& poll)
 {
     std::fill(marked.begin(), marked.end(), 0);
     size_t folded = 0;
-    forEachTriangle(mesh, [&](unsigned i, unsigned j, unsigned k) {
+    forEachTriangle(mesh, poll, [&](unsigned i, unsigned j, unsigned k) {
         const openvdb::Vec3d now = triangleNormal(mesh.points[i], mesh.points[j], mesh.points[k]);
         const openvdb::Vec3d then = triangleNormal(before[i], before[j], before[k]);
         if (now.dot(then) < 0.0) {
@@ -171,14 +182,17 @@ size_t countFoldedTriangles(const SurfaceMesh& mesh, const std::vector<openvdb::
 {
     requireSameSize(mesh, before);
     std::vector<char> marked(mesh.points.size());
-    return markFolded(mesh, before, marked);
+    CancelPoll never(nullptr, "correct surface");
+    return markFolded(mesh, before, marked, never);
 }
 
-size_t repairFolds(SurfaceMesh& mesh, const std::vector<openvdb::Vec3s>& before, int maxRounds)
+size_t repairFolds(SurfaceMesh& mesh, const std::vector<openvdb::Vec3s>& before, int maxRounds,
+                   openvdb::util::NullInterrupter* interrupter)
 {
     requireSameSize(mesh, before);
+    CancelPoll poll(interrupter, "correct surface");
     std::vector<char> marked(mesh.points.size());
-    const size_t first = markFolded(mesh, before, marked);
+    const size_t first = markFolded(mesh, before, marked, poll);
     size_t folded = first;
     for (int round = 0; folded > 0; ++round) {
         const bool last = round >= maxRounds;
@@ -187,7 +201,7 @@ size_t repairFolds(SurfaceMesh& mesh, const std::vector<openvdb::Vec3s>& before,
             mesh.points[i] = last ? before[i] : 0.5f * (mesh.points[i] + before[i]);
         }
         if (last) break;
-        folded = markFolded(mesh, before, marked);
+        folded = markFolded(mesh, before, marked, poll);
     }
     return first;
 }
@@ -204,22 +218,26 @@ void offsetSurface(SurfaceMesh& mesh, double distance)
         });
 }
 
-double preserveVolume(SurfaceMesh& mesh, double targetVolume, double maxDistance)
+double preserveVolume(SurfaceMesh& mesh, double targetVolume, double maxDistance,
+                      openvdb::util::NullInterrupter* interrupter)
 {
     if (!(targetVolume > 0.0) || !std::isfinite(targetVolume)) {
         std::ostringstream msg;
         msg << "target volume must be > 0, got " << targetVolume;
         throw ParameterError(msg.str());
     }
+    CancelPoll poll(interrupter, "correct surface");
     double total = 0.0;
     for (int pass = 0; pass < 2; ++pass) {
-        const MeshMeasures measures = measureMesh(mesh);
+        poll.throwIfStopped();
+        const MeshMeasures measures = measureMesh(mesh);  // serial, not interruptible
+        poll.throwIfStopped();
         if (!(measures.area > 0.0)) break;
         const double distance = std::clamp((targetVolume - measures.volume) / measures.area,
                                            -maxDistance - total, maxDistance - total);
         if (distance == 0.0) break;
         offsetSurface(mesh, distance);
-        computeNormals(mesh);
+        cancellation_internal::computeNormals(mesh, poll);
         total += distance;
     }
     return total;

@@ -1,4 +1,5 @@
 // SPDX-License-Identifier: Apache-2.0
+#include "Cancellation.h"
 #include "ParticleIndexImpl.h"
 
 #include <nonbloppy/CorrectSurface.h>
@@ -17,6 +18,8 @@ namespace nonbloppy {
 
 namespace {
 
+using cancellation_internal::CancelPoll;
+
 std::string formatNumber(double value)
 {
     std::ostringstream out;
@@ -25,9 +28,9 @@ std::string formatNumber(double value)
 }
 
 /// Nearest-neighbour distance of each sampled slot, searched within @a searchRadius;
-/// +inf where no other particle lies that close.
+/// +inf where no other particle lies that close. Unspecified after a stop of @a poll.
 std::vector<double> nearestWithin(const ParticleIndex& index, const std::vector<size_t>& samples,
-                                  double searchRadius)
+                                  double searchRadius, CancelPoll& poll)
 {
     using namespace particle_index_internal;
     const auto& positions = index.sortedPositions();
@@ -37,6 +40,8 @@ std::vector<double> nearestWithin(const ParticleIndex& index, const std::vector<
         [&](const tbb::blocked_range<size_t>& range) {
             auto accessor = grid.getConstAccessor();
             for (size_t i = range.begin(); i < range.end(); ++i) {
+                // A wide search visits thousands of particles per sample: ask every 16.
+                if ((i - range.begin()) % 16 == 0 && poll.stopped()) return;
                 const size_t self = samples[i];
                 const openvdb::Vec3d x = positions[self];
                 double best = searchRadius * searchRadius;
@@ -57,7 +62,10 @@ std::vector<double> nearestWithin(const ParticleIndex& index, const std::vector<
 
 } // namespace
 
-double estimateSpacing(const std::vector<openvdb::Vec3f>& positions, size_t maxSamples)
+namespace {
+
+double estimateSpacing(const std::vector<openvdb::Vec3f>& positions, size_t maxSamples, CancelPoll& poll,
+                       openvdb::util::NullInterrupter* interrupter)
 {
     if (positions.size() < 2) {
         throw ParameterError("cannot estimate the particle spacing from " +
@@ -65,7 +73,10 @@ double estimateSpacing(const std::vector<openvdb::Vec3f>& positions, size_t maxS
                              " particle(s); give --spacing or --radius, --threshold and --voxel-size");
     }
     openvdb::BBoxd bounds;
-    for (const openvdb::Vec3f& p : positions) bounds.expand(openvdb::Vec3d(p));
+    for (size_t n = 0; n < positions.size(); ++n) {
+        if (poll.stoppedAt(n)) poll.throwIfStopped();
+        bounds.expand(openvdb::Vec3d(positions[n]));
+    }
     const openvdb::Vec3d extent = bounds.extents();
     const double count = double(positions.size());
     // First guess: the spacing of the particles spread evenly over their bounding box (or
@@ -77,7 +88,12 @@ double estimateSpacing(const std::vector<openvdb::Vec3f>& positions, size_t maxS
         throw ParameterError("cannot estimate the particle spacing: all particles are at the same position");
     }
 
-    ParticleIndex index = ParticleIndex::build(positions, guess);
+    ParticleIndex index;
+    try {
+        index = ParticleIndex::build(positions, guess, interrupter);
+    } catch (const CancelledError&) {
+        throw CancelledError(std::string("interrupted during ") + poll.stage());  // this stage's name
+    }
     const size_t sampleCount = std::min(std::max<size_t>(maxSamples, 1), positions.size());
     std::vector<size_t> samples(sampleCount);
     for (size_t i = 0; i < sampleCount; ++i) samples[i] = i * positions.size() / sampleCount;
@@ -86,7 +102,8 @@ double estimateSpacing(const std::vector<openvdb::Vec3f>& positions, size_t maxS
     // exact once more than half the samples found one; otherwise widen the search.
     double radius = guess;
     for (int attempt = 0; attempt < 40; ++attempt, radius *= 2.0) {
-        std::vector<double> nearest = nearestWithin(index, samples, radius);
+        std::vector<double> nearest = nearestWithin(index, samples, radius, poll);
+        poll.throwIfStopped();
         const size_t middle = nearest.size() / 2;
         std::nth_element(nearest.begin(), nearest.begin() + middle, nearest.end());
         const double median = nearest[middle];
@@ -99,6 +116,15 @@ double estimateSpacing(const std::vector<openvdb::Vec3f>& positions, size_t maxS
         }
     }
     throw ParameterError("cannot estimate the particle spacing; give --spacing");
+}
+
+} // namespace
+
+double estimateSpacing(const std::vector<openvdb::Vec3f>& positions, size_t maxSamples,
+                       openvdb::util::NullInterrupter* interrupter)
+{
+    CancelPoll poll(interrupter, "estimate parameters");
+    return estimateSpacing(positions, maxSamples, poll, interrupter);
 }
 
 double calibrateThreshold(double effectiveRadiusOverSpacing)
@@ -130,8 +156,10 @@ double calibrateThreshold(double effectiveRadiusOverSpacing)
 }
 
 ResolvedParameters resolveParameters(const SurfaceParameters& params,
-                                     const std::vector<openvdb::Vec3f>& positions)
+                                     const std::vector<openvdb::Vec3f>& positions,
+                                     openvdb::util::NullInterrupter* interrupter)
 {
+    CancelPoll poll(interrupter, "estimate parameters");
     auto requirePositive = [](const std::optional<double>& value, const char* name) {
         if (value && (!(*value > 0.0) || !std::isfinite(*value))) {
             throw ParameterError(std::string(name) + " must be > 0, got " + formatNumber(*value));
@@ -163,7 +191,8 @@ ResolvedParameters resolveParameters(const SurfaceParameters& params,
 
     const bool needSpacing = !params.effectiveRadius || !params.threshold || !params.voxelSize;
     if (params.spacing) out.spacing = *params.spacing;
-    else if (needSpacing) out.spacing = estimateSpacing(positions);
+    else if (needSpacing) out.spacing = estimateSpacing(positions, kSpacingSamples, poll, interrupter);
+    poll.throwIfStopped();
 
     out.effectiveRadius = params.effectiveRadius ? *params.effectiveRadius
                                                  : kDefaultRadiusOverSpacing * out.spacing;
@@ -182,9 +211,12 @@ ResolvedParameters resolveParameters(const SurfaceParameters& params,
         out.preserveVolume = params.preserveVolume ? *params.preserveVolume : out.spacingGiven;
         out.repairFolds = params.repairFolds;
         // The volume target N·s³ needs s even when r_e, r_0 and h were all given.
-        if (out.preserveVolume && !(out.spacing > 0.0)) out.spacing = estimateSpacing(positions);
+        if (out.preserveVolume && !(out.spacing > 0.0)) {
+            out.spacing = estimateSpacing(positions, kSpacingSamples, poll, interrupter);
+        }
     }
 
+    poll.throwIfStopped();
     // The grid holds (2 r_e / h)³ voxels per particle: refuse sizes that would exhaust memory.
     constexpr double kMaxVoxelsPerRadius = 32.0;
     if (out.effectiveRadius / out.voxelSize > kMaxVoxelsPerRadius) {

@@ -3,6 +3,8 @@
 #include <nonbloppy/Error.h>
 #include <nonbloppy/ExtractSurface.h>
 
+#include "SurfaceStages.h"
+
 #include <openvdb/tools/VolumeToMesh.h>
 #include <openvdb/tree/LeafManager.h>
 #include <tbb/parallel_for.h>
@@ -16,8 +18,10 @@ namespace nonbloppy {
 
 namespace {
 
+/// volumeToMesh into @a mesh's vectors (it clears and resizes them, so they keep their
+/// capacity), then every polygon reversed; normals and attributes cleared.
 template<typename GridT>
-SurfaceMesh extract(const GridT& density, double threshold, double adaptivity)
+void extractInto(const GridT& density, double threshold, double adaptivity, SurfaceMesh& mesh)
 {
     if (!std::isfinite(threshold)) {
         std::ostringstream msg;
@@ -29,7 +33,6 @@ SurfaceMesh extract(const GridT& density, double threshold, double adaptivity)
         msg << "--adaptivity must lie in [0,1], got " << adaptivity;
         throw ParameterError(msg.str());
     }
-    SurfaceMesh mesh;
     openvdb::tools::volumeToMesh(density, mesh.points, mesh.triangles, mesh.quads, threshold, adaptivity);
     // The density grows inwards, the opposite of a level set, so volumeToMesh's polygons run
     // clockwise seen from outside: reverse each one.
@@ -41,7 +44,8 @@ SurfaceMesh extract(const GridT& density, double threshold, double adaptivity)
             }
         });
     for (openvdb::Vec3I& t : mesh.triangles) std::swap(t[0], t[2]);
-    return mesh;
+    mesh.normals.clear();
+    mesh.attributes.clear();
 }
 
 } // namespace
@@ -95,12 +99,26 @@ size_t tileDeepInterior(openvdb::FloatGrid& density, double threshold)
 
 SurfaceMesh extractSurface(const openvdb::FloatGrid& density, double threshold, double adaptivity)
 {
-    return extract(density, threshold, adaptivity);
+    SurfaceMesh mesh;
+    extractInto(density, threshold, adaptivity, mesh);
+    return mesh;
 }
 
 SurfaceMesh extractSurface(const openvdb::DoubleGrid& density, double threshold, double adaptivity)
 {
-    return extract(density, threshold, adaptivity);
+    SurfaceMesh mesh;
+    extractInto(density, threshold, adaptivity, mesh);
+    return mesh;
 }
+
+namespace surface_stages_internal {
+
+void extractSurfaceInto(const openvdb::FloatGrid& density, double threshold, double adaptivity,
+                        SurfaceMesh& mesh)
+{
+    extractInto(density, threshold, adaptivity, mesh);
+}
+
+} // namespace surface_stages_internal
 
 } // namespace nonbloppy

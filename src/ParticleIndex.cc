@@ -1,4 +1,5 @@
 // SPDX-License-Identifier: Apache-2.0
+#include "Cancellation.h"
 #include "ParticleIndexImpl.h"
 
 #include <nonbloppy/Error.h>
@@ -24,13 +25,15 @@ struct PositionList
     void getPos(size_t n, openvdb::Vec3R& xyz) const { xyz = positions[n]; }
 };
 
-/// Index of the first non-finite position, or size() if all are finite.
-size_t firstNonFinite(const std::vector<openvdb::Vec3f>& positions)
+/// Index of the first non-finite position, or size() if all are finite (unspecified after a
+/// stop of @a poll).
+size_t firstNonFinite(const std::vector<openvdb::Vec3f>& positions, cancellation_internal::CancelPoll& poll)
 {
     return tbb::parallel_reduce(
         tbb::blocked_range<size_t>(0, positions.size()), positions.size(),
         [&](const tbb::blocked_range<size_t>& range, size_t found) {
             for (size_t n = range.begin(); n < range.end() && n < found; ++n) {
+                if (poll.stoppedAt(n - range.begin())) return found;
                 const openvdb::Vec3f& p = positions[n];
                 if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2])) return n;
             }
@@ -52,7 +55,8 @@ const std::vector<uint32_t>& ParticleIndex::originalIndex() const { return mImpl
 double ParticleIndex::cellSize() const { return mImpl->cellSize; }
 openvdb::GridBase::ConstPtr ParticleIndex::indexGrid() const { return mImpl->grid; }
 
-ParticleIndex ParticleIndex::build(std::vector<openvdb::Vec3f> positions, double cellSize)
+ParticleIndex ParticleIndex::build(std::vector<openvdb::Vec3f> positions, double cellSize,
+                                   openvdb::util::NullInterrupter* interrupter)
 {
     using namespace particle_index_internal;
     openvdb::initialize();
@@ -64,7 +68,9 @@ ParticleIndex ParticleIndex::build(std::vector<openvdb::Vec3f> positions, double
     if (positions.size() > size_t(std::numeric_limits<uint32_t>::max())) {
         throw ParameterError("too many particles: at most 4294967295 are supported");
     }
-    const size_t bad = firstNonFinite(positions);
+    cancellation_internal::CancelPoll poll(interrupter, "index particles");
+    const size_t bad = firstNonFinite(positions, poll);
+    poll.throwIfStopped();
     if (bad < positions.size()) {
         std::ostringstream msg;
         msg << "non-finite position of particle " << bad;
@@ -72,7 +78,9 @@ ParticleIndex ParticleIndex::build(std::vector<openvdb::Vec3f> positions, double
     }
     // Index coordinates are 32-bit: refuse positions whose cell number would overflow.
     double maxAbs = 0.0;
-    for (const openvdb::Vec3f& p : positions) {
+    for (size_t n = 0; n < positions.size(); ++n) {
+        if (poll.stoppedAt(n)) poll.throwIfStopped();
+        const openvdb::Vec3f& p = positions[n];
         maxAbs = std::max({maxAbs, double(std::abs(p[0])), double(std::abs(p[1])), double(std::abs(p[2]))});
     }
     if (maxAbs / cellSize > 1.0e9) {
@@ -86,8 +94,11 @@ ParticleIndex ParticleIndex::build(std::vector<openvdb::Vec3f> positions, double
     Impl& impl = *index.mImpl;
     impl.cellSize = cellSize;
     const openvdb::math::Transform::Ptr transform = openvdb::math::Transform::createLinearTransform(cellSize);
+    // OpenVDB's partitioner takes no interrupter, and stopping its TBB context would leave
+    // its own serial steps working on partial counts: it runs to the end.
     impl.grid = openvdb::tools::createPointIndexGrid<openvdb::tools::PointIndexGrid>(
         PositionList{positions}, *transform);
+    poll.throwIfStopped();
 
     // Give every particle a sorted slot: leaves in tree order, then voxels in offset order,
     // then (sorted here, so the result never depends on the partitioner's threading)
@@ -102,6 +113,7 @@ ParticleIndex ParticleIndex::build(std::vector<openvdb::Vec3f> positions, double
     tbb::parallel_for(tbb::blocked_range<size_t>(0, leaves.leafCount()),
         [&](const tbb::blocked_range<size_t>& range) {
             for (size_t n = range.begin(); n < range.end(); ++n) {
+                if (poll.stopped()) return;  // a leaf holds up to a few thousand particles
                 IndexLeaf& leaf = leaves.leaf(n);
                 auto& indices = leaf.indices();
                 uint32_t begin = 0;
@@ -118,6 +130,7 @@ ParticleIndex ParticleIndex::build(std::vector<openvdb::Vec3f> positions, double
                 }
             }
         });
+    poll.throwIfStopped();
     return index;
 }
 

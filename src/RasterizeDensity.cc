@@ -1,4 +1,5 @@
 // SPDX-License-Identifier: Apache-2.0
+#include "Cancellation.h"
 #include "ParticleIndexImpl.h"
 
 #include <nonbloppy/Error.h>
@@ -8,6 +9,7 @@
 #include <openvdb/tree/LeafManager.h>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_sort.h>
 
 #include <atomic>
 #if defined(__SSE2__)
@@ -20,16 +22,22 @@ namespace nonbloppy {
 
 namespace {
 
+using cancellation_internal::CancelPoll;
 using FloatLeaf = openvdb::FloatTree::LeafNodeType;
 using particle_index_internal::IndexLeaf;
 using particle_index_internal::IndexTree;
 
+/// Density leaves of a task between two polls: a leaf gathers every particle within r_e of
+/// its 512 voxels, so a task of many leaves would otherwise run for milliseconds.
+constexpr size_t kLeavesPerPoll = 8;
+
 /// Origins of the density leaves that may hold a voxel within r_e of a particle: for each
 /// leaf of the particle index, the density leaves overlapping its active cells' bounding box
 /// grown by r_e. Sorted, so the leaf order (and thus everything after) is deterministic.
+/// On a stop (@a poll) the list is incomplete; the caller checks.
 std::vector<openvdb::Coord> candidateLeafOrigins(const ParticleIndex& particles,
                                                  const openvdb::math::Transform& transform,
-                                                 double effectiveRadius)
+                                                 double effectiveRadius, CancelPoll& poll)
 {
     const IndexTree& indexTree = particles.impl().grid->tree();
     const double cellSize = particles.cellSize();
@@ -39,6 +47,7 @@ std::vector<openvdb::Coord> candidateLeafOrigins(const ParticleIndex& particles,
         [&](const tbb::blocked_range<size_t>& range) {
             std::vector<openvdb::Coord>& origins = perThread.local();
             for (size_t n = range.begin(); n < range.end(); ++n) {
+                if (poll.stoppedAt(64 * (n - range.begin()))) return;  // every 64 index leaves
                 openvdb::CoordBBox cells;
                 leaves.leaf(n).evalActiveBoundingBox(cells, /*visitVoxels=*/true);
                 const openvdb::Vec3d worldMin = (cells.min().asVec3d() - 0.5) * cellSize - effectiveRadius;
@@ -55,8 +64,12 @@ std::vector<openvdb::Coord> candidateLeafOrigins(const ParticleIndex& particles,
             }
         });
     std::vector<openvdb::Coord> all;
+    if (poll.stopped()) return all;
     for (auto& origins : perThread) all.insert(all.end(), origins.begin(), origins.end());
-    std::sort(all.begin(), all.end());
+    // Coord's < is a total order, so the parallel sort gives std::sort's result; it can be
+    // stopped (hundreds of thousands of origins, tens of ms).
+    cancellation_internal::runStoppable(poll, [&] { tbb::parallel_sort(all.begin(), all.end()); });
+    if (poll.stopped()) return all;
     all.erase(std::unique(all.begin(), all.end()), all.end());
     return all;
 }
@@ -113,13 +126,11 @@ struct RasterizeLeafOp
     std::vector<FloatLeaf*>& results;
     double voxelSize;
     double effectiveRadius;
-    openvdb::util::NullInterrupter* interrupter;
-    std::atomic<bool>& cancelled;
+    CancelPoll& poll;
     std::atomic<size_t>& done;
 
     void operator()(const tbb::blocked_range<size_t>& range) const
     {
-        if (cancelled) return;
         const auto& positions = particles.sortedPositions();
         auto accessor = particles.impl().grid->getConstAccessor();
         const float h = float(voxelSize);
@@ -131,6 +142,7 @@ struct RasterizeLeafOp
         float values[FloatLeaf::SIZE];
 
         for (size_t n = range.begin(); n < range.end(); ++n) {
+            if ((n - range.begin()) % kLeavesPerPoll == 0 && poll.stopped()) return;
             const openvdb::Coord origin = origins[n];
             std::fill(values, values + FloatLeaf::SIZE, 0.0f);
             const openvdb::Vec3d leafMin = origin.asVec3d() * voxelSize;
@@ -177,10 +189,9 @@ struct RasterizeLeafOp
             if (!active) { delete leaf; leaf = nullptr; }
             results[n] = leaf;
         }
+        // Progress for the caller's display; a stop is remembered by the poll.
         const size_t finished = done.fetch_add(range.size()) + range.size();
-        if (interrupter && interrupter->wasInterrupted(int(100.0 * double(finished) / double(origins.size())))) {
-            cancelled = true;
-        }
+        poll.stopped(int(100.0 * double(finished) / double(origins.size())));
     }
 };
 
@@ -209,26 +220,31 @@ openvdb::FloatGrid::Ptr rasterizeDensity(const ParticleIndex& particles, const D
     const double voxelSize = transform->voxelSize()[0];
 
     if (interrupter) interrupter->start("rasterize density");
-    const std::vector<openvdb::Coord> origins = candidateLeafOrigins(particles, *transform, settings.effectiveRadius);
+    CancelPoll poll(interrupter, "rasterize density");
+    const std::vector<openvdb::Coord> origins =
+        candidateLeafOrigins(particles, *transform, settings.effectiveRadius, poll);
     std::vector<FloatLeaf*> results(origins.size(), nullptr);
-    std::atomic<bool> cancelled{false};
     std::atomic<size_t> done{0};
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, origins.size(), 16),
-        RasterizeLeafOp{particles, origins, results, voxelSize, settings.effectiveRadius, interrupter,
-                        cancelled, done});
+    if (!poll.stopped()) {
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, origins.size(), 16),
+            RasterizeLeafOp{particles, origins, results, voxelSize, settings.effectiveRadius, poll, done});
+    }
 
     openvdb::FloatGrid::Ptr grid = openvdb::FloatGrid::create(0.0f);
     grid->setTransform(transform);
     grid->setName("density");
     grid->setGridClass(openvdb::GRID_FOG_VOLUME);
     openvdb::FloatTree& tree = grid->tree();
-    for (FloatLeaf* leaf : results) {
-        if (!leaf) continue;
-        if (cancelled) delete leaf;
-        else tree.addLeaf(leaf);
+    // Leaves not yet in the tree are ours to delete; those added belong to the grid.
+    for (size_t n = 0; n < results.size(); ++n) {
+        if (poll.stoppedAt(n)) {
+            for (size_t m = n; m < results.size(); ++m) delete results[m];
+            break;
+        }
+        if (results[n]) tree.addLeaf(results[n]);
     }
     if (interrupter) interrupter->end();
-    if (cancelled) throw CancelledError("interrupted during rasterize density");
+    poll.throwIfStopped();
     return grid;
 }
 

@@ -1,4 +1,5 @@
 // SPDX-License-Identifier: Apache-2.0
+#include "Cancellation.h"
 #include "ParticleIndexImpl.h"
 
 #include <nonbloppy/Error.h>
@@ -18,7 +19,12 @@ namespace nonbloppy {
 
 namespace {
 
+using cancellation_internal::CancelPoll;
+
 constexpr size_t kLanes = 8;
+/// Vertex groups of a task between two polls: each group gathers its candidate particles
+/// and sums over them for every vertex, so a task of many groups runs for milliseconds.
+constexpr size_t kGroupsPerPoll = 16;
 /// Edge of a vertex group in particle-index cells.
 constexpr double kGroupCells = 2.0;  ///< candidates processed side by side (two SSE or one AVX register)
 
@@ -95,13 +101,10 @@ struct RelaxStepOp
     float effectiveRadius;
     float blend;
     float maxStep;  ///< cap on one step's length, world units; 0: no cap (the paper)
-    openvdb::util::NullInterrupter* interrupter;
-    std::atomic<bool>& cancelled;
+    CancelPoll& poll;
 
     void operator()(const tbb::blocked_range<size_t>& range) const
     {
-        if (cancelled) return;
-        if (interrupter && interrupter->wasInterrupted()) { cancelled = true; return; }
         const auto& positions = particles.sortedPositions();
         auto accessor = particles.impl().grid->getConstAccessor();
         const double cellSize = particles.cellSize();
@@ -110,6 +113,7 @@ struct RelaxStepOp
         const float minDistance2 = (kMinDistanceFraction * radius) * (kMinDistanceFraction * radius);
         CandidateBuffer candidates;
         for (size_t g = range.begin(); g < range.end(); ++g) {
+            if ((g - range.begin()) % kGroupsPerPoll == 0 && poll.stopped()) return;
             const size_t begin = groupStart[g], end = groupStart[g + 1];
             // The group's cell, grown by r_e, holds every particle near any of its vertices.
             const openvdb::Coord cell = particle_index_internal::cellOf(previous[vertexOrder[begin]], groupSize);
@@ -183,14 +187,17 @@ struct RelaxStepOp
 /// Sort vertex numbers by the group cell (edge @a groupSize) their position falls in and
 /// return the start of each run of equal cells (plus the end). Cells are packed into 64-bit
 /// keys relative to the smallest cell, so the sort compares integers, not coordinates through
-/// an index; ties keep vertex order, so grouping is deterministic.
+/// an index; ties keep vertex order, so grouping is deterministic. Asks @a poll as it goes
+/// and throws its CancelledError on a stop (the sort is stopped through runStoppable()).
 void groupVerticesByCell(const std::vector<openvdb::Vec3s>& points, double groupSize,
-                         std::vector<uint32_t>& order, std::vector<size_t>& groupStart)
+                         std::vector<uint32_t>& order, std::vector<size_t>& groupStart,
+                         CancelPoll& poll)
 {
     using particle_index_internal::cellOf;
     openvdb::Coord lowest(std::numeric_limits<int>::max()), highest(std::numeric_limits<int>::min());
-    for (const openvdb::Vec3s& p : points) {
-        const openvdb::Coord c = cellOf(p, groupSize);
+    for (size_t i = 0; i < points.size(); ++i) {
+        if (poll.stoppedAt(i)) poll.throwIfStopped();
+        const openvdb::Coord c = cellOf(points[i], groupSize);
         lowest.minComponent(c);
         highest.maxComponent(c);
     }
@@ -202,15 +209,20 @@ void groupVerticesByCell(const std::vector<openvdb::Vec3s>& points, double group
     std::vector<std::pair<uint64_t, uint32_t>> keyed(points.size());
     tbb::parallel_for(tbb::blocked_range<size_t>(0, points.size()), [&](const tbb::blocked_range<size_t>& r) {
         for (size_t i = r.begin(); i < r.end(); ++i) {
+            if (poll.stoppedAt(i - r.begin())) return;
             const openvdb::Coord c = cellOf(points[i], groupSize) - lowest;
             const uint64_t key = (uint64_t(c[0]) << 42) | (uint64_t(c[1]) << 21) | uint64_t(c[2]);
             keyed[i] = {key, uint32_t(i)};
         }
     });
-    tbb::parallel_sort(keyed.begin(), keyed.end());
+    poll.throwIfStopped();
+    // Keys are unique (they hold the vertex number), so any sort gives the same order.
+    cancellation_internal::runStoppable(poll, [&] { tbb::parallel_sort(keyed.begin(), keyed.end()); });
+    poll.throwIfStopped();
     order.resize(points.size());
     groupStart.clear();
     for (size_t n = 0; n < keyed.size(); ++n) {
+        if (poll.stoppedAt(n)) poll.throwIfStopped();
         order[n] = keyed[n].second;
         if (n == 0 || keyed[n].first != keyed[n - 1].first) groupStart.push_back(n);
     }
@@ -242,22 +254,25 @@ void relaxVertices(SurfaceMesh& mesh, const ParticleIndex& particles, const Rela
     if (settings.iterations == 0 || settings.blend == 0.0 || mesh.points.empty()) return;
 
     if (interrupter) interrupter->start("relax vertices");
-    std::vector<openvdb::Vec3s> next(mesh.points.size());
-    std::vector<uint32_t> order;
-    std::vector<size_t> groupStart;
-    std::atomic<bool> cancelled{false};
-    for (int iteration = 0; iteration < settings.iterations && !cancelled; ++iteration) {
-        groupVerticesByCell(mesh.points, kGroupCells * particles.cellSize(), order, groupStart);
-        tbb::parallel_for(tbb::blocked_range<size_t>(0, groupStart.size() - 1, 64),
-            RelaxStepOp{particles, order, groupStart, mesh.points, next, float(settings.effectiveRadius),
-                        float(settings.blend), float(settings.maxStep), interrupter, cancelled});
-        mesh.points.swap(next);
-        if (interrupter && interrupter->wasInterrupted(100 * (iteration + 1) / settings.iterations)) {
-            cancelled = true;
+    CancelPoll poll(interrupter, "relax vertices");
+    try {
+        std::vector<openvdb::Vec3s> next(mesh.points.size());
+        std::vector<uint32_t> order;
+        std::vector<size_t> groupStart;
+        for (int iteration = 0; iteration < settings.iterations; ++iteration) {
+            groupVerticesByCell(mesh.points, kGroupCells * particles.cellSize(), order, groupStart, poll);
+            tbb::parallel_for(tbb::blocked_range<size_t>(0, groupStart.size() - 1, 64),
+                RelaxStepOp{particles, order, groupStart, mesh.points, next, float(settings.effectiveRadius),
+                            float(settings.blend), float(settings.maxStep), poll});
+            poll.throwIfStopped();
+            mesh.points.swap(next);
+            if (poll.stopped(100 * (iteration + 1) / settings.iterations)) poll.throwIfStopped();
         }
+    } catch (...) {
+        if (interrupter) interrupter->end();
+        throw;
     }
     if (interrupter) interrupter->end();
-    if (cancelled) throw CancelledError("interrupted during relax vertices");
 }
 
 } // namespace nonbloppy

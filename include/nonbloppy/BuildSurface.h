@@ -40,8 +40,15 @@ struct SurfaceResult
 /// Run the whole pipeline on @a positions (world units), which it takes over.
 /// @param positions    particle positions, world units; moved into the particle index
 /// @param params       method parameters; lengths absolute, in world units (see SurfaceParameters)
-/// @param interrupter  optional; asked between stages and, during rasterization and
-///                     relaxation, once per parallel task, so a cancel takes effect quickly
+/// @param interrupter  optional; every stage is announced with start(name) … end() under
+///                     the names of the timings, and every loop of nonbloppy's own asks
+///                     wasInterrupted() about every 0.1 ms of work (see each stage's
+///                     header). Not interruptible: OpenVDB's volumeToMesh (all of "extract
+///                     surface" but the deep-interior tiling) and its point partitioner
+///                     (part of "index particles" and of "estimate parameters"), the
+///                     threshold calibration (~10 ms) and measureMesh() in the volume
+///                     correction. A stop throws CancelledError("interrupted during
+///                     <stage>") and discards every partial result.
 /// Cost: dominated by "rasterize density", O(N·(r_e/h)³), and "relax vertices",
 /// O(t·V·particles within r_e); memory about the density grid plus 16 bytes per particle.
 /// Runs in parallel (TBB); the result does not depend on the thread count.

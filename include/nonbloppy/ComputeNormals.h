@@ -8,15 +8,23 @@
 #include <nonbloppy/Export.h>
 #include <nonbloppy/Mesh.h>
 
+#include <openvdb/util/NullInterrupter.h>
+
 namespace nonbloppy {
 
 /// Set mesh.normals[i] to the normalized sum of the area-weighted normals of the polygons
 /// around vertex i (a quad's normal is half the cross product of its diagonals).
 /// A vertex no polygon uses, or whose normals cancel, gets (0,0,0).
 /// Cost: O(P + V); deterministic (sums in polygon order). Memory: 24 bytes per vertex scratch.
-/// Thread-safety: reentrant; concurrent calls on different meshes are safe. Throws nothing
-/// but std::bad_alloc; polygon indices must be valid (see measureMesh() to check them).
-NONBLOPPY_API void computeNormals(SurfaceMesh& mesh);
+/// @param mesh         normals written; polygon indices must be valid (see measureMesh())
+/// @param interrupter  optional; asked every 4096 polygons of the serial sum and every 4096
+///                     vertices of each parallel task (no start()/end(): buildSurface()
+///                     announces the stage); a stop leaves mesh.normals unspecified
+/// Thread-safety: reentrant; concurrent calls on different meshes are safe.
+/// @throw CancelledError("interrupted during compute normals") when @a interrupter says
+///        stop; otherwise nothing but std::bad_alloc.
+NONBLOPPY_API void computeNormals(SurfaceMesh& mesh,
+                                  openvdb::util::NullInterrupter* interrupter = nullptr);
 
 } // namespace nonbloppy
 

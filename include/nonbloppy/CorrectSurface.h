@@ -17,6 +17,7 @@
 #include <nonbloppy/Mesh.h>
 
 #include <openvdb/openvdb.h>
+#include <openvdb/util/NullInterrupter.h>
 
 #include <cstddef>
 #include <limits>
@@ -44,16 +45,25 @@ NONBLOPPY_API double calibrateRelaxedThreshold(double effectiveRadiusOverSpacing
 /// @throw ParameterError if @a before and mesh.points differ in size.
 NONBLOPPY_API size_t countFoldedTriangles(const SurfaceMesh& mesh, const std::vector<openvdb::Vec3s>& before);
 
+/// Rounds of halving that repairFolds() tries before moving vertices all the way back.
+constexpr int kDefaultRepairRounds = 4;
+
 /// Unfold triangles folded over by relaxation: every vertex of a folded triangle (see
 /// countFoldedTriangles()) is moved halfway back to its position in @a before, and this is
 /// repeated until no triangle is folded or @a maxRounds rounds have run; the vertices of
 /// triangles still folded then go all the way back. Vertices of unfolded triangles are not
 /// touched, so a mesh without folds is returned bit for bit.
 /// @return the number of folded triangles found in the first round
-/// Cost: O(rounds · P). Deterministic. Normals are not updated.
-/// @throw ParameterError if @a before and mesh.points differ in size.
+/// @param interrupter  optional; asked every 4096 polygons of each (serial) round, no
+///                     start()/end() (buildSurface() announces "correct surface"); a stop
+///                     leaves the vertices partly repaired
+/// Cost: O(rounds · P), serial. Deterministic. Normals are not updated.
+/// Thread-safety: reentrant; the mesh is written.
+/// @throw ParameterError if @a before and mesh.points differ in size;
+///        CancelledError("interrupted during correct surface") when @a interrupter says stop.
 NONBLOPPY_API size_t repairFolds(SurfaceMesh& mesh, const std::vector<openvdb::Vec3s>& before,
-                                 int maxRounds = 4);
+                                 int maxRounds = kDefaultRepairRounds,
+                                 openvdb::util::NullInterrupter* interrupter = nullptr);
 
 /// Move every vertex by @a distance (world units, > 0 outwards) along its unit normal, which
 /// must have been computed (computeNormals()); vertices with a zero normal stay put.
@@ -66,13 +76,20 @@ NONBLOPPY_API void offsetSurface(SurfaceMesh& mesh, double distance);
 /// Only meaningful for a closed mesh whose target is known (e.g. N·s³ for an incompressible
 /// fluid of N particles at spacing s); a wrong target shifts the whole surface.
 /// @return the total distance moved along the normals (world units)
-/// @throw ParameterError if targetVolume is not > 0 or normals are missing.
+/// @throw ParameterError if targetVolume is not > 0 or normals are missing;
+///        CancelledError("interrupted during correct surface") when @a interrupter says stop.
 /// @param mesh         closed mesh with normals; vertices moved, normals recomputed
 /// @param targetVolume volume to enclose, world units³, > 0
 /// @param maxDistance  largest distance moved in total, world units (the correction is
 ///                     clamped to ±maxDistance, so a wrong target cannot move the surface far)
+/// @param interrupter  optional; asked before and after each measureMesh() (which is serial
+///                     and not interruptible, O(P)) and inside computeNormals() as there;
+///                     no start()/end(). A stop leaves the mesh partly offset.
+/// Cost: two passes of measureMesh() + offsetSurface() + computeNormals(), O(P + V).
+/// Thread-safety: reentrant; the mesh is written.
 NONBLOPPY_API double preserveVolume(SurfaceMesh& mesh, double targetVolume,
-                                    double maxDistance = std::numeric_limits<double>::infinity());
+                                    double maxDistance = std::numeric_limits<double>::infinity(),
+                                    openvdb::util::NullInterrupter* interrupter = nullptr);
 
 } // namespace nonbloppy
 

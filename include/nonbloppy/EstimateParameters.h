@@ -9,18 +9,28 @@
 #include <nonbloppy/Export.h>
 
 #include <openvdb/openvdb.h>
+#include <openvdb/util/NullInterrupter.h>
 
 #include <optional>
 #include <vector>
 
 namespace nonbloppy {
 
+/// Samples estimateSpacing() takes by default (and resolveParameters() always).
+constexpr size_t kSpacingSamples = 20000;
+
 /// Median distance from a particle to its nearest neighbour, in world units, over a fixed
 /// deterministic sample of at most @a maxSamples particles (all of them when fewer).
 /// Cost: O(N) to bucket the particles plus O(samples) neighbour searches.
+/// @param interrupter  optional; asked every 4096 particles of the bounding box, as in
+///                     ParticleIndex::build() while bucketing, and every 16 samples of each
+///                     parallel search task; no start()/end()
 /// @throw ParameterError with fewer than two particles, or when the median is 0
-///        (half the particles sit on top of another one).
-NONBLOPPY_API double estimateSpacing(const std::vector<openvdb::Vec3f>& positions, size_t maxSamples = 20000);
+///        (half the particles sit on top of another one);
+///        CancelledError("interrupted during estimate parameters") when @a interrupter says stop.
+NONBLOPPY_API double estimateSpacing(const std::vector<openvdb::Vec3f>& positions,
+                                     size_t maxSamples = kSpacingSamples,
+                                     openvdb::util::NullInterrupter* interrupter = nullptr);
 
 /// The iso-value r_0 for which a flat, uniform half-space of particles on a cubic lattice of
 /// spacing s has its unrelaxed (t = 0) surface s/2 outside the outer particle layer, so the
@@ -112,10 +122,15 @@ struct ResolvedParameters
 /// must be estimated (spacing unset and effectiveRadius, threshold or voxelSize unset).
 /// @throw ParameterError naming the parameter, e.g. "--blend must lie in [0,1], got 1.5"
 ///        (parameters are named by their command-line spelling).
-/// Cost: that of estimateSpacing() when it is needed, else O(1).
+/// Cost: that of estimateSpacing() when it is needed, plus the threshold calibration
+/// (~10 ms, not interruptible), else O(1).
+/// @param interrupter  optional; passed to estimateSpacing() and asked after each step;
+///                     no start()/end() (buildSurface() announces "estimate parameters")
+/// @throw CancelledError("interrupted during estimate parameters") when @a interrupter says stop.
 /// Thread-safety (all functions of this header): reentrant, no shared state.
 NONBLOPPY_API ResolvedParameters resolveParameters(const SurfaceParameters& params,
-                                     const std::vector<openvdb::Vec3f>& positions);
+                                     const std::vector<openvdb::Vec3f>& positions,
+                                     openvdb::util::NullInterrupter* interrupter = nullptr);
 
 } // namespace nonbloppy
 

@@ -22,8 +22,11 @@ namespace nonbloppy {
 /// @param threshold   iso-value r_0, in the grid's value units
 /// @param adaptivity  volumeToMesh's adaptivity in [0,1]: 0 keeps every polygon, larger
 ///                    values merge polygons in flat regions.
-/// Cost: O(active voxels), parallel inside OpenVDB; deterministic. Not interruptible
-/// (volumeToMesh takes no interrupter): see buildSurface() for the checks around it.
+/// Cost: O(active voxels), parallel inside OpenVDB; deterministic. Not interruptible:
+/// volumeToMesh takes no interrupter, and stopping it through its TBB context is unsafe
+/// (its serial steps then size arrays from uninitialised counts: measured, up to 1.4·10⁹
+/// points allocated and zeroed). buildSurface() checks before and after it, so this is the
+/// longest wait for a cancel (the whole extraction, see BuildSurface.h).
 /// Thread-safety: reentrant; the grid is only read.
 /// @throw ParameterError if adaptivity lies outside [0,1] or threshold is not finite.
 NONBLOPPY_API SurfaceMesh extractSurface(const openvdb::FloatGrid& density, double threshold,

@@ -16,6 +16,7 @@
 #include <nonbloppy/Particles.h>
 
 #include <openvdb/openvdb.h>
+#include <openvdb/util/NullInterrupter.h>
 #include <tbb/parallel_for.h>
 
 #include <cmath>
@@ -44,8 +45,17 @@ public:
 
     /// Bucket @a positions (world units, taken over and reordered) into cells of
     /// @a cellSize world units. Cost: O(N) time (parallel radix partitioning by OpenVDB).
-    /// @throw ParameterError if cellSize ≤ 0 or a position is not finite.
-    static ParticleIndex build(std::vector<openvdb::Vec3f> positions, double cellSize);
+    /// @param interrupter  optional; asked every 4096 particles of the checks and once per
+    ///                     index leaf while slots are assigned, not during OpenVDB's
+    ///                     partitioning (createPointIndexGrid takes no interrupter, and
+    ///                     stopping its TBB context would leave its serial steps working on
+    ///                     partial counts); no start()/end() (buildSurface() announces
+    ///                     "index particles")
+    /// Thread-safety: reentrant.
+    /// @throw ParameterError if cellSize ≤ 0 or a position is not finite;
+    ///        CancelledError("interrupted during index particles") when @a interrupter says stop.
+    static ParticleIndex build(std::vector<openvdb::Vec3f> positions, double cellSize,
+                               openvdb::util::NullInterrupter* interrupter = nullptr);
 
     /// Number of particles.
     size_t size() const;
@@ -71,10 +81,13 @@ private:
 };
 
 /// Build a ParticleIndex from any ParticleList (see Particles.h). The caller's array is
-/// only read, through getPos(), in parallel.
-/// @throw ParameterError if a position is NaN or infinite (naming the particle).
+/// only read, through getPos(), in parallel. Cost, interrupter and thread-safety as
+/// ParticleIndex::build().
+/// @throw ParameterError if a position is NaN or infinite (naming the particle);
+///        CancelledError when @a interrupter says stop.
 template<typename ParticleListT>
-ParticleIndex buildParticleIndex(const ParticleListT& particles, double cellSize)
+ParticleIndex buildParticleIndex(const ParticleListT& particles, double cellSize,
+                                 openvdb::util::NullInterrupter* interrupter = nullptr)
 {
     std::vector<openvdb::Vec3f> positions(particles.size());
     tbb::parallel_for(tbb::blocked_range<size_t>(0, positions.size()),
@@ -85,7 +98,7 @@ ParticleIndex buildParticleIndex(const ParticleListT& particles, double cellSize
                 positions[n] = openvdb::Vec3f(xyz);
             }
         });
-    return ParticleIndex::build(std::move(positions), cellSize);
+    return ParticleIndex::build(std::move(positions), cellSize, interrupter);
 }
 
 } // namespace nonbloppy

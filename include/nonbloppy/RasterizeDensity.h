@@ -33,8 +33,12 @@ struct DensitySettings
 /// Cost: O(N·(r_e/h)³) kernel evaluations; memory: the grid (≈ 4.5 bytes per active voxel).
 /// @param particles    the particle index (its cell size does not affect the result)
 /// @param settings     r_e and h in world units, or a caller's transform
-/// @param interrupter  optional; start("rasterize density"), then wasInterrupted(percent)
-///                     once per finished leaf task, end()
+/// @param interrupter  optional; start("rasterize density"), then wasInterrupted() every
+///                     64 particle-index leaves while listing candidate leaves, every 1 ms
+///                     (from a helper thread) while sorting them, every 8 density leaves
+///                     of each task (~0.1–0.5 ms of work) with wasInterrupted(percent) at
+///                     each task's end, every 4096 leaves while assembling the tree; end().
+///                     After a stop the partial grid is freed.
 /// Thread-safety: reentrant; the index is only read.
 /// @throw ParameterError if r_e ≤ 0 or h ≤ 0; CancelledError if @a interrupter says so.
 NONBLOPPY_API openvdb::FloatGrid::Ptr rasterizeDensity(const ParticleIndex& particles,

@@ -36,10 +36,15 @@ struct RelaxSettings
 /// @param mesh         vertices moved in place (world units); polygons untouched
 /// @param particles    index of the particles to relax against (any frame's, any mesh's)
 /// @param settings     r_e (world units), c, t
-/// @param interrupter  optional; start("relax vertices"), wasInterrupted() once per task
-///                     of 64 vertex groups and wasInterrupted(percent) after each iteration
+/// @param interrupter  optional; start("relax vertices"), then per iteration
+///                     wasInterrupted() every 4096 vertices while grouping them by cell,
+///                     every 1 ms (from a helper thread) during the parallel sort, every 16
+///                     vertex groups of each task, and wasInterrupted(percent) after the
+///                     iteration; end(), also when it throws. A stop leaves the mesh at the
+///                     last completed iteration.
 /// Thread-safety: reentrant; the index is only read, the mesh is written.
-/// @throw ParameterError for r_e ≤ 0, c outside [0,1], t < 0 or maxStep < 0; CancelledError on interrupt.
+/// @throw ParameterError for r_e ≤ 0, c outside [0,1], t < 0 or maxStep < 0;
+///        CancelledError("interrupted during relax vertices") on interrupt.
 NONBLOPPY_API void relaxVertices(SurfaceMesh& mesh, const ParticleIndex& particles,
                    const RelaxSettings& settings,
                    openvdb::util::NullInterrupter* interrupter = nullptr);

@@ -70,8 +70,10 @@ public:
     /// Mesh one frame of any ParticleList (see Particles.h: size(), getPos()); the
     /// caller's particles are read once, in parallel, into the reused position buffer.
     /// @return the result, valid until the next reconstruct() or setParameters() call.
+    /// @param interrupter  optional; announced stages and polls as for buildSurface()
     /// @throw ParameterError for bad parameters or non-finite positions, CancelledError
-    ///        when @a interrupter asks to stop (the object stays usable).
+    ///        ("interrupted during <stage>") when @a interrupter asks to stop; the object
+    ///        stays usable, and the next frame gives the same bytes as a fresh object would.
     /// Cost: as buildSurface(), minus the allocations listed in the file comment.
     template<typename ParticleListT>
     const SurfaceResult& reconstruct(const ParticleListT& particles,

@@ -1,0 +1,93 @@
+// SPDX-License-Identifier: Apache-2.0
+/// @file SurfaceStages.cc
+/// @brief The stage chain shared by buildSurface() and SurfaceReconstructor.
+
+#include "SurfaceStages.h"
+
+#include <nonbloppy/ComputeNormals.h>
+#include <nonbloppy/CorrectSurface.h>
+#include <nonbloppy/Error.h>
+#include <nonbloppy/ExtractSurface.h>
+#include <nonbloppy/RasterizeDensity.h>
+#include <nonbloppy/RelaxVertices.h>
+#include <nonbloppy/Version.h>
+
+#include <string>
+
+namespace nonbloppy {
+namespace surface_stages_internal {
+
+void checkCancelled(openvdb::util::NullInterrupter* interrupter, const char* stage)
+{
+    if (interrupter && interrupter->wasInterrupted()) {
+        throw CancelledError(std::string("interrupted during ") + stage);
+    }
+}
+
+void runSurfaceStages(const ParticleIndex& index, bool keepDensity, SurfaceResult& result,
+                      std::vector<openvdb::Vec3s>& unrelaxed, UnrelaxedBuffer whenRepaired,
+                      openvdb::util::NullInterrupter* interrupter)
+{
+    const ResolvedParameters p = result.parameters;
+    {
+        ScopedStageTimer timer(result.timings, "rasterize density");
+        DensitySettings settings;
+        settings.effectiveRadius = p.effectiveRadius;
+        settings.voxelSize = p.voxelSize;
+        result.density = rasterizeDensity(index, settings, interrupter);
+        openvdb::FloatGrid& grid = *result.density;
+        grid.insertMeta("effective_radius", openvdb::DoubleMetadata(p.effectiveRadius));
+        grid.insertMeta("threshold", openvdb::DoubleMetadata(p.threshold));
+        grid.insertMeta("blend", openvdb::DoubleMetadata(p.blend));
+        grid.insertMeta("iterations", openvdb::Int32Metadata(p.iterations));
+        grid.insertMeta("voxel_size", openvdb::DoubleMetadata(p.voxelSize));
+        grid.insertMeta("spacing", openvdb::DoubleMetadata(p.spacing));
+        grid.insertMeta("adaptivity", openvdb::DoubleMetadata(p.adaptivity));
+        grid.insertMeta("method", openvdb::StringMetadata(p.method == Method::Paper ? "paper" : "faithful"));
+        grid.insertMeta("particle_count", openvdb::Int64Metadata(int64_t(result.particleCount)));
+        grid.insertMeta("nonbloppy_version", openvdb::StringMetadata(version()));
+    }
+    {
+        StageScope scope(result.timings, interrupter, "extract surface");
+        if (!keepDensity) tileDeepInterior(*result.density, p.threshold);
+        checkCancelled(interrupter, "extract surface");
+        // volumeToMesh cannot be stopped safely from outside (see Cancellation.h): the
+        // longest wait for a cancel.
+        extractSurfaceInto(*result.density, p.threshold, p.adaptivity, result.mesh);
+        if (!keepDensity) result.density.reset();
+        checkCancelled(interrupter, "extract surface");
+    }
+    {
+        ScopedStageTimer timer(result.timings, "relax vertices");
+        RelaxSettings settings;
+        settings.effectiveRadius = p.effectiveRadius;
+        settings.blend = p.blend;
+        settings.iterations = p.iterations;
+        settings.maxStep = p.maxStep;
+        if (p.repairFolds) unrelaxed.assign(result.mesh.points.begin(), result.mesh.points.end());
+        relaxVertices(result.mesh, index, settings, interrupter);
+    }
+    if (p.repairFolds) {
+        StageScope scope(result.timings, interrupter, "correct surface");
+        repairFolds(result.mesh, unrelaxed, kDefaultRepairRounds, interrupter);
+        // Large frames peak while the normals are computed: give the copy back first.
+        if (whenRepaired == UnrelaxedBuffer::Release) std::vector<openvdb::Vec3s>().swap(unrelaxed);
+        checkCancelled(interrupter, "correct surface");
+    }
+    {
+        StageScope scope(result.timings, interrupter, "compute normals");
+        computeNormals(result.mesh, interrupter);
+        checkCancelled(interrupter, "compute normals");
+    }
+    if (p.preserveVolume) {
+        // Each particle stands for s³ of fluid; preserveVolume() recomputes the normals.
+        StageScope scope(result.timings, interrupter, "correct surface");
+        const double s = p.spacing;
+        preserveVolume(result.mesh, double(result.particleCount) * s * s * s,
+                       kMaxVolumeOffsetOverSpacing * s, interrupter);
+        checkCancelled(interrupter, "correct surface");
+    }
+}
+
+} // namespace surface_stages_internal
+} // namespace nonbloppy

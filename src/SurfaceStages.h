@@ -1,0 +1,85 @@
+// SPDX-License-Identifier: Apache-2.0
+/// @file SurfaceStages.h
+/// @brief Private: the chain of stages that buildSurface() and SurfaceReconstructor share
+///        (rasterize density → extract surface → relax vertices → correct surface →
+///        compute normals), and the cancellation check between stages. Only src/ includes it.
+
+#ifndef NONBLOPPY_SURFACE_STAGES_H
+#define NONBLOPPY_SURFACE_STAGES_H
+
+#include <nonbloppy/BuildSurface.h>
+#include <nonbloppy/ParticleIndex.h>
+
+#include <openvdb/openvdb.h>
+#include <openvdb/util/NullInterrupter.h>
+
+#include <vector>
+
+namespace nonbloppy {
+namespace surface_stages_internal {
+
+/// The particle index's cell edge as a fraction of r_e: a search box of ±r_e then spans about
+/// five cells per axis, which wastes less work on particles outside the support sphere than
+/// cells of r_e (three per axis, 27 r_e³ visited for a 4.2 r_e³ sphere).
+constexpr double kCellOverRadius = 0.5;
+
+/// Throw CancelledError("interrupted during <stage>") if @a interrupter (may be null) asks to
+/// stop. Cost: one wasInterrupted() call. Thread-safety: as the interrupter's.
+void checkCancelled(openvdb::util::NullInterrupter* interrupter, const char* stage);
+
+/// Times one stage in a StageTimings and announces it to the interrupter (start(name) on
+/// construction, end() on destruction, also when the stage throws), for the stages whose
+/// functions do not announce themselves. Cost: two clock reads.
+class StageScope
+{
+public:
+    StageScope(StageTimings& timings, openvdb::util::NullInterrupter* interrupter, const char* stage)
+        : mTimer(timings, stage), mInterrupter(interrupter)
+    {
+        if (mInterrupter) mInterrupter->start(stage);
+    }
+    ~StageScope()
+    {
+        if (mInterrupter) mInterrupter->end();
+    }
+    StageScope(const StageScope&) = delete;
+    StageScope& operator=(const StageScope&) = delete;
+
+private:
+    ScopedStageTimer mTimer;
+    openvdb::util::NullInterrupter* mInterrupter;
+};
+
+/// What runSurfaceStages() does with the unrelaxed-vertex buffer after fold repair.
+enum class UnrelaxedBuffer
+{
+    Release,  ///< free its memory before the normals are computed (lower peak memory)
+    Keep,     ///< keep its capacity for the next frame
+};
+
+/// Run the stages after "index particles" with the parameters in result.parameters, each
+/// announced to @a interrupter (start()/end()) and checked at its end:
+/// rasterize density (metadata holding the parameters), extract surface (into result.mesh's
+/// vectors, which keep their capacity), relax vertices, fold repair, compute normals and the
+/// volume correction, timing each in result.timings. result.density is reset when
+/// @a keepDensity is false (its deep interior is tiled before extraction, the same mesh).
+/// @param index        the frame's particle index, cell size kCellOverRadius·r_e
+/// @param unrelaxed    scratch for the vertex positions before relaxation (fold repair)
+/// @param whenRepaired whether @a unrelaxed is freed or kept once fold repair is done
+/// Cost: as buildSurface() minus its first two stages. Thread-safety: reentrant.
+/// @throw ParameterError, CancelledError as buildSurface(); result is then unspecified.
+void runSurfaceStages(const ParticleIndex& index, bool keepDensity, SurfaceResult& result,
+                      std::vector<openvdb::Vec3s>& unrelaxed, UnrelaxedBuffer whenRepaired,
+                      openvdb::util::NullInterrupter* interrupter);
+
+/// extractSurface() into @a mesh's existing vectors (volumeToMesh clears and resizes them,
+/// which keeps their capacity); normals and attributes are cleared. Same checks, orientation
+/// and result as extractSurface(). Defined in ExtractSurface.cc, the only translation unit
+/// that includes tools/VolumeToMesh.h.
+void extractSurfaceInto(const openvdb::FloatGrid& density, double threshold, double adaptivity,
+                        SurfaceMesh& mesh);
+
+} // namespace surface_stages_internal
+} // namespace nonbloppy
+
+#endif // NONBLOPPY_SURFACE_STAGES_H

@@ -1,0 +1,176 @@
+// SPDX-License-Identifier: Apache-2.0
+/// @file test_Cancellation.cc
+/// @brief A stop requested in any stage makes buildSurface(), SurfaceReconstructor and the
+///        stage functions throw CancelledError("interrupted during <stage>"), and a
+///        reconstructor stays usable afterwards. How fast a stop takes effect is measured
+///        by tests/bench/CancelLatency.cc, not here.
+
+#include "TestUtil.h"
+
+#include <nonbloppy/BuildSurface.h>
+#include <nonbloppy/ComputeNormals.h>
+#include <nonbloppy/CorrectSurface.h>
+#include <nonbloppy/Error.h>
+#include <nonbloppy/EstimateParameters.h>
+#include <nonbloppy/ParticleIndex.h>
+#include <nonbloppy/Particles.h>
+#include <nonbloppy/SurfaceReconstructor.h>
+
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <string>
+#include <vector>
+
+using namespace nonbloppy;
+using nonbloppy_test::latticeParticles;
+
+namespace {
+
+/// The stages in the order buildSurface() runs them, as announced through start().
+const char* const kStages[] = {"estimate parameters", "index particles", "rasterize density",
+                               "extract surface",     "relax vertices",  "correct surface",
+                               "compute normals"};
+
+/// Says stop from the moment stage @a target is announced, ever after.
+struct StopInStage : openvdb::util::NullInterrupter
+{
+    explicit StopInStage(std::string stage) : target(std::move(stage)) {}
+    void start(const char* name) override
+    {
+        if (name && target == name) fired = true;
+    }
+    bool wasInterrupted(int = -1) override { return fired.load(); }
+    std::string target;
+    std::atomic<bool> fired{false};
+};
+
+/// Says stop from its n-th wasInterrupted() call on (n = 0: never); counts the calls.
+struct StopAfterPolls : openvdb::util::NullInterrupter
+{
+    explicit StopAfterPolls(long n) : limit(n) {}
+    bool wasInterrupted(int = -1) override { return ++polls >= limit && limit > 0; }
+    long limit;
+    std::atomic<long> polls{0};
+};
+
+std::vector<openvdb::Vec3f> ballFrame(double radius)
+{
+    return latticeParticles(0.1, radius + 0.1,
+        [radius](const openvdb::Vec3d& x) { return x.length() < radius; }, 0.1, 5);
+}
+
+/// The spacing given, so that the volume correction runs too (a second "correct surface").
+SurfaceParameters withSpacing()
+{
+    SurfaceParameters params;
+    params.spacing = 0.1;
+    return params;
+}
+
+template<typename FunctionT>
+std::string cancelMessage(FunctionT&& function)
+{
+    try {
+        function();
+    } catch (const CancelledError& e) {
+        return e.what();
+    }
+    return "(not cancelled)";
+}
+
+void expectSameBytes(const SurfaceMesh& a, const SurfaceMesh& b)
+{
+    EXPECT_EQ(a.points, b.points);
+    EXPECT_EQ(a.normals, b.normals);
+    EXPECT_EQ(a.triangles, b.triangles);
+    EXPECT_EQ(a.quads, b.quads);
+}
+
+} // namespace
+
+TEST(Cancellation, EveryStageOfBuildSurfaceThrowsItsOwnMessage)
+{
+    const auto frame = ballFrame(0.5);
+    for (const SurfaceParameters& params : {SurfaceParameters(), withSpacing()}) {
+        for (const char* stage : kStages) {
+            SCOPED_TRACE(stage);
+            StopInStage stop(stage);
+            EXPECT_EQ(cancelMessage([&] { buildSurface(frame, params, &stop); }),
+                      std::string("interrupted during ") + stage);
+            EXPECT_TRUE(stop.fired) << "stage never announced";
+        }
+    }
+}
+
+TEST(Cancellation, ReconstructorStaysUsableAfterAStopInEveryStage)
+{
+    const auto frame = ballFrame(0.6);
+    const SurfaceResult expected = buildSurface(frame, withSpacing());
+    SurfaceReconstructor reconstructor(withSpacing());
+    for (const char* stage : kStages) {
+        SCOPED_TRACE(stage);
+        StopInStage stop(stage);
+        EXPECT_EQ(cancelMessage([&] { reconstructor.reconstruct(ParticleSet{frame, {}}, &stop); }),
+                  std::string("interrupted during ") + stage);
+        const SurfaceResult& got = reconstructor.reconstruct(ParticleSet{frame, {}});
+        expectSameBytes(got.mesh, expected.mesh);
+    }
+    EXPECT_EQ(reconstructor.frameCount(), std::size(kStages));
+}
+
+TEST(Cancellation, StopAfterAnyNumberOfPollsNamesAStage)
+{
+    const auto frame = ballFrame(0.5);
+    StopAfterPolls counter(0);
+    const SurfaceResult expected = buildSurface(frame, withSpacing(), &counter);
+    const long total = counter.polls;
+    ASSERT_GT(total, 20);
+    SurfaceReconstructor reconstructor(withSpacing());
+    for (long n = 1; n < total; n += std::max(1L, total / 23)) {
+        SCOPED_TRACE(n);
+        StopAfterPolls stop(n);
+        const std::string message =
+            cancelMessage([&] { reconstructor.reconstruct(ParticleSet{frame, {}}, &stop); });
+        if (message == "(not cancelled)") {
+            // The number of polls varies a little with the threads' split of the work.
+            EXPECT_GT(n, total / 2);
+            continue;
+        }
+        bool known = false;
+        for (const char* stage : kStages) known |= message == std::string("interrupted during ") + stage;
+        EXPECT_TRUE(known) << message;
+        expectSameBytes(reconstructor.reconstruct(ParticleSet{frame, {}}).mesh, expected.mesh);
+    }
+}
+
+TEST(Cancellation, StageFunctionsThrowTheirStagesMessage)
+{
+    const auto frame = ballFrame(0.5);
+    const SurfaceResult result = buildSurface(frame, withSpacing());
+    StopAfterPolls stop(1);
+    EXPECT_EQ(cancelMessage([&] { estimateSpacing(frame, kSpacingSamples, &stop); }),
+              "interrupted during estimate parameters");
+    EXPECT_EQ(cancelMessage([&] { resolveParameters(SurfaceParameters(), frame, &stop); }),
+              "interrupted during estimate parameters");
+    EXPECT_EQ(cancelMessage([&] { ParticleIndex::build(frame, 0.1, &stop); }),
+              "interrupted during index particles");
+    SurfaceMesh mesh = result.mesh;
+    EXPECT_EQ(cancelMessage([&] { computeNormals(mesh, &stop); }), "interrupted during compute normals");
+    mesh = result.mesh;
+    EXPECT_EQ(cancelMessage([&] { repairFolds(mesh, result.mesh.points, kDefaultRepairRounds, &stop); }),
+              "interrupted during correct surface");
+    mesh = result.mesh;
+    EXPECT_EQ(cancelMessage([&] { preserveVolume(mesh, 1.0, 0.01, &stop); }),
+              "interrupted during correct surface");
+}
+
+TEST(Cancellation, AnInterrupterThatNeverFiresChangesNoByte)
+{
+    const auto frame = ballFrame(0.6);
+    StopAfterPolls never(0);
+    const SurfaceResult with = buildSurface(frame, withSpacing(), &never);
+    const SurfaceResult without = buildSurface(frame, withSpacing());
+    EXPECT_GT(never.polls, 0);
+    expectSameBytes(with.mesh, without.mesh);
+}
