@@ -1,16 +1,25 @@
 // SPDX-License-Identifier: Apache-2.0
 /// @file TestUtil.h
-/// @brief Particle sets with known answers, shared by the tests.
+/// @brief Particle sets with known answers, file helpers and a scratch-directory fixture,
+///        shared by the tests.
 
 #ifndef NONBLOPPY_TEST_UTIL_H
 #define NONBLOPPY_TEST_UTIL_H
 
 #include <openvdb/openvdb.h>
 
+#include <gtest/gtest.h>
+
+#include <unistd.h>
+
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <functional>
+#include <iterator>
 #include <random>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace nonbloppy_test {
@@ -18,6 +27,60 @@ namespace nonbloppy_test {
 inline std::string dataPath(const std::string& name)
 {
     return std::string(NONBLOPPY_TEST_DATA_DIR) + "/" + name;
+}
+
+/// The whole content of the file @a path ("" if it cannot be read).
+inline std::string readBytes(const std::string& path)
+{
+    std::ifstream is(path, std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(is), std::istreambuf_iterator<char>());
+}
+
+/// Writes @a bytes as the whole content of @a path; a failed write fails the test.
+inline void writeBytes(const std::string& path, const std::string& bytes)
+{
+    std::ofstream os(path, std::ios::binary | std::ios::trunc);
+    os.write(bytes.data(), std::streamsize(bytes.size()));
+    if (!os.good()) ADD_FAILURE() << "cannot write " << path;
+}
+
+/// A fresh, empty directory per test (under ::testing::TempDir()), removed afterwards.
+class ScratchDirTest : public ::testing::Test
+{
+protected:
+    void SetUp() override
+    {
+        std::string pattern = ::testing::TempDir() + "nonbloppy_test_XXXXXX";
+        ASSERT_NE(::mkdtemp(pattern.data()), nullptr);
+        mDir = pattern;
+    }
+    void TearDown() override
+    {
+        std::error_code ec;
+        std::filesystem::remove_all(mDir, ec);
+    }
+    std::string dir() const { return mDir; }
+    /// @a name inside the test's directory.
+    std::string path(const std::string& name) const { return mDir + "/" + name; }
+
+private:
+    std::string mDir;
+};
+
+/// The mean height z of the mesh vertices @a points above the patch |x|, |y| < halfWidth
+/// with z > 0 (the top face of a slab centred on the z axis), and how many vertices that is.
+inline std::pair<double, int> meanTopHeight(const std::vector<openvdb::Vec3s>& points,
+                                            double halfWidth = 0.5)
+{
+    double heightSum = 0.0;
+    int count = 0;
+    for (const openvdb::Vec3s& p : points) {
+        if (std::abs(p[0]) < halfWidth && std::abs(p[1]) < halfWidth && p[2] > 0.0f) {
+            heightSum += p[2];
+            ++count;
+        }
+    }
+    return {count > 0 ? heightSum / count : 0.0, count};
 }
 
 /// Lattice points of spacing @a spacing inside @a inside (a predicate on world positions),

@@ -55,16 +55,9 @@ TEST(EstimateParameters, CalibratedThresholdPutsAFlatSurfaceHalfASpacingOutside)
     EXPECT_DOUBLE_EQ(result.parameters.effectiveRadius, 2 * result.parameters.spacing);
     EXPECT_DOUBLE_EQ(result.parameters.voxelSize, result.parameters.spacing / 2);
     EXPECT_DOUBLE_EQ(result.parameters.threshold, calibrateThreshold(2.0));
-    double heightSum = 0.0;
-    int count = 0;
-    for (const openvdb::Vec3s& p : result.mesh.points) {
-        if (std::abs(p[0]) < 0.5 && std::abs(p[1]) < 0.5 && p[2] > 0.0f) {
-            heightSum += p[2];
-            ++count;
-        }
-    }
+    const auto [meanHeight, count] = nonbloppy_test::meanTopHeight(result.mesh.points);
     ASSERT_GT(count, 50);
-    EXPECT_NEAR(heightSum / count, spacing / 2, 0.1 * spacing);
+    EXPECT_NEAR(meanHeight, spacing / 2, 0.1 * spacing);
 }
 
 TEST(EstimateParameters, ThresholdGrowsWithTheRadius)

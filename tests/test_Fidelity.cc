@@ -3,6 +3,7 @@
 // (tests/bench/fidelity.cc, docs/fidelity.md) with its targets, and the corrections of
 // CorrectSurface.h one by one.
 
+#include "TestUtil.h"
 #include "bench/FidelityShapes.h"
 
 #include <nonbloppy/BuildSurface.h>
@@ -160,16 +161,9 @@ TEST(Fidelity, RelaxedThresholdEndsAFlatFaceHalfASpacingOutside)
     EXPECT_FALSE(result.parameters.preserveVolume);
     EXPECT_DOUBLE_EQ(result.parameters.threshold,
                      calibrateRelaxedThreshold(2.0, kDefaultBlend, kDefaultIterations));
-    double heightSum = 0.0;
-    int count = 0;
-    for (const openvdb::Vec3s& p : result.mesh.points) {
-        if (std::abs(p[0]) < 0.5 && std::abs(p[1]) < 0.5 && p[2] > 0.0f) {
-            heightSum += p[2];
-            ++count;
-        }
-    }
+    const auto [meanHeight, count] = nonbloppy_test::meanTopHeight(result.mesh.points);
     ASSERT_GT(count, 50);
-    EXPECT_NEAR(heightSum / count, spacing / 2, 0.03 * spacing);
+    EXPECT_NEAR(meanHeight, spacing / 2, 0.03 * spacing);
 }
 
 TEST(Fidelity, RelaxedThresholdIsTheBlobThresholdWithoutRelaxation)

@@ -3,6 +3,8 @@
 // checked against the other reader of the same frame, synthetic files in every encoding,
 // and truncated, corrupt and hostile input with their exact messages.
 
+#include "TestUtil.h"
+
 #include <nonbloppy/Error.h>
 #include <nonbloppy/ReadParticles.h>
 
@@ -29,32 +31,15 @@
 
 namespace {
 
+using nonbloppy_test::dataPath;
+using nonbloppy_test::readBytes;
+using nonbloppy_test::writeBytes;
+
 using nonbloppy::FileError;
 using nonbloppy::ParticleAttribute;
 using nonbloppy::ParticleSet;
 using nonbloppy::ScalarType;
 using nonbloppy::readParticles;
-
-std::string
-dataPath(const std::string& name)
-{
-    return std::string(NONBLOPPY_TEST_DATA_DIR) + "/" + name;
-}
-
-std::string
-readBytes(const std::string& path)
-{
-    std::ifstream is(path, std::ios::binary);
-    return std::string(std::istreambuf_iterator<char>(is), std::istreambuf_iterator<char>());
-}
-
-void
-writeBytes(const std::string& path, const std::string& bytes)
-{
-    std::ofstream os(path, std::ios::binary | std::ios::trunc);
-    os.write(bytes.data(), std::streamsize(bytes.size()));
-    ASSERT_TRUE(os.good()) << path;
-}
 
 std::string
 gunzipBytes(const std::string& compressed)
@@ -110,28 +95,14 @@ bytesOf(T value, bool bigEndian = false)
     return bytes;
 }
 
-class ReadFormatsTest : public ::testing::Test
+class ReadFormatsTest : public nonbloppy_test::ScratchDirTest
 {
 protected:
-    void SetUp() override
-    {
-        std::string pattern = ::testing::TempDir() + "nonbloppy_formats_XXXXXX";
-        ASSERT_NE(mkdtemp(pattern.data()), nullptr);
-        mDir = pattern;
-    }
-    void TearDown() override
-    {
-        const std::string command = "rm -rf '" + mDir + "'";
-        EXPECT_EQ(std::system(command.c_str()), 0);
-    }
-    std::string path(const std::string& name) const { return mDir + "/" + name; }
     std::string write(const std::string& name, const std::string& bytes) const
     {
         writeBytes(path(name), bytes);
         return path(name);
     }
-
-    std::string mDir;
 };
 
 std::string

@@ -2,6 +2,8 @@
 // Tests for readParticles(): the real SPlisHSPlasH frames in tests/data, synthetic VTK, PLY
 // and XYZ files written here, and truncated or corrupt input.
 
+#include "TestUtil.h"
+
 #include <nonbloppy/Error.h>
 #include <nonbloppy/ReadParticles.h>
 
@@ -24,51 +26,18 @@
 
 namespace {
 
+using nonbloppy_test::dataPath;
+using nonbloppy_test::readBytes;
+using nonbloppy_test::writeBytes;
+
 using nonbloppy::FileError;
 using nonbloppy::ParameterError;
 using nonbloppy::ParticleSet;
 using nonbloppy::ScalarType;
 using nonbloppy::readParticles;
 
-std::string
-dataPath(const std::string& name)
+class ReadParticlesTest : public nonbloppy_test::ScratchDirTest
 {
-    return std::string(NONBLOPPY_TEST_DATA_DIR) + "/" + name;
-}
-
-std::string
-readBytes(const std::string& path)
-{
-    std::ifstream is(path, std::ios::binary);
-    return std::string(std::istreambuf_iterator<char>(is), std::istreambuf_iterator<char>());
-}
-
-void
-writeBytes(const std::string& path, const std::string& bytes)
-{
-    std::ofstream os(path, std::ios::binary | std::ios::trunc);
-    os.write(bytes.data(), std::streamsize(bytes.size()));
-    ASSERT_TRUE(os.good()) << path;
-}
-
-/// A fresh directory for one test.
-class ReadParticlesTest : public ::testing::Test
-{
-protected:
-    void SetUp() override
-    {
-        std::string pattern = ::testing::TempDir() + "nonbloppy_read_XXXXXX";
-        ASSERT_NE(mkdtemp(pattern.data()), nullptr);
-        mDir = pattern;
-    }
-    void TearDown() override
-    {
-        const std::string command = "rm -rf '" + mDir + "'";
-        EXPECT_EQ(std::system(command.c_str()), 0);
-    }
-    std::string path(const std::string& name) const { return mDir + "/" + name; }
-
-    std::string mDir;
 };
 
 /// The message of the exception @a ExceptionT that @a f throws ("" if none).

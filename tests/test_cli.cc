@@ -6,144 +6,32 @@
 
 #include <gtest/gtest.h>
 
+#include "CliTestUtil.h"
+
 #include <openvdb/version.h>
 
-#include <fcntl.h>
-#include <signal.h>
-#include <spawn.h>
-#include <sys/wait.h>
-#include <unistd.h>
-
-#include <chrono>
-#include <thread>
-
-#include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
-#include <filesystem>
-#include <fstream>
-#include <iterator>
-#include <sstream>
 #include <string>
 #include <vector>
 
 namespace {
 
 namespace fs = std::filesystem;
+using namespace nonbloppy_test;
 
-const std::string kCli = NONBLOPPY_CLI_PATH;
 const std::string kData = NONBLOPPY_TEST_DATA_DIR;
 const std::string kCube = kData + "/cube_2366_particles.vtk";
 
-std::string readText(const std::string& path)
-{
-    std::ifstream in(path, std::ios::binary);
-    return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-}
-
-void writeText(const std::string& path, const std::string& text)
-{
-    std::ofstream out(path, std::ios::binary);
-    out << text;
-}
-
-std::string quote(const std::string& s)
-{
-    std::string out = "'";
-    for (char c : s) {
-        if (c == '\'') out += "'\\''";
-        else out += c;
-    }
-    return out + "'";
-}
-
-std::vector<std::string> lines(const std::string& text)
-{
-    std::vector<std::string> out;
-    std::istringstream in(text);
-    for (std::string line; std::getline(in, line);) out.push_back(line);
-    return out;
-}
-
-/// Names of the entries of @a dir, sorted.
-std::vector<std::string> listDir(const std::string& dir)
-{
-    std::vector<std::string> names;
-    for (const auto& entry : fs::directory_iterator(dir)) {
-        names.push_back(entry.path().filename().string());
-    }
-    std::sort(names.begin(), names.end());
-    return names;
-}
-
-struct RunResult
-{
-    int exitCode = -1;
-    std::string out, err;
-};
-
-/// A fresh directory per test under ::testing::TempDir(), removed afterwards.
-class CliTest : public ::testing::Test
+class CliTest : public CliFixture
 {
 protected:
-    void SetUp() override
-    {
-        const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-        mDir = (fs::path(::testing::TempDir()) / ("nonbloppy_cli_" + std::string(info->name())
-                                                  + "_" + std::to_string(::getpid())))
-                   .string();
-        fs::remove_all(mDir);
-        fs::create_directories(mDir + "/out");
-        fs::create_directories(mDir + "/in");
-    }
-    void TearDown() override
-    {
-        std::error_code ec;
-        fs::remove_all(mDir, ec);
-    }
-
-    /// Run `nonbloppy ARGS` (ARGS already shell-quoted) with stdout and stderr in files.
-    RunResult run(const std::string& args) const
-    {
-        const std::string outFile = mDir + "/stdout.txt", errFile = mDir + "/stderr.txt";
-        const std::string command = quote(kCli) + " " + args + " >" + quote(outFile) + " 2>"
-                                    + quote(errFile) + " </dev/null";
-        const int status = std::system(command.c_str());
-        RunResult result;
-        result.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-        result.out = readText(outFile);
-        result.err = readText(errFile);
-        return result;
-    }
-
-    std::string dir() const { return mDir; }
-    std::string out(const std::string& name) const { return mDir + "/out/" + name; }
-    std::string in(const std::string& name) const { return mDir + "/in/" + name; }
-
-    /// The failure contract: non-zero exit, exactly one stderr line, equal to @a message,
-    /// and nothing (not even a temporary file) in the output directory.
-    void expectFailure(const std::string& args, const std::string& message) const
-    {
-        SCOPED_TRACE(args);
-        const RunResult r = run(args);
-        EXPECT_NE(r.exitCode, 0);
-        EXPECT_LT(r.exitCode, 128) << "crashed";
-        const std::vector<std::string> errLines = lines(r.err);
-        ASSERT_EQ(errLines.size(), 1u) << r.err;
-        EXPECT_EQ(errLines[0], "nonbloppy: " + message);
-        EXPECT_TRUE(listDir(mDir + "/out").empty()) << "output files left behind";
-    }
-
     /// Mesh the cube into out/NAME.obj and out/NAME.vdb; returns the run.
     RunResult meshCube(const std::string& name, const std::string& extra = "") const
     {
         return run("mesh " + quote(kCube) + " -o " + quote(out(name + ".obj")) + " --vdb "
                    + quote(out(name + ".vdb")) + " " + extra);
     }
-
-private:
-    std::string mDir;
 };
 
 /// The number after `"key": ` in a JSON text, NaN when absent.
@@ -397,35 +285,16 @@ TEST_F(CliTest, InspectMissingFile)
 
 TEST_F(CliTest, SigintCancelsWithoutLeavingFiles)
 {
-    // A run long enough to be caught mid-way: a fine grid on the dam-break frame.
-    const std::string errFile = dir() + "/stderr.txt";
-    const std::vector<std::string> args = {
-        kCli, "mesh", kData + "/dam_break_frame_23_24389_particles.vtk", "-o", out("dam.obj"),
-        "--vdb", out("dam.vdb"), "--voxel-size", "0.005", "-v"};
-    std::vector<char*> argv;
-    for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
-    argv.push_back(nullptr);
-
-    posix_spawn_file_actions_t actions;
-    posix_spawn_file_actions_init(&actions);
-    posix_spawn_file_actions_addopen(&actions, 1, "/dev/null", O_WRONLY, 0);
-    posix_spawn_file_actions_addopen(&actions, 2, errFile.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    pid_t pid = 0;
-    ASSERT_EQ(posix_spawn(&pid, kCli.c_str(), &actions, nullptr, argv.data(), environ), 0);
-    posix_spawn_file_actions_destroy(&actions);
-
-    // The progress line shows that the signal handlers are installed; interrupt then.
-    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(30);
-    while (readText(errFile).find("[progress] rasterize density") == std::string::npos
-           && std::chrono::steady_clock::now() < deadline) {
-        std::this_thread::sleep_for(std::chrono::milliseconds(5));
-    }
-    ::kill(pid, SIGINT);
-    int status = 0;
-    ASSERT_EQ(::waitpid(pid, &status, 0), pid);
-    ASSERT_TRUE(WIFEXITED(status)) << "killed by signal " << WTERMSIG(status);
-    EXPECT_EQ(WEXITSTATUS(status), 130);
-    const std::vector<std::string> errLines = lines(readText(errFile));
+    // A run long enough to be caught mid-way: a fine grid on the dam-break frame. The
+    // progress line shows that the signal handlers are installed; interrupt then.
+    const RunResult r = interruptWhen(
+        {"mesh", kData + "/dam_break_frame_23_24389_particles.vtk", "-o", out("dam.obj"), "--vdb",
+         out("dam.vdb"), "--voxel-size", "0.005", "-v"},
+        [](const std::string& err) { return err.find("[progress] rasterize density") != std::string::npos; },
+        SIGINT);
+    ASSERT_EQ(r.killedBy, 0) << "killed by the signal instead of handling it";
+    EXPECT_EQ(r.exitCode, 130);
+    const std::vector<std::string> errLines = lines(r.err);
     ASSERT_FALSE(errLines.empty());
     EXPECT_EQ(errLines.back(), "nonbloppy: interrupted");
     EXPECT_TRUE(listDir(dir() + "/out").empty()) << "output files left behind";

@@ -13,14 +13,9 @@
 
 #include <gtest/gtest.h>
 
-#include <sys/wait.h>
-#include <unistd.h>
+#include "CliTestUtil.h"
 
 #include <cmath>
-#include <cstdlib>
-#include <filesystem>
-#include <fstream>
-#include <iterator>
 #include <map>
 #include <string>
 #include <vector>
@@ -28,57 +23,16 @@
 namespace {
 
 namespace fs = std::filesystem;
+using namespace nonbloppy_test;
 using nonbloppy::ParticleAttribute;
 using nonbloppy::ParticleSet;
 
-const std::string kCli = NONBLOPPY_CLI_PATH;
 const std::string kData = NONBLOPPY_TEST_DATA_DIR;
 
-std::string quote(const std::string& s) { return "'" + s + "'"; }
-
-std::string readText(const std::string& path)
-{
-    std::ifstream is(path, std::ios::binary);
-    return std::string(std::istreambuf_iterator<char>(is), std::istreambuf_iterator<char>());
-}
-
-struct RunResult
-{
-    int exitCode = -1;
-    std::string out, err;
-};
-
-class CliFormatsTest : public ::testing::Test
+class CliFormatsTest : public CliFixture
 {
 protected:
-    void SetUp() override
-    {
-        const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-        mDir = (fs::path(::testing::TempDir()) / ("nonbloppy_clifmt_" + std::string(info->name()) +
-                                                  "_" + std::to_string(::getpid()))).string();
-        fs::remove_all(mDir);
-        fs::create_directories(mDir);
-    }
-    void TearDown() override
-    {
-        std::error_code ec;
-        fs::remove_all(mDir, ec);
-    }
-    RunResult run(const std::string& args) const
-    {
-        const std::string outFile = mDir + "/stdout.txt", errFile = mDir + "/stderr.txt";
-        const std::string command = quote(kCli) + " " + args + " >" + quote(outFile) + " 2>" +
-                                    quote(errFile) + " </dev/null";
-        const int status = std::system(command.c_str());
-        RunResult result;
-        result.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-        result.out = readText(outFile);
-        result.err = readText(errFile);
-        return result;
-    }
-    std::string path(const std::string& name) const { return mDir + "/" + name; }
-
-    std::string mDir;
+    std::string path(const std::string& name) const { return dir() + "/" + name; }
 };
 
 /// The values of attribute @a name (component @a c) per particle, keyed by the "id"

@@ -7,125 +7,31 @@
 
 #include <gtest/gtest.h>
 
-#include <fcntl.h>
-#include <signal.h>
-#include <spawn.h>
-#include <sys/wait.h>
-#include <unistd.h>
+#include "CliTestUtil.h"
 
-#include <algorithm>
-#include <chrono>
-#include <cmath>
-#include <cstdlib>
-#include <filesystem>
-#include <fstream>
-#include <iterator>
-#include <sstream>
+#include <cstdio>
 #include <string>
-#include <thread>
 #include <vector>
 
 namespace {
 
 namespace fs = std::filesystem;
+using namespace nonbloppy_test;
 
-const std::string kCli = NONBLOPPY_CLI_PATH;
 const std::string kData = NONBLOPPY_TEST_DATA_DIR;
 const std::string kCube = kData + "/cube_2366_particles.vtk";
 const std::string kFree = kData + "/free_particles_125_particles.vtk";
 
-std::string readText(const std::string& path)
-{
-    std::ifstream in(path, std::ios::binary);
-    return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-}
-
-void writeText(const std::string& path, const std::string& text)
-{
-    std::ofstream out(path, std::ios::binary);
-    out << text;
-}
-
-std::string quote(const std::string& s)
-{
-    std::string out = "'";
-    for (char c : s) {
-        if (c == '\'') out += "'\\''";
-        else out += c;
-    }
-    return out + "'";
-}
-
-std::vector<std::string> lines(const std::string& text)
-{
-    std::vector<std::string> out;
-    std::istringstream in(text);
-    for (std::string line; std::getline(in, line);) out.push_back(line);
-    return out;
-}
-
-std::vector<std::string> listDir(const std::string& dir)
-{
-    std::vector<std::string> names;
-    for (const auto& entry : fs::directory_iterator(dir)) {
-        names.push_back(entry.path().filename().string());
-    }
-    std::sort(names.begin(), names.end());
-    return names;
-}
-
-size_t count(const std::string& text, const std::string& needle)
-{
-    size_t n = 0;
-    for (size_t at = text.find(needle); at != std::string::npos; at = text.find(needle, at + 1)) ++n;
-    return n;
-}
-
-struct RunResult
-{
-    int exitCode = -1;
-    std::string out, err;
-};
-
-class CliSequenceTest : public ::testing::Test
+class CliSequenceTest : public CliFixture
 {
 protected:
-    void SetUp() override
-    {
-        const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-        mDir = (fs::path(::testing::TempDir()) / ("nonbloppy_seq_" + std::string(info->name())
-                                                  + "_" + std::to_string(::getpid())))
-                   .string();
-        fs::remove_all(mDir);
-        fs::create_directories(mDir + "/in");
-        fs::create_directories(mDir + "/out");
-    }
-    void TearDown() override
-    {
-        std::error_code ec;
-        fs::remove_all(mDir, ec);
-    }
-
-    RunResult run(const std::string& args) const
-    {
-        const std::string outFile = mDir + "/stdout.txt", errFile = mDir + "/stderr.txt";
-        const std::string command = quote(kCli) + " " + args + " >" + quote(outFile) + " 2>"
-                                    + quote(errFile) + " </dev/null";
-        const int status = std::system(command.c_str());
-        RunResult result;
-        result.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-        result.out = readText(outFile);
-        result.err = readText(errFile);
-        return result;
-    }
-
     /// in/fluid_0001.vtk ... one file per source, numbered from @a first.
     void makeFrames(const std::vector<std::string>& sources, int first = 1) const
     {
         for (size_t i = 0; i < sources.size(); ++i) {
             char name[64];
             std::snprintf(name, sizeof(name), "/in/fluid_%04d.vtk", int(first + i));
-            fs::copy_file(sources[i], mDir + name, fs::copy_options::overwrite_existing);
+            fs::copy_file(sources[i], dir() + name, fs::copy_options::overwrite_existing);
         }
     }
 
@@ -134,12 +40,8 @@ protected:
     {
         char name[64];
         std::snprintf(name, sizeof(name), "/in/fluid_%04d.vtk", number);
-        writeText(mDir + name, readText(kCube).substr(0, 300));
+        writeText(dir() + name, readText(kCube).substr(0, 300));
     }
-
-    std::string dir() const { return mDir; }
-    std::string in(const std::string& name) const { return mDir + "/in/" + name; }
-    std::string out(const std::string& name) const { return mDir + "/out/" + name; }
 
     /// `mesh in/fluid_{}.vtk -o OUTDIR/mesh_{}.obj --vdb OUTDIR/density_####.vdb -q EXTRA`
     RunResult meshSequence(const std::string& outDir, const std::string& extra) const
@@ -148,9 +50,6 @@ protected:
         return run("mesh " + quote(in("fluid_{}.vtk")) + " -o " + quote(outDir + "/mesh_{}.obj")
                    + " --vdb " + quote(outDir + "/density_####.vdb") + " " + extra);
     }
-
-private:
-    std::string mDir;
 };
 
 } // namespace
@@ -345,33 +244,15 @@ TEST_F(CliSequenceTest, InterruptedRunLeavesNoPartialFile)
 {
     // Frame 1 is quick; frame 2, the dam break on a fine grid, takes long enough to be caught.
     makeFrames({kCube, kData + "/dam_break_frame_23_24389_particles.vtk", kCube});
-    const std::string errFile = dir() + "/stderr.txt";
-    const std::vector<std::string> args = {
-        kCli, "mesh", in("fluid_{}.vtk"), "-o", out("mesh_{}.obj"), "--vdb", out("d_{}.vdb"),
-        "--voxel-size", "0.005", "-v", "--log", dir() + "/run.jsonl"};
-    std::vector<char*> argv;
-    for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
-    argv.push_back(nullptr);
-    posix_spawn_file_actions_t actions;
-    posix_spawn_file_actions_init(&actions);
-    posix_spawn_file_actions_addopen(&actions, 1, "/dev/null", O_WRONLY, 0);
-    posix_spawn_file_actions_addopen(&actions, 2, errFile.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    pid_t pid = 0;
-    ASSERT_EQ(posix_spawn(&pid, kCli.c_str(), &actions, nullptr, argv.data(), environ), 0);
-    posix_spawn_file_actions_destroy(&actions);
-
     // Interrupt once the second frame's density is being computed.
-    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(30);
-    while (count(readText(errFile), "[progress] rasterize density ...") < 2
-           && std::chrono::steady_clock::now() < deadline) {
-        std::this_thread::sleep_for(std::chrono::milliseconds(5));
-    }
-    ::kill(pid, SIGTERM);
-    int status = 0;
-    ASSERT_EQ(::waitpid(pid, &status, 0), pid);
-    ASSERT_TRUE(WIFEXITED(status)) << "killed by signal " << WTERMSIG(status);
-    EXPECT_EQ(WEXITSTATUS(status), 130);
-    const std::vector<std::string> errLines = lines(readText(errFile));
+    const RunResult r = interruptWhen(
+        {"mesh", in("fluid_{}.vtk"), "-o", out("mesh_{}.obj"), "--vdb", out("d_{}.vdb"),
+         "--voxel-size", "0.005", "-v", "--log", dir() + "/run.jsonl"},
+        [](const std::string& err) { return count(err, "[progress] rasterize density ...") >= 2; },
+        SIGTERM);
+    ASSERT_EQ(r.killedBy, 0) << "killed by the signal instead of handling it";
+    EXPECT_EQ(r.exitCode, 130);
+    const std::vector<std::string> errLines = lines(r.err);
     ASSERT_FALSE(errLines.empty());
     EXPECT_EQ(errLines.back(), "nonbloppy: interrupted; finished frames: 1 (1 of 3)");
     EXPECT_EQ(listDir(dir() + "/out"), (std::vector<std::string>{"d_0001.vdb", "mesh_0001.obj"}));

@@ -6,6 +6,7 @@
 #include "BatchRun.h"
 
 #include "Commands.h"
+#include "Json.h"
 
 #include <nonbloppy/Error.h>
 
@@ -466,43 +467,6 @@ std::string ResidentSampler::report(const nonbloppy::StageTimings& timings, size
                   particles ? double(peak) / double(particles) : 0.0);
     out += line;
     return out;
-}
-
-// ---------------------------------------------------------------------------------------
-// JSON
-
-std::string jsonString(const std::string& text)
-{
-    std::string out = "\"";
-    for (const char c : text) {
-        switch (c) {
-        case '"': out += "\\\""; break;
-        case '\\': out += "\\\\"; break;
-        case '\n': out += "\\n"; break;
-        case '\r': out += "\\r"; break;
-        case '\t': out += "\\t"; break;
-        default:
-            if (static_cast<unsigned char>(c) < 0x20) {
-                char buffer[8];
-                std::snprintf(buffer, sizeof(buffer), "\\u%04x", c);
-                out += buffer;
-            } else {
-                out += c;
-            }
-        }
-    }
-    return out + "\"";
-}
-
-std::string jsonNumber(double value)
-{
-    if (!std::isfinite(value)) return "null";
-    char buffer[40];
-    for (int precision = 1; precision <= 17; ++precision) {
-        std::snprintf(buffer, sizeof(buffer), "%.*g", precision, value);
-        if (std::strtod(buffer, nullptr) == value) break;
-    }
-    return buffer;
 }
 
 } // namespace nonbloppy_tool

@@ -104,14 +104,6 @@ private:
     std::thread mThread;
 };
 
-// ---------------------------------------------------------------------------------------
-// JSON
-
-/// @a text as a JSON string literal, quotes included.
-std::string jsonString(const std::string& text);
-/// @a value as a JSON number (shortest round-trip form; null for NaN/inf).
-std::string jsonNumber(double value);
-
 } // namespace nonbloppy_tool
 
 #endif // NONBLOPPY_TOOL_BATCH_RUN_H

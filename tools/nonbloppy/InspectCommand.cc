@@ -4,6 +4,7 @@
 ///        manner of vdb_print (one line per grid) and pbrt's `plytool info`.
 
 #include "Commands.h"
+#include "Json.h"
 
 #include <nonbloppy/Error.h>
 #include <nonbloppy/EstimateParameters.h>
@@ -42,45 +43,6 @@ namespace {
 // ---------------------------------------------------------------------------------------
 // A small JSON writer: objects and arrays, indented two spaces, strings escaped.
 
-/// A double in the fewest digits that read back to the same value; null when not finite
-/// (JSON has no NaN or infinity).
-std::string jsonNumber(double value)
-{
-    if (!std::isfinite(value)) return "null";
-    char buffer[40];
-    for (int precision = 6; precision <= 17; ++precision) {
-        std::snprintf(buffer, sizeof(buffer), "%.*g", precision, value);
-        if (std::strtod(buffer, nullptr) == value) break;
-    }
-    return buffer;
-}
-
-std::string jsonString(const std::string& text)
-{
-    std::string out = "\"";
-    for (const char ch : text) {
-        const unsigned char c = static_cast<unsigned char>(ch);
-        switch (c) {
-        case '"': out += "\\\""; break;
-        case '\\': out += "\\\\"; break;
-        case '\n': out += "\\n"; break;
-        case '\r': out += "\\r"; break;
-        case '\t': out += "\\t"; break;
-        case '\b': out += "\\b"; break;
-        case '\f': out += "\\f"; break;
-        default:
-            if (c < 0x20 || c == 0x7f) {
-                char buffer[8];
-                std::snprintf(buffer, sizeof(buffer), "\\u%04x", c);
-                out += buffer;
-            } else {
-                out += ch; // UTF-8 bytes pass through unchanged
-            }
-        }
-    }
-    return out + "\"";
-}
-
 class JsonWriter
 {
 public:
@@ -102,6 +64,19 @@ public:
     void vec3(const char* key, double x, double y, double z)
     {
         raw(key, "[" + jsonNumber(x) + ", " + jsonNumber(y) + ", " + jsonNumber(z) + "]");
+    }
+
+    /// "bbox": {"min": [...], "max": [...]}, or null when there is no point.
+    void boundingBox(const std::optional<std::pair<openvdb::Vec3d, openvdb::Vec3d>>& bbox)
+    {
+        if (!bbox) {
+            raw("bbox", "null");
+            return;
+        }
+        beginObject("bbox");
+        vec3("min", bbox->first.x(), bbox->first.y(), bbox->first.z());
+        vec3("max", bbox->second.x(), bbox->second.y(), bbox->second.z());
+        endObject();
     }
 
     std::string str() const { return mOut.str() + "\n"; }
@@ -201,14 +176,7 @@ int inspectParticles(const std::string& path, const nonbloppy::ParticleSet& part
         w.string("file", path);
         w.string("type", "particles");
         w.integer("particles", static_cast<long long>(particles.size()));
-        if (bbox) {
-            w.beginObject("bbox");
-            w.vec3("min", bbox->first.x(), bbox->first.y(), bbox->first.z());
-            w.vec3("max", bbox->second.x(), bbox->second.y(), bbox->second.z());
-            w.endObject();
-        } else {
-            w.raw("bbox", "null");
-        }
+        w.boundingBox(bbox);
         if (spacing) w.number("spacing", *spacing);
         else w.raw("spacing", "null");
         w.beginArray("attributes");
@@ -275,14 +243,7 @@ int inspectMesh(const std::string& path, const nonbloppy::SurfaceMesh& mesh, boo
         w.integer("unused_vertices", static_cast<long long>(m.unusedVertices));
         w.number("area", m.area);
         w.number("volume", m.volume);
-        if (bbox) {
-            w.beginObject("bbox");
-            w.vec3("min", bbox->first.x(), bbox->first.y(), bbox->first.z());
-            w.vec3("max", bbox->second.x(), bbox->second.y(), bbox->second.z());
-            w.endObject();
-        } else {
-            w.raw("bbox", "null");
-        }
+        w.boundingBox(bbox);
         w.endObject();
         std::cout << w.str();
         return 0;

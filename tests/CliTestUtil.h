@@ -1,0 +1,189 @@
+// SPDX-License-Identifier: Apache-2.0
+/// @file CliTestUtil.h
+/// @brief Running the built `nonbloppy` tool (NONBLOPPY_CLI_PATH) from tests as a user would:
+///        a fresh directory per test, captured stdout/stderr, the one-line failure contract,
+///        and a spawned run that a test can signal mid-way.
+
+#ifndef NONBLOPPY_CLI_TEST_UTIL_H
+#define NONBLOPPY_CLI_TEST_UTIL_H
+
+#include <gtest/gtest.h>
+
+#include <fcntl.h>
+#include <signal.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <iterator>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+namespace nonbloppy_test {
+
+inline const std::string kCli = NONBLOPPY_CLI_PATH;
+
+inline std::string readText(const std::string& path)
+{
+    std::ifstream in(path, std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+inline void writeText(const std::string& path, const std::string& text)
+{
+    std::ofstream out(path, std::ios::binary);
+    out << text;
+}
+
+/// @a s quoted for /bin/sh.
+inline std::string quote(const std::string& s)
+{
+    std::string out = "'";
+    for (char c : s) {
+        if (c == '\'') out += "'\\''";
+        else out += c;
+    }
+    return out + "'";
+}
+
+inline std::vector<std::string> lines(const std::string& text)
+{
+    std::vector<std::string> out;
+    std::istringstream in(text);
+    for (std::string line; std::getline(in, line);) out.push_back(line);
+    return out;
+}
+
+/// Names of the entries of @a dir, sorted.
+inline std::vector<std::string> listDir(const std::string& dir)
+{
+    std::vector<std::string> names;
+    for (const auto& entry : std::filesystem::directory_iterator(dir)) {
+        names.push_back(entry.path().filename().string());
+    }
+    std::sort(names.begin(), names.end());
+    return names;
+}
+
+/// How often @a needle occurs in @a text.
+inline size_t count(const std::string& text, const std::string& needle)
+{
+    size_t n = 0;
+    for (size_t at = text.find(needle); at != std::string::npos; at = text.find(needle, at + 1)) ++n;
+    return n;
+}
+
+struct RunResult
+{
+    int exitCode = -1;  ///< 128 + signal number when the tool was killed by a signal
+    int killedBy = 0;   ///< interruptWhen(): the signal that killed the tool, 0 if it exited
+    std::string out, err;
+};
+
+/// A fresh directory per test, `<TempDir>/nonbloppy_<suite>_<test>_<pid>` with empty
+/// subdirectories in/ and out/, removed afterwards.
+class CliFixture : public ::testing::Test
+{
+protected:
+    void SetUp() override
+    {
+        const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+        mDir = (std::filesystem::path(::testing::TempDir())
+                / ("nonbloppy_" + std::string(info->test_suite_name()) + "_" + info->name() + "_"
+                   + std::to_string(::getpid())))
+                   .string();
+        std::filesystem::remove_all(mDir);
+        std::filesystem::create_directories(mDir + "/in");
+        std::filesystem::create_directories(mDir + "/out");
+    }
+    void TearDown() override
+    {
+        std::error_code ec;
+        std::filesystem::remove_all(mDir, ec);
+    }
+
+    std::string dir() const { return mDir; }
+    std::string in(const std::string& name) const { return mDir + "/in/" + name; }
+    std::string out(const std::string& name) const { return mDir + "/out/" + name; }
+
+    /// Run `nonbloppy ARGS` (ARGS already shell-quoted) with stdout and stderr in files.
+    RunResult run(const std::string& args) const
+    {
+        const std::string outFile = mDir + "/stdout.txt", errFile = mDir + "/stderr.txt";
+        const std::string command = quote(kCli) + " " + args + " >" + quote(outFile) + " 2>"
+                                    + quote(errFile) + " </dev/null";
+        const int status = std::system(command.c_str());
+        RunResult result;
+        result.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+        result.out = readText(outFile);
+        result.err = readText(errFile);
+        return result;
+    }
+
+    /// The failure contract: non-zero exit, exactly one stderr line, equal to
+    /// "nonbloppy: " + @a message, and nothing (not even a temporary file) in out/.
+    void expectFailure(const std::string& args, const std::string& message) const
+    {
+        SCOPED_TRACE(args);
+        const RunResult r = run(args);
+        EXPECT_NE(r.exitCode, 0);
+        EXPECT_LT(r.exitCode, 128) << "crashed";
+        const std::vector<std::string> errLines = lines(r.err);
+        ASSERT_EQ(errLines.size(), 1u) << r.err;
+        EXPECT_EQ(errLines[0], "nonbloppy: " + message);
+        EXPECT_TRUE(listDir(mDir + "/out").empty()) << "output files left behind";
+    }
+
+    /// Starts `nonbloppy ARGS` (unquoted arguments) with stdout to /dev/null and stderr to
+    /// stderr.txt; waits until @a ready holds for that stderr (at most 30 s), sends @a signal
+    /// and waits for the exit. Returns how it ended and the stderr text.
+    RunResult interruptWhen(const std::vector<std::string>& args,
+                            const std::function<bool(const std::string& err)>& ready, int signal) const
+    {
+        const std::string errFile = mDir + "/stderr.txt";
+        std::vector<std::string> full = {kCli};
+        full.insert(full.end(), args.begin(), args.end());
+        std::vector<char*> argv;
+        for (const std::string& a : full) argv.push_back(const_cast<char*>(a.c_str()));
+        argv.push_back(nullptr);
+
+        posix_spawn_file_actions_t actions;
+        posix_spawn_file_actions_init(&actions);
+        posix_spawn_file_actions_addopen(&actions, 1, "/dev/null", O_WRONLY, 0);
+        posix_spawn_file_actions_addopen(&actions, 2, errFile.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+        pid_t pid = 0;
+        RunResult result;
+        const int spawned = posix_spawn(&pid, kCli.c_str(), &actions, nullptr, argv.data(), environ);
+        posix_spawn_file_actions_destroy(&actions);
+        if (spawned != 0) {
+            ADD_FAILURE() << "posix_spawn failed: " << spawned;
+            return result;
+        }
+        const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+        while (!ready(readText(errFile)) && std::chrono::steady_clock::now() < deadline) {
+            std::this_thread::sleep_for(std::chrono::milliseconds(5));
+        }
+        ::kill(pid, signal);
+        int status = 0;
+        if (::waitpid(pid, &status, 0) != pid) ADD_FAILURE() << "waitpid failed";
+        result.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+        result.killedBy = WIFSIGNALED(status) ? WTERMSIG(status) : 0;
+        result.err = readText(errFile);
+        return result;
+    }
+
+private:
+    std::string mDir;
+};
+
+} // namespace nonbloppy_test
+
+#endif // NONBLOPPY_CLI_TEST_UTIL_H

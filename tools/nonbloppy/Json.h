@@ -1,0 +1,23 @@
+// SPDX-License-Identifier: Apache-2.0
+/// @file Json.h
+/// @brief The two JSON value encoders the tool's outputs share (`inspect --json`, the
+///        `--log` lines of a frame sequence): strings and numbers.
+
+#ifndef NONBLOPPY_TOOL_JSON_H
+#define NONBLOPPY_TOOL_JSON_H
+
+#include <string>
+
+namespace nonbloppy_tool {
+
+/// @a text as a JSON string literal, quotes included: `"` `\` and control characters
+/// escaped, other bytes (UTF-8) passed through.
+std::string jsonString(const std::string& text);
+
+/// @a value as a JSON number in the fewest significant digits (at least 6) that read back
+/// to the same double; `null` when not finite (JSON has no NaN or infinity).
+std::string jsonNumber(double value);
+
+} // namespace nonbloppy_tool
+
+#endif // NONBLOPPY_TOOL_JSON_H
