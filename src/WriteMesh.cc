@@ -4,7 +4,10 @@
 ///
 /// Each writer formats into a large in-memory chunk that is handed to the stream a few
 /// megabytes at a time, instead of one ostream operation per value, and goes through
-/// AtomicFile so a failed write never leaves a partial mesh behind.
+/// AtomicFile so a failed write never leaves a partial mesh behind. The binary formats have
+/// fixed-size records (a vertex, a triangle, a quad), so each batch of records is encoded in
+/// parallel straight to its final offset and then written in order: the bytes are the same
+/// for any thread count.
 
 #include <nonbloppy/WriteMesh.h>
 
@@ -13,11 +16,16 @@
 #include "AtomicFile.h"
 #include "FileFormats.h"
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
 #include <charconv>
 #include <cstdint>
 #include <cstring>
 #include <limits>
 #include <ostream>
+#include <vector>
 
 namespace nonbloppy {
 
@@ -32,11 +40,6 @@ public:
 
     void text(const char* s) { mBuffer.append(s); maybeFlush(); }
     void text(const std::string& s) { mBuffer.append(s); maybeFlush(); }
-    void bytes(const void* p, size_t n)
-    {
-        mBuffer.append(static_cast<const char*>(p), n);
-        maybeFlush();
-    }
     void character(char ch) { mBuffer.push_back(ch); }
 
     /// Shortest decimal text that reads back as exactly @a value (deterministic).
@@ -53,25 +56,6 @@ public:
         mBuffer.append(digits, size_t(result.ptr - digits));
     }
 
-    template<typename T>
-    void littleEndian(T value)
-    {
-        static_assert(sizeof(T) == 4, "4-byte values only");
-        uint32_t bits;
-        std::memcpy(&bits, &value, 4);
-        if (__BYTE_ORDER__ == __ORDER_BIG_ENDIAN__) bits = __builtin_bswap32(bits);
-        bytes(&bits, 4);
-    }
-    template<typename T>
-    void bigEndian(T value)
-    {
-        static_assert(sizeof(T) == 4, "4-byte values only");
-        uint32_t bits;
-        std::memcpy(&bits, &value, 4);
-        if (__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__) bits = __builtin_bswap32(bits);
-        bytes(&bits, 4);
-    }
-
     void maybeFlush()
     {
         if (mBuffer.size() >= kChunk) flush();
@@ -80,6 +64,12 @@ public:
     {
         mStream.write(mBuffer.data(), std::streamsize(mBuffer.size()));
         mBuffer.clear();
+    }
+    /// The stream, with everything collected so far passed on: for writing directly.
+    std::ostream& stream()
+    {
+        flush();
+        return mStream;
     }
 
 private:
@@ -123,6 +113,79 @@ struct PolygonView
         }
     }
 };
+
+/// Stores @a value's bytes at @a at in the given byte order; returns the next position.
+template<bool BigEndian, typename T>
+inline char* put4(char* at, T value)
+{
+    static_assert(sizeof(T) == 4, "4-byte values only");
+    uint32_t bits;
+    std::memcpy(&bits, &value, 4);
+    if ((__BYTE_ORDER__ == __ORDER_BIG_ENDIAN__) != BigEndian) bits = __builtin_bswap32(bits);
+    std::memcpy(at, &bits, 4);
+    return at + 4;
+}
+
+/// Writes @a count records of @a recordBytes each, record i encoded by
+/// encode(i, char* record): batches of about 16 MB are encoded in parallel into one buffer
+/// and written in order (peak extra memory: one batch).
+template<typename EncodeT>
+void
+writeRecords(ChunkWriter& out, size_t count, size_t recordBytes, const EncodeT& encode)
+{
+    if (count == 0) return;
+    std::ostream& os = out.stream();
+    constexpr size_t kBatchBytes = size_t(16) << 20;
+    const size_t perBatch = std::max<size_t>(1, kBatchBytes / recordBytes);
+    std::vector<char> batch(std::min(count, perBatch) * recordBytes);
+    for (size_t first = 0; first < count; first += perBatch) {
+        const size_t n = std::min(perBatch, count - first);
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 8192), [&](const tbb::blocked_range<size_t>& r) {
+            for (size_t i = r.begin(); i < r.end(); ++i) encode(first + i, batch.data() + i * recordBytes);
+        });
+        os.write(batch.data(), std::streamsize(n * recordBytes));
+    }
+}
+
+/// The polygons of @a polygons as fixed-size records: the triangles, then the quads (one
+/// quad record each, or two triangle records when split). Each corner is a 4-byte int;
+/// PLY starts a polygon with a one-byte corner count, VTK with a 4-byte one.
+template<bool BigEndian, typename CountT>
+void
+writePolygonRecords(ChunkWriter& out, const PolygonView& polygons)
+{
+    const SurfaceMesh& mesh = polygons.mesh;
+    static_assert(sizeof(CountT) == 1 || sizeof(CountT) == 4, "one- or four-byte counts");
+    auto putPolygon = [](char* at, const uint32_t* corners, int n) {
+        if constexpr (sizeof(CountT) == 1) {
+            *at++ = char(n);
+        } else {
+            at = put4<BigEndian>(at, CountT(n));
+        }
+        for (int i = 0; i < n; ++i) at = put4<BigEndian>(at, int32_t(corners[i]));
+        return at;
+    };
+    const size_t triangleBytes = sizeof(CountT) + 3 * 4, quadBytes = sizeof(CountT) + 4 * 4;
+    writeRecords(out, mesh.triangles.size(), triangleBytes, [&](size_t i, char* at) {
+        const openvdb::Vec3I& t = mesh.triangles[i];
+        const uint32_t corners[3] = {t[0], t[1], t[2]};
+        putPolygon(at, corners, 3);
+    });
+    if (polygons.keepQuads) {
+        writeRecords(out, mesh.quads.size(), quadBytes, [&](size_t i, char* at) {
+            const openvdb::Vec4I& q = mesh.quads[i];
+            const uint32_t corners[4] = {q[0], q[1], q[2], q[3]};
+            putPolygon(at, corners, 4);
+        });
+    } else {
+        writeRecords(out, mesh.quads.size(), 2 * triangleBytes, [&](size_t i, char* at) {
+            const openvdb::Vec4I& q = mesh.quads[i];
+            const uint32_t first[3] = {q[0], q[1], q[2]};
+            const uint32_t second[3] = {q[0], q[2], q[3]};
+            putPolygon(putPolygon(at, first, 3), second, 3);
+        });
+    }
+}
 
 /// A mesh with out-of-range indices would produce a file every reader rejects.
 void
@@ -251,20 +314,19 @@ writePly(const SurfaceMesh& mesh, const PolygonView& polygons, const std::string
     }
     out.text("element face " + std::to_string(polygons.polygonCount()) + "\n");
     out.text("property list uchar int vertex_indices\nend_header\n");
-    for (size_t i = 0; i < mesh.points.size(); ++i) {
-        for (int axis = 0; axis < 3; ++axis) out.littleEndian(float(mesh.points[i][axis]));
+    size_t floatsPerVertex = withNormals ? 6 : 3;
+    for (const MeshAttribute& attribute : mesh.attributes) floatsPerVertex += size_t(attribute.components);
+    writeRecords(out, mesh.points.size(), 4 * floatsPerVertex, [&](size_t i, char* at) {
+        for (int axis = 0; axis < 3; ++axis) at = put4<false>(at, float(mesh.points[i][axis]));
         if (withNormals) {
-            for (int axis = 0; axis < 3; ++axis) out.littleEndian(float(mesh.normals[i][axis]));
+            for (int axis = 0; axis < 3; ++axis) at = put4<false>(at, float(mesh.normals[i][axis]));
         }
         for (const MeshAttribute& attribute : mesh.attributes) {
             const float* values = attribute.values.data() + i * size_t(attribute.components);
-            for (int c = 0; c < attribute.components; ++c) out.littleEndian(values[c]);
+            for (int c = 0; c < attribute.components; ++c) at = put4<false>(at, values[c]);
         }
-    }
-    polygons.forEach([&](const uint32_t* corners, int n) {
-        out.character(char(n));
-        for (int i = 0; i < n; ++i) out.littleEndian(int32_t(corners[i]));
     });
+    writePolygonRecords</*BigEndian=*/false, uint8_t>(out, polygons);
     out.flush();
 }
 
@@ -277,24 +339,20 @@ writeVtk(const SurfaceMesh& mesh, const PolygonView& polygons, const std::string
     ChunkWriter out(os);
     out.text("# vtk DataFile Version 3.0\nnonbloppy surface mesh\nBINARY\nDATASET POLYDATA\n");
     out.text("POINTS " + std::to_string(mesh.points.size()) + " float\n");
-    for (const openvdb::Vec3s& p : mesh.points) {
-        for (int axis = 0; axis < 3; ++axis) out.bigEndian(float(p[axis]));
-    }
+    auto putVec3 = [](char* at, const openvdb::Vec3s& v) {
+        for (int axis = 0; axis < 3; ++axis) at = put4<true>(at, float(v[axis]));
+    };
+    writeRecords(out, mesh.points.size(), 12, [&](size_t i, char* at) { putVec3(at, mesh.points[i]); });
     out.text("\nPOLYGONS " + std::to_string(polygons.polygonCount()) + " " +
         std::to_string(polygons.polygonCount() + polygons.cornerCount()) + "\n");
-    polygons.forEach([&](const uint32_t* corners, int n) {
-        out.bigEndian(int32_t(n));
-        for (int i = 0; i < n; ++i) out.bigEndian(int32_t(corners[i]));
-    });
+    writePolygonRecords</*BigEndian=*/true, int32_t>(out, polygons);
     out.text("\n");
     if (!mesh.normals.empty() || !mesh.attributes.empty()) {
         out.text("POINT_DATA " + std::to_string(mesh.points.size()) + "\n");
     }
     if (!mesh.normals.empty()) {
         out.text("NORMALS normals float\n");
-        for (const openvdb::Vec3s& n : mesh.normals) {
-            for (int axis = 0; axis < 3; ++axis) out.bigEndian(float(n[axis]));
-        }
+        writeRecords(out, mesh.normals.size(), 12, [&](size_t i, char* at) { putVec3(at, mesh.normals[i]); });
         out.text("\n");
     }
     // Vectors as VECTORS, 1, 2 and 4 components as SCALARS, anything else as a FIELD array.
@@ -309,7 +367,8 @@ writeVtk(const SurfaceMesh& mesh, const PolygonView& polygons, const std::string
             out.text("FIELD FieldData 1\n" + name + " " + std::to_string(attribute.components) +
                 " " + std::to_string(mesh.points.size()) + " float\n");
         }
-        for (const float value : attribute.values) out.bigEndian(value);
+        writeRecords(out, attribute.values.size(), 4,
+                     [&](size_t i, char* at) { put4<true>(at, attribute.values[i]); });
         out.text("\n");
     }
     out.flush();

@@ -2,6 +2,8 @@
 // Tests for writeMesh(), readMesh() and the AtomicFile helper: round trips through all three
 // formats, exact bytes, atomic replacement and clean failure.
 
+#include "TestUtil.h"
+
 #include <nonbloppy/Error.h>
 #include <nonbloppy/MeasureMesh.h>
 #include <nonbloppy/ReadMesh.h>
@@ -12,6 +14,8 @@
 
 #include <gtest/gtest.h>
 
+#include <tbb/global_control.h>
+
 #include <dirent.h>
 #include <sys/stat.h>
 
@@ -20,6 +24,7 @@
 #include <cstring>
 #include <fstream>
 #include <functional>
+#include <random>
 #include <iterator>
 #include <set>
 #include <stdexcept>
@@ -28,26 +33,15 @@
 
 namespace {
 
+using nonbloppy_test::dataPath;
+using nonbloppy_test::readBytes;
+using nonbloppy_test::writeBytes;
+
 using nonbloppy::FileError;
 using nonbloppy::MeshWriteSettings;
 using nonbloppy::SurfaceMesh;
 using nonbloppy::readMesh;
 using nonbloppy::writeMesh;
-
-std::string
-readBytes(const std::string& path)
-{
-    std::ifstream is(path, std::ios::binary);
-    return std::string(std::istreambuf_iterator<char>(is), std::istreambuf_iterator<char>());
-}
-
-void
-writeBytes(const std::string& path, const std::string& bytes)
-{
-    std::ofstream os(path, std::ios::binary | std::ios::trunc);
-    os.write(bytes.data(), std::streamsize(bytes.size()));
-    ASSERT_TRUE(os.good()) << path;
-}
 
 std::set<std::string>
 listDirectory(const std::string& dir)
@@ -104,23 +98,8 @@ mixedMesh()
     return mesh;
 }
 
-class WriteMeshTest : public ::testing::Test
+class WriteMeshTest : public nonbloppy_test::ScratchDirTest
 {
-protected:
-    void SetUp() override
-    {
-        std::string pattern = ::testing::TempDir() + "nonbloppy_write_XXXXXX";
-        ASSERT_NE(mkdtemp(pattern.data()), nullptr);
-        mDir = pattern;
-    }
-    void TearDown() override
-    {
-        const std::string command = "rm -rf '" + mDir + "'";
-        EXPECT_EQ(std::system(command.c_str()), 0);
-    }
-    std::string path(const std::string& name) const { return mDir + "/" + name; }
-
-    std::string mDir;
 };
 
 /// The mesh @a mesh should read back as after writing with @a keepQuads.
@@ -169,7 +148,7 @@ TEST_F(WriteMeshTest, RoundTripThroughEveryFormatWithQuadsKeptAndSplit)
                 settings.keepQuads = keepQuads;
                 writeMesh(*mesh, p, settings);
                 expectSameMesh(readMesh(p), expectedAfterWrite(*mesh, keepQuads));
-                EXPECT_EQ(listDirectory(mDir), std::set<std::string>{std::string("mesh") + ext});
+                EXPECT_EQ(listDirectory(dir()), std::set<std::string>{std::string("mesh") + ext});
                 std::remove(p.c_str());
             }
         }
@@ -214,6 +193,75 @@ TEST_F(WriteMeshTest, OutputIsDeterministicAndOfTheDocumentedLayout)
     EXPECT_NE(vtk.find("\nPOINT_DATA 5\nNORMALS normals float\n"), std::string::npos);
 }
 
+/// PLY as the format says, one value at a time: the reference for the batched writer.
+static std::string
+referencePly(const SurfaceMesh& mesh)
+{
+    std::string bytes = "ply\nformat binary_little_endian 1.0\ncomment written by nonbloppy\n"
+        "element vertex " + std::to_string(mesh.points.size()) + "\nproperty float x\n"
+        "property float y\nproperty float z\nproperty float nx\nproperty float ny\n"
+        "property float nz\nelement face " + std::to_string(mesh.triangles.size() + 2 * mesh.quads.size())
+        + "\nproperty list uchar int vertex_indices\nend_header\n";
+    auto put = [&](auto value) {
+        static_assert(sizeof(value) == 4, "4 bytes");
+        unsigned char le[4];
+        uint32_t bits;
+        std::memcpy(&bits, &value, 4);
+        for (int b = 0; b < 4; ++b) le[b] = static_cast<unsigned char>(bits >> (8 * b));
+        bytes.append(reinterpret_cast<const char*>(le), 4);
+    };
+    for (size_t i = 0; i < mesh.points.size(); ++i) {
+        for (int a = 0; a < 3; ++a) put(mesh.points[i][a]);
+        for (int a = 0; a < 3; ++a) put(mesh.normals[i][a]);
+    }
+    auto triangle = [&](uint32_t a, uint32_t b, uint32_t c) {
+        bytes.push_back(3);
+        put(int32_t(a));
+        put(int32_t(b));
+        put(int32_t(c));
+    };
+    for (const openvdb::Vec3I& t : mesh.triangles) triangle(t[0], t[1], t[2]);
+    for (const openvdb::Vec4I& q : mesh.quads) {
+        triangle(q[0], q[1], q[2]);
+        triangle(q[0], q[2], q[3]);
+    }
+    return bytes;
+}
+
+TEST_F(WriteMeshTest, BatchedParallelEncodingMatchesTheFormatAtAnyThreadCount)
+{
+    // Enough polygons for several 16 MB batches of split quads (26 bytes each).
+    SurfaceMesh mesh;
+    std::mt19937 random(11);
+    std::uniform_real_distribution<float> coordinate(-10.0f, 10.0f);
+    std::uniform_int_distribution<uint32_t> vertex(0, 99999);
+    for (int i = 0; i < 100000; ++i) {
+        mesh.points.emplace_back(coordinate(random), coordinate(random), coordinate(random));
+        mesh.normals.emplace_back(coordinate(random), coordinate(random), coordinate(random));
+    }
+    for (int i = 0; i < 30000; ++i) mesh.triangles.emplace_back(vertex(random), vertex(random), vertex(random));
+    for (int i = 0; i < 1400000; ++i) {
+        mesh.quads.emplace_back(vertex(random), vertex(random), vertex(random), vertex(random));
+    }
+    const std::string expected = referencePly(mesh);
+    ASSERT_GT(expected.size(), size_t(2) * (16 << 20));
+    {
+        tbb::global_control oneThread(tbb::global_control::max_allowed_parallelism, 1);
+        writeMesh(mesh, path("one.ply"));
+        writeMesh(mesh, path("one.vtk"));
+    }
+    writeMesh(mesh, path("many.ply"));
+    writeMesh(mesh, path("many.vtk"));
+    EXPECT_TRUE(readBytes(path("one.ply")) == expected);
+    EXPECT_TRUE(readBytes(path("many.ply")) == expected);
+    EXPECT_TRUE(readBytes(path("one.vtk")) == readBytes(path("many.vtk")));
+    const SurfaceMesh back = readMesh(path("many.vtk"));
+    ASSERT_EQ(back.points.size(), mesh.points.size());
+    ASSERT_EQ(back.triangles.size(), mesh.triangles.size() + 2 * mesh.quads.size());
+    EXPECT_EQ(back.points.back(), mesh.points.back());
+    EXPECT_EQ(back.triangles.back(), openvdb::Vec3I(mesh.quads.back()[0], mesh.quads.back()[2], mesh.quads.back()[3]));
+}
+
 TEST_F(WriteMeshTest, ObjTextIsExact)
 {
     SurfaceMesh mesh;
@@ -250,7 +298,7 @@ TEST_F(WriteMeshTest, FailuresNameThePathAndLeaveNothingBehind)
     const std::string missing = path("missing/mesh.obj");
     EXPECT_EQ(messageOf<FileError>([&] { writeMesh(unitCube(), missing); }),
         "cannot write " + missing + ": No such file or directory");
-    EXPECT_TRUE(listDirectory(mDir).empty());
+    EXPECT_TRUE(listDirectory(dir()).empty());
 
     EXPECT_EQ(messageOf<FileError>([&] { writeMesh(unitCube(), path("mesh.stl")); }),
         "unknown mesh file extension '.stl' (" + path("mesh.stl") +
@@ -258,13 +306,13 @@ TEST_F(WriteMeshTest, FailuresNameThePathAndLeaveNothingBehind)
     EXPECT_EQ(messageOf<FileError>([&] { readMesh(path("mesh.stl")); }),
         "unknown mesh file extension '.stl' (" + path("mesh.stl") +
         "); expected .obj, .ply or .vtk");
-    EXPECT_TRUE(listDirectory(mDir).empty());
+    EXPECT_TRUE(listDirectory(dir()).empty());
 
     SurfaceMesh broken = unitCube();
     broken.quads[5][2] = 8;
     EXPECT_EQ(messageOf<nonbloppy::ParameterError>([&] { writeMesh(broken, path("b.ply")); }),
         "polygon 5 references vertex 8 but the mesh has 8 vertices (" + path("b.ply") + ")");
-    EXPECT_TRUE(listDirectory(mDir).empty());
+    EXPECT_TRUE(listDirectory(dir()).empty());
 
     EXPECT_FALSE(nonbloppy::isMeshFile("x.stl"));
     EXPECT_TRUE(nonbloppy::isMeshFile("x.Vtk"));
@@ -290,9 +338,9 @@ TEST_F(WriteMeshTest, AtomicFileRemovesItsTemporaryUnlessCommitted)
         EXPECT_EQ(file.path(), target);
         EXPECT_EQ(file.tempPath().rfind(target + ".tmp-", 0), 0u);
         writeBytes(file.tempPath(), "new");
-        EXPECT_EQ(listDirectory(mDir).size(), 2u);
+        EXPECT_EQ(listDirectory(dir()).size(), 2u);
     }  // not committed
-    EXPECT_EQ(listDirectory(mDir), std::set<std::string>{"out.vdb"});
+    EXPECT_EQ(listDirectory(dir()), std::set<std::string>{"out.vdb"});
     EXPECT_EQ(readBytes(target), "old");
 
     {
@@ -301,7 +349,7 @@ TEST_F(WriteMeshTest, AtomicFileRemovesItsTemporaryUnlessCommitted)
         file.commit();
         EXPECT_TRUE(file.committed());
     }
-    EXPECT_EQ(listDirectory(mDir), std::set<std::string>{"out.vdb"});
+    EXPECT_EQ(listDirectory(dir()), std::set<std::string>{"out.vdb"});
     EXPECT_EQ(readBytes(target), "new");
 
     // A writer that fails half-way leaves the old file as it was.
@@ -312,7 +360,7 @@ TEST_F(WriteMeshTest, AtomicFileRemovesItsTemporaryUnlessCommitted)
         });
     }), "cannot write " + target + ": disk on fire");
     EXPECT_EQ(readBytes(target), "new");
-    EXPECT_EQ(listDirectory(mDir), std::set<std::string>{"out.vdb"});
+    EXPECT_EQ(listDirectory(dir()), std::set<std::string>{"out.vdb"});
 
     // nonbloppy errors (e.g. cancellation) pass through unchanged.
     EXPECT_EQ(messageOf<nonbloppy::CancelledError>([&] {
@@ -320,7 +368,7 @@ TEST_F(WriteMeshTest, AtomicFileRemovesItsTemporaryUnlessCommitted)
             throw nonbloppy::CancelledError("cancelled");
         });
     }), "cancelled");
-    EXPECT_EQ(listDirectory(mDir), std::set<std::string>{"out.vdb"});
+    EXPECT_EQ(listDirectory(dir()), std::set<std::string>{"out.vdb"});
 
     nonbloppy::writeFileAtomically(target, [](std::ostream& os) { os << "newest"; });
     EXPECT_EQ(readBytes(target), "newest");
