@@ -26,27 +26,39 @@ namespace {
 thread_local bool tRecordAllocations = false;
 thread_local size_t tLargestAllocation = 0;
 
+void*
+recordedAllocation(std::size_t size) noexcept
+{
+    if (tRecordAllocations && size > tLargestAllocation) tLargestAllocation = size;
+    return std::malloc(size == 0 ? 1 : size);
+}
+
 } // namespace
 
+// Every non-aligned form is replaced, so all of them pair malloc with free (AddressSanitizer
+// checks that allocation and deallocation functions match); aligned forms stay the library's.
 void*
 operator new(std::size_t size)
 {
-    if (tRecordAllocations && size > tLargestAllocation) tLargestAllocation = size;
-    if (void* p = std::malloc(size == 0 ? 1 : size)) return p;
+    if (void* p = recordedAllocation(size)) return p;
     throw std::bad_alloc();
 }
 
-void
-operator delete(void* p) noexcept
+void*
+operator new[](std::size_t size)
 {
-    std::free(p);
+    if (void* p = recordedAllocation(size)) return p;
+    throw std::bad_alloc();
 }
 
-void
-operator delete(void* p, std::size_t) noexcept
-{
-    std::free(p);
-}
+void* operator new(std::size_t size, const std::nothrow_t&) noexcept { return recordedAllocation(size); }
+void* operator new[](std::size_t size, const std::nothrow_t&) noexcept { return recordedAllocation(size); }
+void operator delete(void* p) noexcept { std::free(p); }
+void operator delete[](void* p) noexcept { std::free(p); }
+void operator delete(void* p, std::size_t) noexcept { std::free(p); }
+void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
+void operator delete(void* p, const std::nothrow_t&) noexcept { std::free(p); }
+void operator delete[](void* p, const std::nothrow_t&) noexcept { std::free(p); }
 
 namespace {
 
