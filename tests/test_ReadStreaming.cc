@@ -6,6 +6,8 @@
 // text; VTK float and double points, attributes, and VTK 5 cell arrays that are skipped;
 // truncation deep inside a file; and input from a pipe, which has no size.
 
+#include "TestUtil.h"
+
 #include <nonbloppy/Error.h>
 #include <nonbloppy/ReadParticles.h>
 
@@ -36,35 +38,10 @@ using nonbloppy::ParticleSet;
 using nonbloppy::ScalarType;
 using nonbloppy::readParticles;
 
-/// Writes @a bytes as the whole content of @a path; a failed write fails the test.
-void
-writeBytes(const std::string& path, const std::string& bytes)
-{
-    std::ofstream os(path, std::ios::binary | std::ios::trunc);
-    os.write(bytes.data(), std::streamsize(bytes.size()));
-    if (!os.good()) ADD_FAILURE() << "cannot write " << path;
-}
+using nonbloppy_test::writeBytes;
 
-/// Each test gets a fresh directory under ::testing::TempDir(), removed afterwards.
-class ReadStreamingTest : public ::testing::Test
+class ReadStreamingTest : public nonbloppy_test::ScratchDirTest
 {
-protected:
-    void SetUp() override
-    {
-        std::string pattern = ::testing::TempDir() + "nonbloppy_streaming_XXXXXX";
-        ASSERT_NE(::mkdtemp(pattern.data()), nullptr);
-        mDir = pattern;
-    }
-    void TearDown() override
-    {
-        std::error_code ec;
-        std::filesystem::remove_all(mDir, ec);
-    }
-    /// @a name inside the test's directory.
-    std::string path(const std::string& name) const { return mDir + "/" + name; }
-
-private:
-    std::string mDir;
 };
 
 /// More particles than fit in the reader's 1 MiB buffer in any layout below
