@@ -23,7 +23,7 @@ cd "$(dirname "$0")/../.."
 seconds="${1:-60}"
 shift || true
 targets=("$@")
-((${#targets[@]})) || targets=(bgeo vtu table json vdb_points vtk ply)
+((${#targets[@]})) || targets=(bgeo vtu table json vdb_points vtk ply vtk_file ply_file)
 build_dir="${BUILD_DIR:-/tmp/nonbloppy-fuzz-build}"
 out="${OUT:-/tmp/nonbloppy-fuzz}"
 parallel="${PARALLEL:-1}"
@@ -41,8 +41,8 @@ seeds_for() {
     table) echo "tests/fuzz/seeds/*.csv tests/fuzz/seeds/*.txt tests/data/fuzz/*.csv tests/data/fuzz/*.txt" ;;
     json) echo "tests/fuzz/seeds/*.json tests/data/fuzz/*.json" ;;
     vdb_points) echo "tests/fuzz/seeds/*.vdb tests/data/fuzz/*.vdb" ;;
-    vtk) echo "tests/data/cube_8_particles.vtk tests/data/free_particles_125_particles.vtk tests/data/fuzz/*.vtk" ;;
-    ply) echo "tests/fuzz/seeds/*.ply tests/data/fuzz/*.ply" ;;
+    vtk|vtk_file) echo "tests/data/cube_8_particles.vtk tests/data/free_particles_125_particles.vtk tests/data/fuzz/*.vtk" ;;
+    ply|ply_file) echo "tests/fuzz/seeds/*.ply tests/data/fuzz/*.ply" ;;
     *) echo "run_fuzzers: unknown target '$1'" >&2; exit 2 ;;
   esac
 }

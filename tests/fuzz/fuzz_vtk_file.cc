@@ -1,0 +1,9 @@
+// SPDX-License-Identifier: Apache-2.0
+// libFuzzer target: readParticles() on a .vtk file, i.e. the streaming VTK reader of
+// src/ReadParticles.cc (fuzz_vtk covers the in-memory parser readMesh() uses).
+#include "FuzzFile.h"
+#include "FuzzReader.h"
+
+#include <nonbloppy/ReadParticles.h>
+
+NONBLOPPY_FUZZ_READER(nonbloppy::readParticles(nonbloppy_fuzz::writeInput(bytes, size, ".vtk")))
