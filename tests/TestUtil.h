@@ -44,6 +44,18 @@ inline void writeBytes(const std::string& path, const std::string& bytes)
     if (!os.good()) ADD_FAILURE() << "cannot write " << path;
 }
 
+/// The message of the exception @a ExceptionT that @a f throws ("" if it throws none).
+template<typename ExceptionT>
+std::string messageOf(const std::function<void()>& f)
+{
+    try {
+        f();
+    } catch (const ExceptionT& e) {
+        return e.what();
+    }
+    return "";
+}
+
 /// A fresh, empty directory per test (under ::testing::TempDir()), removed afterwards.
 class ScratchDirTest : public ::testing::Test
 {

@@ -105,15 +105,11 @@ protected:
     }
 };
 
+/// The FileError message readParticles(@a path) throws ("" if none).
 std::string
 fileErrorOf(const std::string& path)
 {
-    try {
-        readParticles(path);
-    } catch (const FileError& e) {
-        return e.what();
-    }
-    return "";
+    return nonbloppy_test::messageOf<FileError>([&] { readParticles(path); });
 }
 
 const ParticleAttribute&

@@ -27,6 +27,7 @@
 namespace {
 
 using nonbloppy_test::dataPath;
+using nonbloppy_test::messageOf;
 using nonbloppy_test::readBytes;
 using nonbloppy_test::writeBytes;
 
@@ -40,18 +41,6 @@ class ReadParticlesTest : public nonbloppy_test::ScratchDirTest
 {
 };
 
-/// The message of the exception @a ExceptionT that @a f throws ("" if none).
-template<typename ExceptionT>
-std::string
-messageOf(const std::function<void()>& f)
-{
-    try {
-        f();
-    } catch (const ExceptionT& e) {
-        return e.what();
-    }
-    return "";
-}
 
 std::string
 fileErrorOf(const std::string& path)

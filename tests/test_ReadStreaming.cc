@@ -48,15 +48,11 @@ class ReadStreamingTest : public nonbloppy_test::ScratchDirTest
 /// (12 bytes each for packed float x y z).
 constexpr size_t kManyParticles = 150001;
 
+/// The FileError message readParticles(@a path) throws ("" if none).
 std::string
 fileErrorOf(const std::string& path)
 {
-    try {
-        readParticles(path);
-    } catch (const FileError& e) {
-        return e.what();
-    }
-    return "";
+    return nonbloppy_test::messageOf<FileError>([&] { readParticles(path); });
 }
 
 template<typename T>

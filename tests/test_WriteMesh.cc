@@ -34,6 +34,7 @@
 namespace {
 
 using nonbloppy_test::dataPath;
+using nonbloppy_test::messageOf;
 using nonbloppy_test::readBytes;
 using nonbloppy_test::writeBytes;
 
@@ -57,17 +58,6 @@ listDirectory(const std::string& dir)
     return names;
 }
 
-template<typename ExceptionT>
-std::string
-messageOf(const std::function<void()>& f)
-{
-    try {
-        f();
-    } catch (const ExceptionT& e) {
-        return e.what();
-    }
-    return "";
-}
 
 /// A unit cube with corners at 0 and 1 and six outward-facing (counter-clockwise) quads.
 SurfaceMesh
