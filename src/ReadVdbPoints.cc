@@ -235,13 +235,44 @@ public:
 
     /// What io::Archive::readGrid() reads before the tree: compression flags, the grid's
     /// MetaMap and transform; then, for a PointDataGrid, the tree's topology.
-    void grid(const std::string& name, bool pointDataGrid)
+    void grid(const std::string& name, bool pointDataGrid, uint32_t version)
     {
         const std::string grid = "grid '" + printable(name) + "'";
         const uint32_t compression = u32(grid + " compression flags");
         metaMap(grid);
         transform(grid);
-        if (pointDataGrid) pointTreeTopology(compression, "tree of " + grid);
+        if (!pointDataGrid) return;
+        mLeafCount = 0;
+        pointTreeTopology(compression, "tree of " + grid);
+        if (version >= openvdb::OPENVDB_FILE_VERSION_MULTIPASS_IO && mLeafCount > 0) {
+            firstAttributeDescriptor("leaf buffers of " + grid);
+        }
+    }
+
+    /// Grid::readBuffers() of a PointDataGrid up to the first leaf's attribute descriptor
+    /// (AttributeSet::Descriptor::read, which sizes its arrays from the counts in it): the
+    /// pass count, pass 0 (two bytes per leaf), the first leaf's header byte.
+    void firstAttributeDescriptor(const std::string& what)
+    {
+        skip(2 + 2 * mLeafCount + 1, what);
+        const std::string descriptor = "attribute descriptor in " + what;
+        const uint64_t attributes = u64(descriptor);
+        // An attribute takes a type, a codec and a name (three string lengths) and an index.
+        if (attributes > left() / 20) {
+            corrupt(descriptor + " claims " + std::to_string(attributes) + " attributes");
+        }
+        for (uint64_t a = 0; a < 2 * attributes; ++a) string("type name in " + descriptor);
+        for (uint64_t a = 0; a < attributes; ++a) {
+            string("attribute name in " + descriptor);
+            skip(8, descriptor);
+        }
+        const uint64_t groups = u64(descriptor);
+        if (groups > left() / 12) corrupt(descriptor + " claims " + std::to_string(groups) + " groups");
+        for (uint64_t g = 0; g < groups; ++g) {
+            string("group name in " + descriptor);
+            skip(8, descriptor);
+        }
+        metaMap(descriptor);
     }
 
     /// math::Transform::read(): the map's type name, then its fields (a frustum map nests
@@ -273,7 +304,13 @@ public:
     /// buffer count, root background, tiles, then each child's subtree.
     void pointTreeTopology(uint32_t compression, const std::string& what)
     {
-        skip(4 + 4, what);  // buffer count, background
+        skip(4, what);  // buffer count
+        // Leaves are made with the background as their value, and a PointDataLeafNode
+        // asserts that it is 0 (its values are point offsets), aborting the process.
+        const uint32_t background = u32(what);
+        if (background != 0) {
+            corrupt(what + " has background " + std::to_string(background) + "; point grids need 0");
+        }
         const uint32_t tiles = u32(what);
         const uint32_t children = u32(what);
         if (tiles > left() / 17) {
@@ -307,6 +344,7 @@ public:
             if (log2Dim == 5) internalNode(4, compression, what);
             else skip(64, what);
         }
+        if (log2Dim == 4) mLeafCount += childCount;
     }
 
     /// io::readCompressedValues() of @a count 4-byte values: a flag saying what follows,
@@ -349,6 +387,15 @@ public:
         size_t n = 0;
         for (size_t i = 0; i < size; ++i) n += size_t(__builtin_popcount(bytes[i]));
         return n;
+    }
+
+    uint64_t u64(const std::string& what)
+    {
+        need(8, what);
+        uint64_t value;
+        std::memcpy(&value, mData + mPos, 8);
+        mPos += 8;
+        return value;
     }
 
     /// Also used for the grid count.
@@ -422,6 +469,7 @@ private:
     size_t mPos = 0;
     const std::string& mPath;
     bool mHasGridOffsets = false;
+    uint64_t mLeafCount = 0;  ///< leaves in the topology walked last
 };
 
 /// io::Stream's reading, grid by grid, with VdbSizeCheck run on each part before OpenVDB
@@ -491,7 +539,7 @@ public:
                 continue;
             }
             // An instance shares its parent's tree; the file stores none for it.
-            check.grid(descriptor.uniqueName(), pointDataGrid && !descriptor.isInstance());
+            check.grid(descriptor.uniqueName(), pointDataGrid && !descriptor.isInstance(), version);
             grid->setSaveFloatAsHalf(descriptor.saveFloatAsHalf());
             readGrid(grid, descriptor, is);
             grids.push_back(grid);

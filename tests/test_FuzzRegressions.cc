@@ -136,6 +136,18 @@ const Expected kExpected[] = {
     {"vdb_points_tree_chunk_size_7eb.vdb",
      "cannot read .vdb file: compressed chunk in tree of grid 'points' claims 7349874591868649472 "
      "bytes, 494 left"},
+    // fuzz_vdb_points, 300 s runs: the first leaf's attribute descriptor claims billions of
+    // attributes; AttributeSet::Descriptor::read sized a vector by it (up to 1.2 TB).
+    {"vdb_points_leaf_descriptor_attribute_count_1tb.vdb",
+     "cannot read .vdb file: attribute descriptor in leaf buffers of grid 'points' claims "
+     "18881471093 attributes"},
+    {"vdb_points_leaf_descriptor_attribute_count_563t.vdb",
+     "cannot read .vdb file: attribute descriptor in leaf buffers of grid 'points' claims "
+     "562949954234675 attributes"},
+    // fuzz_vdb_points, 120 s run: a non-zero root background; leaves are made with it and
+    // PointDataLeafNode asserts it is 0, so Debian's libopenvdb (built with assertions) aborted.
+    {"vdb_points_tree_nonzero_background_assert.vdb",
+     "cannot read .vdb file: tree of grid 'points' has background 3735552; point grids need 0"},
     // A billion points claimed in about 1 KB, one file per reader that reads a count
     // (.vdb: the P attribute array of the only leaf says 1e9 values; the leaf holds 8).
     {"billion_points_header.bgeo",
