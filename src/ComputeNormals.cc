@@ -5,6 +5,8 @@
 
 #include <tbb/parallel_for.h>
 
+#include <memory>
+
 namespace nonbloppy {
 
 namespace cancellation_internal {
@@ -14,7 +16,17 @@ void computeNormals(SurfaceMesh& mesh, CancelPoll& poll)
     const std::vector<openvdb::Vec3s>& p = mesh.points;
     // Accumulate in double and in polygon order, so the result is deterministic; twice the
     // area-weighted normal is the cross product of a triangle's edges, or of a quad's diagonals.
-    std::vector<openvdb::Vec3d> sums(p.size(), openvdb::Vec3d(0.0));
+    // Zeroed in parallel tasks that poll, not by a vector's serial fill: 24 bytes per vertex
+    // (~110 MB for 4.5M vertices) take tens of milliseconds to fault in.
+    std::unique_ptr<openvdb::Vec3d[]> sums(new openvdb::Vec3d[p.size()]);
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, p.size()),
+        [&](const tbb::blocked_range<size_t>& range) {
+            for (size_t i = range.begin(); i < range.end(); ++i) {
+                if (poll.stoppedAt(i - range.begin())) return;
+                sums[i] = openvdb::Vec3d(0.0);
+            }
+        });
+    poll.throwIfStopped();
     for (size_t n = 0; n < mesh.triangles.size(); ++n) {
         if (poll.stoppedAt(n)) poll.throwIfStopped();
         const openvdb::Vec3I& t = mesh.triangles[n];

@@ -54,6 +54,9 @@ constexpr int kDefaultRepairRounds = 4;
 /// triangles still folded then go all the way back. Vertices of unfolded triangles are not
 /// touched, so a mesh without folds is returned bit for bit.
 /// @return the number of folded triangles found in the first round
+/// @param mesh         relaxed mesh; vertices of folded triangles moved back
+/// @param before       vertex positions before relaxation (same count as mesh.points)
+/// @param maxRounds    halving rounds before the last resort of moving all the way back
 /// @param interrupter  optional; asked every 4096 polygons of each (serial) round, no
 ///                     start()/end() (buildSurface() announces "correct surface"); a stop
 ///                     leaves the vertices partly repaired

@@ -22,6 +22,8 @@ constexpr size_t kSpacingSamples = 20000;
 /// Median distance from a particle to its nearest neighbour, in world units, over a fixed
 /// deterministic sample of at most @a maxSamples particles (all of them when fewer).
 /// Cost: O(N) to bucket the particles plus O(samples) neighbour searches.
+/// @param positions    particle positions, world units (only read)
+/// @param maxSamples   how many particles' nearest neighbours to search, evenly spread
 /// @param interrupter  optional; asked every 4096 particles of the bounding box, as in
 ///                     ParticleIndex::build() while bucketing, and every 16 samples of each
 ///                     parallel search task; no start()/end()
@@ -124,6 +126,8 @@ struct ResolvedParameters
 ///        (parameters are named by their command-line spelling).
 /// Cost: that of estimateSpacing() when it is needed, plus the threshold calibration
 /// (~10 ms, not interruptible), else O(1).
+/// @param params       what the user gave
+/// @param positions    particle positions, world units (only read)
 /// @param interrupter  optional; passed to estimateSpacing() and asked after each step;
 ///                     no start()/end() (buildSurface() announces "estimate parameters")
 /// @throw CancelledError("interrupted during estimate parameters") when @a interrupter says stop.

@@ -45,6 +45,8 @@ public:
 
     /// Bucket @a positions (world units, taken over and reordered) into cells of
     /// @a cellSize world units. Cost: O(N) time (parallel radix partitioning by OpenVDB).
+    /// @param positions    world units; taken over (reordered into the index's own array)
+    /// @param cellSize     cell edge, world units, > 0
     /// @param interrupter  optional; asked every 4096 particles of the checks and once per
     ///                     index leaf while slots are assigned, not during OpenVDB's
     ///                     partitioning (createPointIndexGrid takes no interrupter, and

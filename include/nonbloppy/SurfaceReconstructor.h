@@ -70,6 +70,7 @@ public:
     /// Mesh one frame of any ParticleList (see Particles.h: size(), getPos()); the
     /// caller's particles are read once, in parallel, into the reused position buffer.
     /// @return the result, valid until the next reconstruct() or setParameters() call.
+    /// @param particles    any ParticleList, world units (read once)
     /// @param interrupter  optional; announced stages and polls as for buildSurface()
     /// @throw ParameterError for bad parameters or non-finite positions, CancelledError
     ///        ("interrupted during <stage>") when @a interrupter asks to stop; the object
