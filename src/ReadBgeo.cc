@@ -11,10 +11,19 @@
 /// everything big-endian. Primitives and the rest that follows the points are ignored.
 /// Newer Houdini `.bgeo` files are JSON-based (binary JSON starts with byte 0x7f, text
 /// JSON with '['); they are reported as unsupported rather than misread.
+///
+/// The file is read through a StreamReader (a bounded buffer, gzip inflated on the fly)
+/// and the points are decoded from it straight into the final arrays. An uncompressed
+/// file's point count is checked against the bytes left before allocating. A gzip file's
+/// inflated size is unknown until its end: a count beyond what deflate's 1032:1 limit
+/// allows is truncated for sure (rejected before allocating); a smaller one reserves at
+/// most kTrustedRatio times the compressed bytes left, and the arrays grow as points
+/// actually arrive beyond that, so a hostile count never allocates more than the data.
 
 #include "Decode.h"
 #include "FileFormats.h"
 #include "ParticleReaders.h"
+#include "StreamReader.h"
 
 #include <nonbloppy/Error.h>
 
@@ -27,35 +36,62 @@ namespace {
 
 using namespace decode_internal;
 
-/// A bounds-checked big-endian reader over the decompressed bytes.
-class BigEndianCursor
+/// Arrays are reserved up front for at most this many inflated bytes per compressed byte
+/// left; particle floats rarely compress better than 2:1. Beyond it they grow as read.
+constexpr uint64_t kTrustedRatio = 8;
+
+/// Points decoded per block of a gzip file (the arrays grow a block at a time).
+constexpr size_t kBlockPoints = size_t(1) << 16;
+
+/// Big-endian values from a StreamReader; a short read fails with "truncated <section>".
+class BigEndianInput
 {
 public:
-    BigEndianCursor(const unsigned char* data, size_t size, const std::string& path)
-        : mData(data), mSize(size), mPath(path) {}
+    BigEndianInput(StreamReader& in, const std::string& path) : mIn(in), mPath(path) {}
 
-    size_t left() const { return mSize - mPos; }
-    void need(size_t bytes, const char* section) const
+    void need(size_t bytes, const char* section)
     {
-        if (bytes > left()) fail(mPath, std::string("truncated ") + section);
+        if (!mIn.ensure(bytes)) fail(mPath, std::string("truncated ") + section);
     }
-    uint32_t u32(const char* section) { need(4, section); mPos += 4; return loadBigEndian32(mData + mPos - 4); }
+    uint32_t u32(const char* section)
+    {
+        need(4, section);
+        const uint32_t v = loadBigEndian32(here());
+        mIn.advance(4);
+        return v;
+    }
     int32_t i32(const char* section) { return static_cast<int32_t>(u32(section)); }
-    uint16_t u16(const char* section) { need(2, section); mPos += 2; return loadBigEndian16(mData + mPos - 2); }
+    uint16_t u16(const char* section)
+    {
+        need(2, section);
+        const uint16_t v = loadBigEndian16(here());
+        mIn.advance(2);
+        return v;
+    }
     std::string text(size_t length, const char* section)
     {
         need(length, section);
-        std::string s(reinterpret_cast<const char*>(mData + mPos), length);
-        mPos += length;
+        std::string s(mIn.here(), length);
+        mIn.advance(length);
         return s;
     }
-    void skip(size_t bytes, const char* section) { need(bytes, section); mPos += bytes; }
-    const unsigned char* here() const { return mData + mPos; }
+    void skip(size_t bytes, const char* section)
+    {
+        if (!mIn.skip(bytes)) fail(mPath, std::string("truncated ") + section);
+    }
+    /// The next 4 bytes as a big-endian word; false at the end of the data.
+    bool word(uint32_t& bits)
+    {
+        if (mIn.available() < 4 && !mIn.ensure(4)) return false;
+        bits = loadBigEndian32(here());
+        mIn.advance(4);
+        return true;
+    }
 
 private:
-    const unsigned char* mData;
-    size_t mSize;
-    size_t mPos = 0;
+    const unsigned char* here() const { return reinterpret_cast<const unsigned char*>(mIn.here()); }
+
+    StreamReader& mIn;
     const std::string& mPath;
 };
 
@@ -66,25 +102,17 @@ struct BgeoAttribute
     ScalarType type = ScalarType::Float32;
 };
 
-} // namespace
-
 ParticleSet
-readBgeoParticles(const char* data, size_t size, const std::string& path)
+parseBgeo(StreamReader& stream, const std::string& path)
 {
-    std::vector<char> inflated;
-    if (isGzip(data, size)) {
-        inflated = gunzip(data, size, path);
-        data = inflated.data();
-        size = inflated.size();
-    }
-    if (size >= 1 && (data[0] == 0x7f || data[0] == '[' || data[0] == '{')) {
+    if (stream.ensure(1) && (stream.here()[0] == 0x7f || stream.here()[0] == '[' || stream.here()[0] == '{')) {
         fail(path, "unsupported BGEO version (JSON-based, Houdini 12 or later); "
                    "only the classic binary BgeoV layout is read");
     }
-    if (size < 5 || std::memcmp(data, "BgeoV", 5) != 0) {
+    if (!stream.ensure(5) || std::memcmp(stream.here(), "BgeoV", 5) != 0) {
         fail(path, "not a BGEO file (no 'BgeoV' magic)");
     }
-    BigEndianCursor in(reinterpret_cast<const unsigned char*>(data), size, path);
+    BigEndianInput in(stream, path);
     in.skip(5, "BGEO header");
     const int32_t version = in.i32("BGEO header");
     if (version != 5) fail(path, "unsupported BGEO version (" + std::to_string(version) + ")");
@@ -129,39 +157,94 @@ readBgeoParticles(const char* data, size_t size, const std::string& path)
         attributes.push_back(std::move(attribute));
     }
 
-    // The point block must be present in full before anything is allocated for it.
-    if (uint64_t(pointCount) > in.left() / pointBytes) {
+    const uint64_t pointsStart = stream.pos();
+    auto truncatedPoints = [&](uint64_t left) {
         fail(path, "truncated BGEO points: header claims " + std::to_string(pointCount) +
              " points of " + std::to_string(pointBytes) + " bytes, " +
-             std::to_string(in.left()) + " bytes left");
+             std::to_string(left) + " bytes left");
+    };
+    // The point block must be able to be present in full before anything is allocated.
+    size_t reserved = size_t(pointCount);
+    if (!stream.compressed()) {
+        if (uint64_t(pointCount) > stream.remaining() / pointBytes) truncatedPoints(stream.remaining());
+    } else {
+        const uint64_t compressedLeft = stream.rawRemaining();
+        const uint64_t mostLeft = stream.available() + compressedLeft * kMaxInflateRatio + 4096;
+        if (uint64_t(pointCount) > mostLeft / pointBytes) {
+            // Truncated for sure; inflate the rest, keeping nothing, to say by how much.
+            stream.drain();
+            truncatedPoints(stream.pos() - pointsStart);
+        }
+        reserved = size_t(std::min<uint64_t>(
+            uint64_t(pointCount), (stream.available() + compressedLeft * kTrustedRatio) / pointBytes));
     }
+
     ParticleSet particles;
-    particles.positions.resize(size_t(pointCount));
+    particles.positions.reserve(reserved);
     particles.attributes.resize(attributes.size());
     for (size_t a = 0; a < attributes.size(); ++a) {
         ParticleAttribute& out = particles.attributes[a];
         out.name = attributes[a].name;
         out.type = attributes[a].type;
         out.components = attributes[a].components;
-        out.bytes.resize(size_t(pointCount) * size_t(out.components) * 4);
+        out.bytes.reserve(reserved * size_t(out.components) * 4);
     }
-    const unsigned char* p = in.here();
-    for (size_t n = 0; n < size_t(pointCount); ++n) {
-        for (int axis = 0; axis < 3; ++axis) {
-            const uint32_t bits = loadBigEndian32(p + 4 * axis);
-            std::memcpy(&particles.positions[n][axis], &bits, 4);
-        }
-        p += 16;
+    // Uncompressed: one block of all points (the size check above guarantees them);
+    // gzip: blocks of kBlockPoints, so the arrays hold only points actually read.
+    const size_t blockPoints = stream.compressed() ? kBlockPoints : std::max<size_t>(size_t(pointCount), 1);
+    for (size_t done = 0; done < size_t(pointCount);) {
+        const size_t end = std::min(size_t(pointCount), done + blockPoints);
+        particles.positions.resize(end);
         for (ParticleAttribute& out : particles.attributes) {
-            unsigned char* dst = out.bytes.data() + n * size_t(out.components) * 4;
-            for (int c = 0; c < out.components; ++c) {
-                const uint32_t bits = loadBigEndian32(p);
-                std::memcpy(dst + 4 * c, &bits, 4);
-                p += 4;
+            out.bytes.resize(end * size_t(out.components) * 4);
+        }
+        for (size_t n = done; n < end; ++n) {
+            uint32_t bits;
+            for (int axis = 0; axis < 4; ++axis) {
+                if (!in.word(bits)) truncatedPoints(stream.pos() + stream.available() - pointsStart);
+                if (axis < 3) std::memcpy(&particles.positions[n][axis], &bits, 4);
+            }
+            for (ParticleAttribute& out : particles.attributes) {
+                unsigned char* dst = out.bytes.data() + n * size_t(out.components) * 4;
+                for (int c = 0; c < out.components; ++c) {
+                    if (!in.word(bits)) truncatedPoints(stream.pos() + stream.available() - pointsStart);
+                    std::memcpy(dst + 4 * c, &bits, 4);
+                }
             }
         }
+        done = end;
     }
+    // Primitives and the rest are ignored, but a gzip stream is still checked to its end.
+    stream.drain();
     return particles;
+}
+
+/// parseBgeo(), with gzip errors first (as when the whole file was inflated up front).
+ParticleSet
+readBgeo(StreamReader& stream, const std::string& path)
+{
+    try {
+        return parseBgeo(stream, path);
+    } catch (const FileError&) {
+        stream.drain();
+        throw;
+    }
+}
+
+} // namespace
+
+ParticleSet
+readBgeoParticles(const char* data, size_t size, const std::string& path)
+{
+    StreamReader stream(data, size, path, /*inflateGzip=*/true);
+    return readBgeo(stream, path);
+}
+
+ParticleSet
+readBgeoFile(const std::string& path)
+{
+    StreamReader stream(path, /*inflateGzip=*/true);
+    return readBgeo(stream, path);
 }
 
 } // namespace io_internal

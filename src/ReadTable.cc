@@ -9,9 +9,17 @@
 /// position, pos or p. Every other column is an attribute; consecutive columns
 /// `<name>:0,:1,:2` (ParaView), `<name>_x,_y,_z`, `<name>[0..2]` form one 3-component
 /// attribute `<name>`. An attribute whose values are all integers is Int64, else Float64.
+///
+/// Both are read through a StreamReader (a bounded buffer) straight into the final arrays:
+/// table rows line by line, attribute values stored as float64 and turned into int64 in
+/// place at the end if all were integers; JSON through nlohmann's SAX parser, with no DOM.
+/// Text has no counts to check; once the first rows show the bytes per particle, the
+/// arrays are reserved for the bytes left in the file plus a quarter (re-estimated if that
+/// falls short), so they are not copied as they grow.
 
 #include "FileFormats.h"
 #include "ParticleReaders.h"
+#include "StreamReader.h"
 
 #include <nonbloppy/Error.h>
 
@@ -117,20 +125,34 @@ parseDoubleField(std::string_view text, double& value)
     return result.ec == std::errc() && result.ptr == text.data() + text.size() && !text.empty();
 }
 
-} // namespace
+/// Rows read before the arrays are reserved from the bytes per row seen so far.
+constexpr size_t kEstimateAfterRows = 1024;
+
+/// True when the arrays, holding @a size items in @a capacity, should be reserved for an
+/// estimate of the whole input: after the first rows, and again instead of doubling if the
+/// estimate falls short (reserved but untouched room costs address space, not memory).
+bool
+timeToEstimate(size_t size, size_t capacity)
+{
+    return size == kEstimateAfterRows || (size > kEstimateAfterRows && size == capacity);
+}
+
+/// Room for @a done items read from @a doneBytes, plus what the @a remaining bytes may
+/// hold at the same rate, with a quarter more for rows that grow longer (numbers printed
+/// with more digits further on).
+size_t
+estimatedCount(size_t done, uint64_t doneBytes, uint64_t remaining)
+{
+    const double bytesPerItem = std::max(double(doneBytes) / double(done), 1.0);
+    return done + size_t(double(remaining) / bytesPerItem * 1.25) + 16;
+}
 
 ParticleSet
-readTableParticles(const char* data, size_t size, const std::string& path)
+parseTable(StreamReader& in, const std::string& path)
 {
-    const std::string_view text(data, size);
-    size_t pos = 0;
     size_t lineNumber = 0;
     auto nextLine = [&](std::string_view& line) {
-        while (pos < text.size()) {
-            size_t end = text.find('\n', pos);
-            if (end == std::string_view::npos) end = text.size();
-            line = text.substr(pos, end - pos);
-            pos = end + 1;
+        while (in.line(line)) {
             ++lineNumber;
             const std::string_view content = trimmed(line);
             if (content.empty() || content[0] == '#') continue;
@@ -139,8 +161,9 @@ readTableParticles(const char* data, size_t size, const std::string& path)
         return false;
     };
 
-    std::string_view header;
-    if (!nextLine(header)) fail(path, "empty table: no header row");
+    std::string_view headerLine;
+    if (!nextLine(headerLine)) fail(path, "empty table: no header row");
+    const std::string header(headerLine);  // the reader's buffer moves on
     char separator = ' ';
     for (char candidate : {',', ';', '\t'}) {
         if (header.find(candidate) != std::string_view::npos) {
@@ -190,10 +213,12 @@ readTableParticles(const char* data, size_t size, const std::string& path)
         fail(path, "the header must name columns x, y and z, got '" + printable(header) + "'");
     }
 
-    // Values, as doubles first; the type of each attribute is settled at the end.
-    std::vector<std::vector<double>> values(names.size());
-    std::vector<bool> integral(names.size(), true);
+    // Values go straight into the attribute arrays as float64; an attribute whose values
+    // are all integers is turned into int64 in place at the end.
     ParticleSet particles;
+    particles.attributes.resize(names.size());
+    std::vector<bool> integral(names.size(), true);
+    const uint64_t dataStart = in.pos();
     std::string_view line;
     while (nextLine(line)) {
         splitLine(line, separator, fields);
@@ -212,7 +237,9 @@ readTableParticles(const char* data, size_t size, const std::string& path)
                 p[columns[i].component] = static_cast<float>(value);
             } else {
                 const size_t a = size_t(columns[i].attribute);
-                values[a].push_back(value);
+                std::vector<unsigned char>& bytes = particles.attributes[a].bytes;
+                const unsigned char* raw = reinterpret_cast<const unsigned char*>(&value);
+                bytes.insert(bytes.end(), raw, raw + 8);
                 if (integral[a] && (field.find_first_of(".eE") != std::string_view::npos
                                     || !(std::abs(value) < 9.0e15))) {
                     integral[a] = false;
@@ -220,24 +247,44 @@ readTableParticles(const char* data, size_t size, const std::string& path)
             }
         }
         particles.positions.push_back(p);
+        if (timeToEstimate(particles.positions.size(), particles.positions.capacity())) {
+            const size_t rows = estimatedCount(particles.positions.size(), in.pos() - dataStart, in.remaining());
+            particles.positions.reserve(rows);
+            for (size_t a = 0; a < names.size(); ++a) {
+                particles.attributes[a].bytes.reserve(rows * size_t(componentCounts[a]) * 8);
+            }
+        }
     }
     for (size_t a = 0; a < names.size(); ++a) {
-        ParticleAttribute attribute;
+        ParticleAttribute& attribute = particles.attributes[a];
         attribute.name = names[a];
         attribute.components = componentCounts[a];
         attribute.type = integral[a] ? ScalarType::Int64 : ScalarType::Float64;
-        attribute.bytes.resize(values[a].size() * 8);
-        for (size_t k = 0; k < values[a].size(); ++k) {
-            if (integral[a]) {
-                const int64_t v = static_cast<int64_t>(values[a][k]);
-                std::memcpy(attribute.bytes.data() + 8 * k, &v, 8);
-            } else {
-                std::memcpy(attribute.bytes.data() + 8 * k, &values[a][k], 8);
-            }
+        if (!integral[a]) continue;
+        for (size_t k = 0; k < attribute.bytes.size() / 8; ++k) {
+            double value;
+            std::memcpy(&value, attribute.bytes.data() + 8 * k, 8);
+            const int64_t v = static_cast<int64_t>(value);
+            std::memcpy(attribute.bytes.data() + 8 * k, &v, 8);
         }
-        particles.attributes.push_back(std::move(attribute));
     }
     return particles;
+}
+
+} // namespace
+
+ParticleSet
+readTableParticles(const char* data, size_t size, const std::string& path)
+{
+    StreamReader in(data, size, path, /*inflateGzip=*/false);
+    return parseTable(in, path);
+}
+
+ParticleSet
+readTableFile(const std::string& path)
+{
+    StreamReader in(path, /*inflateGzip=*/false);
+    return parseTable(in, path);
 }
 
 namespace {
@@ -247,7 +294,7 @@ namespace {
 class JsonPointsHandler : public nlohmann::json_sax<nlohmann::json>
 {
 public:
-    explicit JsonPointsHandler(const std::string& path) : mPath(path) {}
+    JsonPointsHandler(StreamReader& in, const std::string& path) : mIn(in), mPath(path) {}
 
     std::vector<openvdb::Vec3f> positions;
     std::string error;
@@ -283,6 +330,9 @@ public:
                               std::to_string(mComponent) + " coordinates, expected 3");
             }
             positions.push_back(mPoint);
+            if (timeToEstimate(positions.size(), positions.capacity())) {
+                positions.reserve(estimatedCount(positions.size(), mIn.pos(), mIn.remaining()));
+            }
         }
         --mDepth;
         return true;
@@ -306,26 +356,41 @@ private:
         return false;
     }
 
+    StreamReader& mIn;
     const std::string& mPath;
     int mDepth = 0;
     int mComponent = 0;
     openvdb::Vec3f mPoint;
 };
 
-} // namespace
-
 ParticleSet
-readJsonParticles(const char* data, size_t size, const std::string& path)
+readJson(StreamReader& in, const std::string& path)
 {
-    JsonPointsHandler handler(path);
-    const bool ok = nlohmann::json::sax_parse(data, data + size, &handler,
-                                              nlohmann::json::input_format_t::json, true);
+    JsonPointsHandler handler(in, path);
+    const bool ok = nlohmann::json::sax_parse(StreamReader::CharIterator(in), StreamReader::CharIterator(),
+                                              &handler, nlohmann::json::input_format_t::json, true);
     if (!ok || !handler.error.empty()) {
         fail(path, "bad JSON particle list: " + (handler.error.empty() ? "parse error" : handler.error));
     }
     ParticleSet particles;
     particles.positions = std::move(handler.positions);
     return particles;
+}
+
+} // namespace
+
+ParticleSet
+readJsonParticles(const char* data, size_t size, const std::string& path)
+{
+    StreamReader in(data, size, path, /*inflateGzip=*/false);
+    return readJson(in, path);
+}
+
+ParticleSet
+readJsonFile(const std::string& path)
+{
+    StreamReader in(path, /*inflateGzip=*/false);
+    return readJson(in, path);
 }
 
 } // namespace io_internal

@@ -1,0 +1,440 @@
+// SPDX-License-Identifier: Apache-2.0
+// Tests for the streaming BGEO, CSV/TXT and JSON readers (src/StreamReader.h): files larger
+// than the reader's 1 MiB buffer, so values, points and lines straddle buffer boundaries;
+// BGEO plain and gzip (inflated on the fly); tables with extra columns, CRLF, comments and
+// a line longer than the buffer; JSON through the SAX parser; truncation and bad values deep
+// inside a file give the messages the whole-file readers gave; hostile counts are rejected.
+// Each file is read both by path (readBgeoFile & co.) and through readParticles().
+
+#include "TestUtil.h"
+
+#include "../src/StreamReader.h"
+
+#include <nonbloppy/Error.h>
+#include <nonbloppy/ReadParticles.h>
+
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+#include <zlib.h>
+
+#include <algorithm>
+#include <cstdint>
+#include <cstring>
+#include <functional>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace {
+
+using nonbloppy::FileError;
+using nonbloppy::ParticleAttribute;
+using nonbloppy::ParticleSet;
+using nonbloppy::ScalarType;
+using nonbloppy::readParticles;
+namespace io = nonbloppy::io_internal;
+
+using nonbloppy_test::messageOf;
+using nonbloppy_test::readBytes;
+using nonbloppy_test::writeBytes;
+
+class ReadStreamingFormatsTest : public nonbloppy_test::ScratchDirTest
+{
+protected:
+    std::string write(const std::string& name, const std::string& bytes)
+    {
+        writeBytes(path(name), bytes);
+        return path(name);
+    }
+};
+
+/// More particles than fit in a 1 MiB buffer in every layout below.
+constexpr size_t kManyParticles = 120001;
+
+/// Particle @a i of a synthetic frame: irregular values.
+struct Record
+{
+    float x, y, z;
+    float density;
+    int32_t id;
+    float velocity[3];
+};
+
+Record
+record(size_t i)
+{
+    const float t = float(i);
+    return {0.001f * t - 17.25f, std::sin(t) * 3.0f, 1.0f / (1.0f + t), 1000.0f + std::cos(t),
+            int32_t(i * 7919 % 100003) - 50000,
+            {t * 0.5f, -t * 0.25f, std::sqrt(t)}};
+}
+
+std::string
+bigEndian32(uint32_t v)
+{
+    return {char(v >> 24), char(v >> 16), char(v >> 8), char(v)};
+}
+
+std::string
+bigEndianFloat(float f)
+{
+    uint32_t bits;
+    std::memcpy(&bits, &f, 4);
+    return bigEndian32(bits);
+}
+
+std::string
+bigEndian16(uint16_t v)
+{
+    return {char(v >> 8), char(v)};
+}
+
+/// A classic BGEO with @a count points (header claims @a claimed, default the same):
+/// attributes density (float), id (int), velocity (vector 3), kind (index, 2 strings).
+std::string
+bgeoBytes(size_t count, int64_t claimed = -1)
+{
+    std::string b = "BgeoV" + bigEndian32(5) + bigEndian32(uint32_t(claimed < 0 ? int64_t(count) : claimed));
+    for (uint32_t v : {1u, 0u, 0u, 4u, 0u, 0u, 0u}) b += bigEndian32(v);  // prims ... attributes
+    auto name = [&](const std::string& n) { b += bigEndian16(uint16_t(n.size())) + n; };
+    name("density");
+    b += bigEndian16(1) + bigEndian32(0) + bigEndianFloat(1000.0f);
+    name("id");
+    b += bigEndian16(1) + bigEndian32(1) + bigEndian32(0);
+    name("velocity");
+    b += bigEndian16(3) + bigEndian32(5) + std::string(12, '\0');
+    name("kind");
+    b += bigEndian16(1) + bigEndian32(4) + bigEndian32(2);
+    name("water");
+    name("foam");
+    for (size_t i = 0; i < count; ++i) {
+        const Record r = record(i);
+        b += bigEndianFloat(r.x) + bigEndianFloat(r.y) + bigEndianFloat(r.z) + bigEndianFloat(1.0f);
+        b += bigEndianFloat(r.density) + bigEndian32(uint32_t(r.id));
+        for (float v : r.velocity) b += bigEndianFloat(v);
+        b += bigEndian32(uint32_t(i % 2));
+    }
+    b += "primitives and the rest, ignored";
+    return b;
+}
+
+/// Bytes of the BGEO attribute table above; the points start at 41 + this.
+constexpr size_t kBgeoTableBytes = (2 + 7 + 2 + 4 + 4) + (2 + 2 + 2 + 4 + 4) + (2 + 8 + 2 + 4 + 12)
+                                 + (2 + 4 + 2 + 4 + 4 + 2 + 5 + 2 + 4);
+constexpr size_t kBgeoPointBytes = 16 + 4 + 4 + 12 + 4;
+
+std::string
+gzipBytes(const std::string& plain)
+{
+    z_stream stream{};
+    EXPECT_EQ(deflateInit2(&stream, 6, Z_DEFLATED, 16 + MAX_WBITS, 8, Z_DEFAULT_STRATEGY), Z_OK);
+    std::string out(deflateBound(&stream, uLong(plain.size())), '\0');
+    stream.next_in = reinterpret_cast<Bytef*>(const_cast<char*>(plain.data()));
+    stream.avail_in = uInt(plain.size());
+    stream.next_out = reinterpret_cast<Bytef*>(out.data());
+    stream.avail_out = uInt(out.size());
+    EXPECT_EQ(deflate(&stream, Z_FINISH), Z_STREAM_END);
+    out.resize(stream.total_out);
+    deflateEnd(&stream);
+    return out;
+}
+
+const ParticleAttribute&
+attribute(const ParticleSet& particles, const std::string& name)
+{
+    for (const ParticleAttribute& a : particles.attributes) {
+        if (a.name == name) return a;
+    }
+    static const ParticleAttribute none;
+    ADD_FAILURE() << "no attribute " << name;
+    return none;
+}
+
+void
+expectBgeoParticles(const ParticleSet& particles, size_t count)
+{
+    ASSERT_EQ(particles.size(), count);
+    ASSERT_EQ(particles.attributes.size(), 4u);
+    const ParticleAttribute& density = attribute(particles, "density");
+    const ParticleAttribute& id = attribute(particles, "id");
+    const ParticleAttribute& velocity = attribute(particles, "velocity");
+    const ParticleAttribute& kind = attribute(particles, "kind");
+    EXPECT_EQ(density.type, ScalarType::Float32);
+    EXPECT_EQ(id.type, ScalarType::Int32);
+    EXPECT_EQ(velocity.components, 3);
+    EXPECT_EQ(kind.type, ScalarType::Int32);
+    for (size_t i = 0; i < count; ++i) {
+        const Record r = record(i);
+        ASSERT_EQ(particles.positions[i], openvdb::Vec3f(r.x, r.y, r.z)) << i;
+        ASSERT_EQ(density.asDouble(i), double(r.density)) << i;
+        ASSERT_EQ(id.asDouble(i), double(r.id)) << i;
+        for (int c = 0; c < 3; ++c) ASSERT_EQ(velocity.asDouble(i, c), double(r.velocity[c])) << i;
+        ASSERT_EQ(kind.asDouble(i), double(i % 2)) << i;
+    }
+}
+
+/// The FileError of reading @a path by path, which must equal readParticles()'s.
+std::string
+errorOfBoth(const std::string& path, const std::function<ParticleSet(const std::string&)>& readFile)
+{
+    const std::string direct = messageOf<FileError>([&] { readFile(path); });
+    EXPECT_EQ(direct, messageOf<FileError>([&] { readParticles(path); })) << path;
+    return direct;
+}
+
+// ---------------------------------------------------------------------------------------
+// BGEO
+
+TEST_F(ReadStreamingFormatsTest, BgeoPlainAndGzipLargerThanTheBuffer)
+{
+    const std::string plain = bgeoBytes(kManyParticles);
+    ASSERT_GT(plain.size(), 4 * io::kStreamChunkBytes);
+    const std::string plainFile = write("plain.bgeo", plain);
+    expectBgeoParticles(io::readBgeoFile(plainFile), kManyParticles);
+    expectBgeoParticles(readParticles(plainFile), kManyParticles);
+
+    const std::string gz = gzipBytes(plain);
+    ASSERT_GT(gz.size(), io::kStreamChunkBytes);
+    const std::string gzFile = write("gz.bgeo", gz);
+    expectBgeoParticles(io::readBgeoFile(gzFile), kManyParticles);
+    expectBgeoParticles(readParticles(gzFile), kManyParticles);
+
+    // No points at all, plain and gzip.
+    expectBgeoParticles(io::readBgeoFile(write("empty.bgeo", bgeoBytes(0))), 0);
+    expectBgeoParticles(io::readBgeoFile(write("emptygz.bgeo", gzipBytes(bgeoBytes(0)))), 0);
+}
+
+TEST_F(ReadStreamingFormatsTest, BgeoTruncatedDeepInTheFile)
+{
+    const std::string plain = bgeoBytes(kManyParticles);
+    const size_t pointsStart = 41 + kBgeoTableBytes;
+    ASSERT_EQ(plain.substr(pointsStart, 4), bigEndianFloat(record(0).x));
+    const size_t left = 3 * io::kStreamChunkBytes + 7;
+    const std::string expected = "truncated BGEO points: header claims " + std::to_string(kManyParticles) +
+        " points of " + std::to_string(kBgeoPointBytes) + " bytes, " + std::to_string(left) + " bytes left";
+    const std::string cut = plain.substr(0, pointsStart + left);
+    const std::string cutFile = write("cut.bgeo", cut);
+    EXPECT_EQ(errorOfBoth(cutFile, io::readBgeoFile), expected + " (" + cutFile + ")");
+
+    // A complete gzip stream of the cut file: the same message, found while reading.
+    const std::string cutGzFile = write("cutgz.bgeo", gzipBytes(cut));
+    EXPECT_EQ(errorOfBoth(cutGzFile, io::readBgeoFile), expected + " (" + cutGzFile + ")");
+
+    // The gzip stream itself cut deep inside, or corrupted there.
+    const std::string gz = gzipBytes(plain);
+    const std::string gzCut = write("gzcut.bgeo", gz.substr(0, gz.size() - gz.size() / 4));
+    EXPECT_EQ(errorOfBoth(gzCut, io::readBgeoFile), "truncated gzip data (" + gzCut + ")");
+    std::string flipped = gz;
+    for (size_t i = gz.size() / 2; i < gz.size() / 2 + 100; ++i) flipped[i] = char(~flipped[i]);
+    const std::string corrupt = write("corrupt.bgeo", flipped);
+    EXPECT_EQ(errorOfBoth(corrupt, io::readBgeoFile).rfind("corrupt gzip data: ", 0), 0u);
+
+    // gzip errors come before BGEO ones, as when the whole file was inflated first.
+    std::string badType = plain;
+    badType[41 + 2 + 7 + 2 + 3] = 9;  // density's houdini type 0 -> 9
+    const std::string badTypeFile = write("badtype.bgeo", badType);
+    EXPECT_EQ(errorOfBoth(badTypeFile, io::readBgeoFile),
+              "unsupported BGEO attribute type 9 of 'density' (" + badTypeFile + ")");
+    const std::string badTypeGz = gzipBytes(badType);
+    const std::string badTypeGzCut = write("badtypegz.bgeo", badTypeGz.substr(0, badTypeGz.size() / 2));
+    EXPECT_EQ(errorOfBoth(badTypeGzCut, io::readBgeoFile), "truncated gzip data (" + badTypeGzCut + ")");
+}
+
+TEST_F(ReadStreamingFormatsTest, BgeoHostileCountsAreRejected)
+{
+    // Plain: checked against the file size before allocating.
+    const std::string plain = bgeoBytes(3, 1000000000);
+    const std::string plainFile = write("hostile.bgeo", plain);
+    const size_t left = plain.size() - 41 - kBgeoTableBytes;
+    EXPECT_EQ(errorOfBoth(plainFile, io::readBgeoFile),
+              "truncated BGEO points: header claims 1000000000 points of 40 bytes, " +
+              std::to_string(left) + " bytes left (" + plainFile + ")");
+    // gzip: beyond deflate's 1032:1 for the compressed bytes left, so truncated for sure.
+    const std::string gzFile = write("hostilegz.bgeo", gzipBytes(plain));
+    EXPECT_EQ(errorOfBoth(gzFile, io::readBgeoFile),
+              "truncated BGEO points: header claims 1000000000 points of 40 bytes, " +
+              std::to_string(left) + " bytes left (" + gzFile + ")");
+    // gzip within that limit: found short while reading.
+    const std::string nearly = bgeoBytes(kManyParticles, int64_t(kManyParticles) + 1000);
+    const std::string nearlyFile = write("nearly.bgeo", gzipBytes(nearly));
+    EXPECT_EQ(errorOfBoth(nearlyFile, io::readBgeoFile),
+              "truncated BGEO points: header claims " + std::to_string(kManyParticles + 1000) +
+              " points of 40 bytes, " + std::to_string(nearly.size() - 41 - kBgeoTableBytes) +
+              " bytes left (" + nearlyFile + ")");
+}
+
+// ---------------------------------------------------------------------------------------
+// CSV / TXT
+
+/// A text form of @a value that reads back exactly.
+template<typename T>
+std::string
+text(T value)
+{
+    std::ostringstream os;
+    os.precision(17);
+    os << value;
+    return os.str();
+}
+
+/// id, x, y, z, velocity:0..2, density and a comment column, with @a eol line ends, a
+/// comment and a blank line every 1000 rows.
+std::string
+tableBytes(size_t count, const std::string& eol, char separator = ',')
+{
+    const std::string s(1, separator);
+    std::string t = "# made by test_ReadStreamingFormats" + eol;
+    t += "id" + s + "x" + s + "y" + s + "z" + s + "velocity:0" + s + "velocity:1" + s +
+         "velocity:2" + s + "density" + s + "flag" + eol;
+    for (size_t i = 0; i < count; ++i) {
+        const Record r = record(i);
+        t += std::to_string(r.id) + s + text(r.x) + s + text(r.y) + s + text(r.z) + s +
+             text(double(r.velocity[0])) + s + text(double(r.velocity[1])) + s +
+             text(double(r.velocity[2])) + s + text(double(r.density) + 0.5) + s +
+             std::to_string(i % 3) + eol;
+        if (i % 1000 == 999) t += "# comment" + eol + eol;
+    }
+    return t;
+}
+
+void
+expectTableParticles(const ParticleSet& particles, size_t count)
+{
+    ASSERT_EQ(particles.size(), count);
+    ASSERT_EQ(particles.attributes.size(), 4u);
+    const ParticleAttribute& id = attribute(particles, "id");
+    const ParticleAttribute& velocity = attribute(particles, "velocity");
+    const ParticleAttribute& density = attribute(particles, "density");
+    const ParticleAttribute& flag = attribute(particles, "flag");
+    EXPECT_EQ(id.type, ScalarType::Int64);
+    EXPECT_EQ(flag.type, ScalarType::Int64);
+    EXPECT_EQ(velocity.type, ScalarType::Float64);
+    EXPECT_EQ(velocity.components, 3);
+    EXPECT_EQ(density.type, ScalarType::Float64);
+    for (size_t i = 0; i < count; ++i) {
+        const Record r = record(i);
+        ASSERT_EQ(particles.positions[i], openvdb::Vec3f(r.x, r.y, r.z)) << i;
+        ASSERT_EQ(id.asDouble(i), double(r.id)) << i;
+        for (int c = 0; c < 3; ++c) ASSERT_EQ(velocity.asDouble(i, c), double(r.velocity[c])) << i;
+        ASSERT_EQ(density.asDouble(i), double(r.density) + 0.5) << i;
+        ASSERT_EQ(flag.asDouble(i), double(i % 3)) << i;
+    }
+}
+
+TEST_F(ReadStreamingFormatsTest, TablesLargerThanTheBuffer)
+{
+    const std::string csv = tableBytes(kManyParticles, "\n");
+    ASSERT_GT(csv.size(), 4 * io::kStreamChunkBytes);
+    const std::string csvFile = write("p.csv", csv);
+    expectTableParticles(io::readTableFile(csvFile), kManyParticles);
+    expectTableParticles(readParticles(csvFile), kManyParticles);
+
+    // CRLF, semicolons, no line break after the last row.
+    std::string crlf = tableBytes(kManyParticles, "\r\n", ';');
+    crlf.resize(crlf.size() - 2);
+    expectTableParticles(io::readTableFile(write("crlf.csv", crlf)), kManyParticles);
+
+    // Spaces, and a comment line longer than the buffer in the middle.
+    std::string txt = tableBytes(kManyParticles, "\n", ' ');
+    const size_t middle = txt.find('\n', txt.size() / 2) + 1;
+    txt.insert(middle, "#" + std::string(3 * io::kStreamChunkBytes, 'c') + "\n");
+    expectTableParticles(io::readTableFile(write("p.txt", txt)), kManyParticles);
+}
+
+TEST_F(ReadStreamingFormatsTest, TableErrorsDeepInTheFile)
+{
+    const std::string csv = tableBytes(kManyParticles, "\n");
+    // Line numbers count every line: the comment, the header, rows and the comment and
+    // blank line after every 1000 rows.
+    auto lineOfRow = [](size_t row) { return 3 + row + 2 * (row / 1000); };
+    const size_t row = kManyParticles * 3 / 4;
+    const size_t start = [&] {
+        size_t pos = 0;
+        for (size_t line = 1; line < lineOfRow(row); ++line) pos = csv.find('\n', pos) + 1;
+        return pos;
+    }();
+    ASSERT_EQ(csv.compare(start, std::to_string(record(row).id).size() + 1, std::to_string(record(row).id) + ","), 0);
+
+    // Cut in the middle of a row: it has fewer fields.
+    const std::string cut = write("cut.csv", csv.substr(0, csv.find(',', csv.find(',', start) + 1)));
+    EXPECT_EQ(errorOfBoth(cut, io::readTableFile),
+              "line " + std::to_string(lineOfRow(row)) + " has 2 fields, the header 9 (" + cut + ")");
+
+    std::string bad = csv;
+    bad.replace(start, std::to_string(record(row).id).size(), "12x");
+    const std::string badFile = write("bad.csv", bad);
+    EXPECT_EQ(errorOfBoth(badFile, io::readTableFile),
+              "bad number '12x' on line " + std::to_string(lineOfRow(row)) + " (" + badFile + ")");
+}
+
+// ---------------------------------------------------------------------------------------
+// JSON
+
+std::string
+jsonBytes(size_t count)
+{
+    std::string j = "[\n";
+    for (size_t i = 0; i < count; ++i) {
+        const Record r = record(i);
+        j += (i ? ",\n  [" : "  [") + text(r.x) + ", " + text(r.y) + "," + text(r.z) + "]";
+    }
+    return j + "\n]\n";
+}
+
+/// The message the whole-file reader gave for a JSON syntax error in @a bytes.
+std::string
+jsonSyntaxError(const std::string& bytes)
+{
+    try {
+        const nlohmann::json document = nlohmann::json::parse(bytes);
+    } catch (const nlohmann::json::parse_error& e) {
+        std::string message = e.what();
+        message = message.substr(message.find("] ") + 2);
+        return "bad JSON particle list: " + message + " (byte " + std::to_string(e.byte) + ")";
+    }
+    return "(no parse error)";
+}
+
+TEST_F(ReadStreamingFormatsTest, JsonLargerThanTheBuffer)
+{
+    const std::string json = jsonBytes(kManyParticles);
+    ASSERT_GT(json.size(), 4 * io::kStreamChunkBytes);
+    const std::string file = write("p.json", json);
+    for (const ParticleSet& particles : {io::readJsonFile(file), readParticles(file)}) {
+        ASSERT_EQ(particles.size(), kManyParticles);
+        EXPECT_TRUE(particles.attributes.empty());
+        for (size_t i = 0; i < kManyParticles; ++i) {
+            const Record r = record(i);
+            ASSERT_EQ(particles.positions[i], openvdb::Vec3f(r.x, r.y, r.z)) << i;
+        }
+    }
+    EXPECT_EQ(io::readJsonFile(write("empty.json", "[]")).size(), 0u);
+}
+
+TEST_F(ReadStreamingFormatsTest, JsonErrorsDeepInTheFile)
+{
+    const std::string json = jsonBytes(kManyParticles);
+    const std::string cutBytes = json.substr(0, json.size() * 2 / 3);
+    const std::string cut = write("cut.json", cutBytes);
+    EXPECT_EQ(errorOfBoth(cut, io::readJsonFile), jsonSyntaxError(cutBytes) + " (" + cut + ")");
+    EXPECT_NE(jsonSyntaxError(cutBytes).find("unexpected end of input"), std::string::npos);
+
+    std::string garbled = json;
+    const size_t at = json.find('[', json.size() / 2);
+    garbled[at + 1] = '@';
+    const std::string garbledFile = write("garbled.json", garbled);
+    EXPECT_EQ(errorOfBoth(garbledFile, io::readJsonFile), jsonSyntaxError(garbled) + " (" + garbledFile + ")");
+
+    // A point with two coordinates deep inside.
+    std::string two = json;
+    const size_t point = std::count(json.begin(), json.begin() + long(at), '[') - 1;  // outer '[' too
+    const size_t lastComma = json.rfind(',', json.find(']', at));
+    two.erase(lastComma, json.find(']', at) - lastComma);
+    const std::string twoFile = write("two.json", two);
+    EXPECT_EQ(errorOfBoth(twoFile, io::readJsonFile),
+              "bad JSON particle list: particle " + std::to_string(point) +
+              " has 2 coordinates, expected 3 (" + twoFile + ")");
+}
+
+} // namespace
