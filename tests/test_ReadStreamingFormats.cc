@@ -4,7 +4,8 @@
 // BGEO plain and gzip (inflated on the fly); tables with extra columns, CRLF, comments and
 // a line longer than the buffer; JSON through the SAX parser; truncation and bad values deep
 // inside a file give the messages the whole-file readers gave; hostile counts are rejected.
-// Each file is read both by path (readBgeoFile & co.) and through readParticles().
+// Each file is read both by path (readBgeoFile & co.) and through readParticles(); pipes,
+// which have no size, are read whole.
 
 #include "TestUtil.h"
 
@@ -24,7 +25,10 @@
 #include <functional>
 #include <sstream>
 #include <string>
+#include <thread>
 #include <vector>
+
+#include <sys/stat.h>
 
 namespace {
 
@@ -435,6 +439,32 @@ TEST_F(ReadStreamingFormatsTest, JsonErrorsDeepInTheFile)
     EXPECT_EQ(errorOfBoth(twoFile, io::readJsonFile),
               "bad JSON particle list: particle " + std::to_string(point) +
               " has 2 coordinates, expected 3 (" + twoFile + ")");
+}
+
+// ---------------------------------------------------------------------------------------
+// Pipes
+
+TEST_F(ReadStreamingFormatsTest, PipesAreReadWhole)
+{
+    // A FIFO has no size to check counts against, so it is loaded whole first.
+    struct Case { std::string name; std::string bytes; std::function<ParticleSet(const std::string&)> read; };
+    const std::vector<Case> cases = {
+        {"p.bgeo", gzipBytes(bgeoBytes(kManyParticles)), io::readBgeoFile},
+        {"p.csv", tableBytes(kManyParticles, "\n"), io::readTableFile},
+        {"p.json", jsonBytes(kManyParticles), io::readJsonFile}};
+    for (const Case& c : cases) {
+        const std::string fifo = path(c.name);
+        ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+        std::thread writer([&] { writeBytes(fifo, c.bytes); });
+        ParticleSet particles;
+        EXPECT_NO_THROW(particles = c.read(fifo)) << c.name;
+        writer.join();
+        ASSERT_EQ(particles.size(), kManyParticles) << c.name;
+        EXPECT_EQ(particles.positions[kManyParticles - 1],
+                  openvdb::Vec3f(record(kManyParticles - 1).x, record(kManyParticles - 1).y,
+                                 record(kManyParticles - 1).z)) << c.name;
+    }
+    expectBgeoParticles(io::readBgeoFile(write("check.bgeo", cases[0].bytes)), kManyParticles);
 }
 
 } // namespace
