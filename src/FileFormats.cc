@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 /// @file FileFormats.cc
-/// @brief Legacy VTK and PLY decoding shared by readParticles() and readMesh().
+/// @brief Legacy VTK and PLY decoding shared by readParticles() and readMesh(), and the
+///        file, text, number and type-name helpers that the streaming readers use too.
 
 #include "FileFormats.h"
 
@@ -24,30 +25,44 @@ namespace io_internal {
 // ------------------------------------------------------------------------------------------
 // Files, messages, text
 
+[[noreturn]] void
+failRead(const std::string& path, int errorNumber)
+{
+    throw FileError("cannot read " + path + ": " + std::strerror(errorNumber));
+}
+
+OpenFile
+openFile(const std::string& path)
+{
+    OpenFile file;
+    file.fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+    if (file.fd < 0) throw FileError("cannot open " + path + ": " + std::strerror(errno));
+    struct stat info;
+    const int error = (::fstat(file.fd, &info) != 0) ? errno : S_ISDIR(info.st_mode) ? EISDIR : 0;
+    if (error != 0) {
+        ::close(file.fd);
+        failRead(path, error);
+    }
+    file.regular = S_ISREG(info.st_mode);
+    file.size = uint64_t(info.st_size);
+    return file;
+}
+
 std::vector<char>
 loadFile(const std::string& path)
 {
-    const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
-    if (fd < 0) throw FileError("cannot open " + path + ": " + std::strerror(errno));
-
-    struct FdCloser { int fd; ~FdCloser() { ::close(fd); } } closer{fd};
-    auto readError = [&path](int errorNumber) {
-        return FileError("cannot read " + path + ": " + std::strerror(errorNumber));
-    };
-
-    struct stat info;
-    if (::fstat(fd, &info) != 0) throw readError(errno);
-    if (S_ISDIR(info.st_mode)) throw readError(EISDIR);
+    const OpenFile file = openFile(path);
+    struct FdCloser { int fd; ~FdCloser() { ::close(fd); } } closer{file.fd};
 
     // st_size is only a hint (pipes and /proc files report 0); read until end of file.
-    std::vector<char> data(S_ISREG(info.st_mode) ? size_t(info.st_size) + 1 : 65536);
+    std::vector<char> data(file.regular ? size_t(file.size) + 1 : 65536);
     size_t used = 0;
     for (;;) {
         if (used == data.size()) data.resize(data.size() * 2);
-        const ssize_t n = ::read(fd, data.data() + used, data.size() - used);
+        const ssize_t n = ::read(file.fd, data.data() + used, data.size() - used);
         if (n < 0) {
             if (errno == EINTR) continue;
-            throw readError(errno);
+            failRead(path, errno);
         }
         if (n == 0) break;
         used += size_t(n);
@@ -87,22 +102,6 @@ printable(std::string_view text)
     return result;
 }
 
-namespace {
-
-constexpr bool kHostIsBigEndian = (__BYTE_ORDER__ == __ORDER_BIG_ENDIAN__);
-
-bool
-isSpace(char ch)
-{
-    return ch == ' ' || ch == '\t' || ch == '\n' || ch == '\r' || ch == '\v' || ch == '\f';
-}
-
-char
-toLower(char ch)
-{
-    return (ch >= 'A' && ch <= 'Z') ? char(ch - 'A' + 'a') : ch;
-}
-
 bool
 iequals(std::string_view a, std::string_view b)
 {
@@ -135,59 +134,18 @@ splitWords(std::string_view text)
     return words;
 }
 
-/// A read position in a buffer; every access is bounds-checked by the caller via remaining().
-class Cursor
+std::string
+upper(std::string_view text)
 {
-public:
-    Cursor(const char* data, size_t size) : mData(data), mSize(size) {}
-
-    size_t pos() const { return mPos; }
-    void setPos(size_t pos) { mPos = std::min(pos, mSize); }
-    size_t remaining() const { return mSize - mPos; }
-    bool atEnd() const { return mPos >= mSize; }
-    const char* here() const { return mData + mPos; }
-    void advance(size_t n) { mPos += std::min(n, remaining()); }
-
-    void skipSpace()
-    {
-        while (mPos < mSize && isSpace(mData[mPos])) ++mPos;
+    std::string result(text);
+    for (char& ch : result) {
+        if (ch >= 'a' && ch <= 'z') ch = char(ch - 'a' + 'A');
     }
+    return result;
+}
 
-    /// The next run of non-space characters (empty at the end of the buffer).
-    std::string_view token()
-    {
-        skipSpace();
-        const size_t begin = mPos;
-        while (mPos < mSize && !isSpace(mData[mPos])) ++mPos;
-        return std::string_view(mData + begin, mPos - begin);
-    }
-
-    /// The rest of the current line without its line break; moves past the '\n'.
-    std::string_view line()
-    {
-        const size_t begin = mPos;
-        const void* newline = std::memchr(mData + mPos, '\n', mSize - mPos);
-        size_t end = newline ? size_t(static_cast<const char*>(newline) - mData) : mSize;
-        mPos = newline ? end + 1 : mSize;
-        if (end > begin && mData[end - 1] == '\r') --end;
-        return std::string_view(mData + begin, end - begin);
-    }
-
-    /// True if the next non-space text starts with the word @a word (case-insensitive).
-    /// Moves nothing.
-    bool peekWord(std::string_view word)
-    {
-        const size_t saved = mPos;
-        const std::string_view next = token();
-        mPos = saved;
-        return iequals(next, word);
-    }
-
-private:
-    const char* mData;
-    size_t mSize;
-    size_t mPos = 0;
-};
+// ------------------------------------------------------------------------------------------
+// Numbers
 
 bool
 parseCount(std::string_view text, uint64_t& value)
@@ -196,6 +154,8 @@ parseCount(std::string_view text, uint64_t& value)
     const auto result = std::from_chars(text.data(), end, value);
     return !text.empty() && result.ec == std::errc() && result.ptr == end;
 }
+
+namespace {
 
 bool
 parseDouble(std::string_view text, double& value)
@@ -215,28 +175,20 @@ parseDouble(std::string_view text, double& value)
     return false;
 }
 
-template<typename IntT>
-bool
-parseInteger(std::string_view text, IntT& value)
-{
-    if (!text.empty() && text.front() == '+') text.remove_prefix(1);
-    const char* end = text.data() + text.size();
-    const auto result = std::from_chars(text.data(), end, value);
-    return !text.empty() && result.ec == std::errc() && result.ptr == end;
-}
-
 template<typename IntT, typename WideT>
 bool
 parseNarrow(std::string_view text, unsigned char* out)
 {
     WideT wide;
-    if (!parseInteger(text, wide)) return false;
+    if (!parseWhole(text, wide)) return false;
     if (wide < WideT(std::numeric_limits<IntT>::min()) ||
         wide > WideT(std::numeric_limits<IntT>::max())) return false;
     const IntT value = IntT(wide);
     std::memcpy(out, &value, sizeof(IntT));
     return true;
 }
+
+} // namespace
 
 /// Parse one text value of @a type into native bytes at @a out.
 bool
@@ -268,44 +220,33 @@ parseTextValue(std::string_view text, ScalarType type, unsigned char* out)
     return false;
 }
 
-/// Copy @a count values of @a width bytes, reversing the bytes of each if @a swap.
+namespace {
+
+/// Apply @a swap to each of @a count unaligned UIntT values at @a data.
+template<typename UIntT, typename SwapT>
 void
-copyValues(const char* src, size_t count, size_t width, bool swap, unsigned char* dst)
+swapEach(unsigned char* data, size_t count, SwapT swap)
 {
-    if (!swap || width == 1) {
-        if (count > 0) std::memcpy(dst, src, count * width);
-        return;
-    }
-    switch (width) {
-        case 2:
-            for (size_t i = 0; i < count; ++i) {
-                uint16_t v;
-                std::memcpy(&v, src + 2 * i, 2);
-                v = __builtin_bswap16(v);
-                std::memcpy(dst + 2 * i, &v, 2);
-            }
-            break;
-        case 4:
-            for (size_t i = 0; i < count; ++i) {
-                uint32_t v;
-                std::memcpy(&v, src + 4 * i, 4);
-                v = __builtin_bswap32(v);
-                std::memcpy(dst + 4 * i, &v, 4);
-            }
-            break;
-        case 8:
-            for (size_t i = 0; i < count; ++i) {
-                uint64_t v;
-                std::memcpy(&v, src + 8 * i, 8);
-                v = __builtin_bswap64(v);
-                std::memcpy(dst + 8 * i, &v, 8);
-            }
-            break;
-        default: break;
+    for (size_t i = 0; i < count; ++i) {
+        UIntT v;
+        std::memcpy(&v, data + sizeof(UIntT) * i, sizeof(UIntT));
+        v = swap(v);
+        std::memcpy(data + sizeof(UIntT) * i, &v, sizeof(UIntT));
     }
 }
 
-bool integerValue(const unsigned char* p, ScalarType type, int64_t& value);
+} // namespace
+
+void
+swapInPlace(unsigned char* data, size_t count, size_t width)
+{
+    switch (width) {
+        case 2: swapEach<uint16_t>(data, count, [](uint16_t v) { return __builtin_bswap16(v); }); break;
+        case 4: swapEach<uint32_t>(data, count, [](uint32_t v) { return __builtin_bswap32(v); }); break;
+        case 8: swapEach<uint64_t>(data, count, [](uint64_t v) { return __builtin_bswap64(v); }); break;
+        default: break;
+    }
+}
 
 double
 valueAsDouble(const unsigned char* p, ScalarType type)
@@ -350,87 +291,166 @@ integerValue(const unsigned char* p, ScalarType type, int64_t& value)
     }
 }
 
-/// Reads typed value arrays from a Cursor, text or binary, never past the buffer's end.
-class ValueReader
+// ------------------------------------------------------------------------------------------
+// Inputs and typed values
+
+namespace {
+
+/// A read position in a memory buffer.
+class Cursor final : public ByteInput
 {
 public:
-    ValueReader(Cursor& cursor, bool binary, bool bigEndian, const std::string& path)
-        : mCursor(cursor), mBinary(binary), mSwap(binary && bigEndian != kHostIsBigEndian)
-        , mPath(path) {}
+    Cursor(const char* data, size_t size) : mData(data), mSize(size) {}
 
-    bool binary() const { return mBinary; }
+    uint64_t remaining() const override { return mSize - mPos; }
+    bool atEnd() override { return mPos >= mSize; }
 
-    /// Fail with "truncated <section> (path)" unless @a count values of @a type can still
-    /// be in the buffer: checked before allocating, so a corrupt count cannot exhaust memory.
-    void requireRoom(uint64_t count, ScalarType type, const std::string& section) const
+    void skipSpace() override
     {
-        const size_t left = mCursor.remaining();
-        // A text value takes at least one character plus a separator.
-        const uint64_t capacity = mBinary ? left / scalarSize(type) : (uint64_t(left) + 1) / 2;
-        if (count > capacity) fail(mPath, "truncated " + section);
+        while (mPos < mSize && isSpace(mData[mPos])) ++mPos;
     }
 
-    /// @a count values of @a type, in native byte order, appended to @a out.
-    void read(uint64_t count, ScalarType type, const std::string& section,
-              std::vector<unsigned char>& out)
+    std::string_view token() override
     {
-        requireRoom(count, type, section);
-        const size_t width = scalarSize(type);
-        const size_t start = out.size();
-        out.resize(start + size_t(count) * width);
-        readInto(size_t(count), type, section, out.data() + start);
+        skipSpace();
+        const size_t begin = mPos;
+        while (mPos < mSize && !isSpace(mData[mPos])) ++mPos;
+        return std::string_view(mData + begin, mPos - begin);
     }
 
-    /// @a count values into @a dst (room for count × scalarSize(type) bytes).
-    void readInto(size_t count, ScalarType type, const std::string& section,
-                  unsigned char* dst)
+    std::string line() override
     {
-        requireRoom(count, type, section);
-        const size_t width = scalarSize(type);
-        if (mBinary) {
-            copyValues(mCursor.here(), count, width, mSwap, dst);
-            mCursor.advance(count * width);
-            return;
+        const size_t begin = mPos;
+        const void* newline = std::memchr(mData + mPos, '\n', mSize - mPos);
+        size_t end = newline ? size_t(static_cast<const char*>(newline) - mData) : mSize;
+        mPos = newline ? end + 1 : mSize;
+        if (end > begin && mData[end - 1] == '\r') --end;
+        return std::string(mData + begin, end - begin);
+    }
+
+    bool peekWord(std::string_view word) override
+    {
+        const size_t saved = mPos;
+        const std::string_view next = token();
+        mPos = saved;
+        return iequals(next, word);
+    }
+
+    bool skipLineStartingWith(std::string_view word, bool skipSpaceFirst) override
+    {
+        const size_t saved = mPos;
+        if (skipSpaceFirst) skipSpace();
+        if (mSize - mPos >= word.size() &&
+            iequals(std::string_view(mData + mPos, word.size()), word)) {
+            line();
+            return true;
         }
-        for (size_t i = 0; i < count; ++i) {
-            const std::string_view text = mCursor.token();
-            if (text.empty()) fail(mPath, "truncated " + section);
-            if (!parseTextValue(text, type, dst + i * width)) {
-                fail(mPath, "bad " + std::string(scalarTypeName(type)) + " value '" +
-                    printable(text) + "' in " + section);
-            }
-        }
+        mPos = saved;
+        return false;
     }
 
-    /// Move past @a count values of @a type without keeping them.
-    void skip(uint64_t count, ScalarType type, const std::string& section)
+    bool readBytes(unsigned char* dst, size_t n) override
     {
-        requireRoom(count, type, section);
-        if (mBinary) {
-            mCursor.advance(size_t(count) * scalarSize(type));
-            return;
+        if (n > mSize - mPos) {
+            mPos = mSize;
+            return false;
         }
-        for (uint64_t i = 0; i < count; ++i) {
-            if (mCursor.token().empty()) fail(mPath, "truncated " + section);
-        }
+        if (n > 0) std::memcpy(dst, mData + mPos, n);
+        mPos += n;
+        return true;
     }
 
-    /// One value of integer @a type (e.g. a PLY list length).
-    int64_t readInteger(ScalarType type, const std::string& section)
-    {
-        unsigned char bytes[8];
-        readInto(1, type, section, bytes);
-        int64_t value = 0;
-        if (!integerValue(bytes, type, value)) fail(mPath, "integer out of range in " + section);
-        return value;
-    }
+    void skipBytes(uint64_t n) override { mPos += size_t(std::min<uint64_t>(n, mSize - mPos)); }
 
 private:
-    Cursor& mCursor;
-    bool mBinary;
-    bool mSwap;
-    const std::string& mPath;
+    const char* mData;
+    size_t mSize;
+    size_t mPos = 0;
 };
+
+} // namespace
+
+void
+ValueReader::requireRoom(uint64_t count, ScalarType type, const std::string& section) const
+{
+    const uint64_t left = mInput.remaining();
+    // A text value takes at least one character plus a separator.
+    const uint64_t capacity = mBinary ? left / scalarSize(type) : (left + 1) / 2;
+    if (count > capacity) fail(mPath, "truncated " + section);
+}
+
+void
+ValueReader::read(uint64_t count, ScalarType type, const std::string& section,
+                  std::vector<unsigned char>& out)
+{
+    requireRoom(count, type, section);
+    const size_t start = out.size();
+    out.resize(start + size_t(count) * scalarSize(type));
+    readInto(size_t(count), type, section, out.data() + start);
+}
+
+void
+ValueReader::readInto(size_t count, ScalarType type, const std::string& section,
+                      unsigned char* dst)
+{
+    requireRoom(count, type, section);
+    const size_t width = scalarSize(type);
+    if (mBinary) {
+        if (!mInput.readBytes(dst, count * width)) fail(mPath, "truncated " + section);
+        if (mSwap && width > 1) swapInPlace(dst, count, width);
+        return;
+    }
+    for (size_t i = 0; i < count; ++i) {
+        const std::string_view text = mInput.token();
+        if (text.empty()) fail(mPath, "truncated " + section);
+        if (!parseTextValue(text, type, dst + i * width)) {
+            fail(mPath, "bad " + std::string(scalarTypeName(type)) + " value '" +
+                printable(text) + "' in " + section);
+        }
+    }
+}
+
+void
+ValueReader::readFloats(size_t count, ScalarType type, const std::string& section, float* dst)
+{
+    requireRoom(count, type, section);
+    if (type == ScalarType::Float32) {
+        readInto(count, type, section, reinterpret_cast<unsigned char*>(dst));
+        return;
+    }
+    std::vector<double> values(std::min<size_t>(count, kChunkBytes / sizeof(double)));
+    for (size_t done = 0; done < count;) {
+        const size_t n = std::min(values.size(), count - done);
+        readInto(n, type, section, reinterpret_cast<unsigned char*>(values.data()));
+        for (size_t i = 0; i < n; ++i) dst[done + i] = float(values[i]);
+        done += n;
+    }
+}
+
+void
+ValueReader::skip(uint64_t count, ScalarType type, const std::string& section)
+{
+    requireRoom(count, type, section);
+    if (mBinary) {
+        mInput.skipBytes(count * scalarSize(type));
+        return;
+    }
+    for (uint64_t i = 0; i < count; ++i) {
+        if (mInput.token().empty()) fail(mPath, "truncated " + section);
+    }
+}
+
+int64_t
+ValueReader::readInteger(ScalarType type, const std::string& section)
+{
+    unsigned char bytes[8];
+    readInto(1, type, section, bytes);
+    int64_t value = 0;
+    if (!integerValue(bytes, type, value)) fail(mPath, "integer out of range in " + section);
+    return value;
+}
+
+namespace {
 
 std::vector<int64_t>
 toIntegers(const std::vector<unsigned char>& bytes, ScalarType type, const std::string& path,
@@ -473,18 +493,43 @@ toFloats(const NumericArray& array)
     return values;
 }
 
+
 // ------------------------------------------------------------------------------------------
-// Legacy VTK
+// Type names
 
 namespace {
+
+struct TypeName
+{
+    const char* name;
+    ScalarType type;
+};
+
+template<size_t SizeT>
+bool
+findTypeName(const TypeName (&table)[SizeT], std::string_view name, bool ignoreCase,
+             ScalarType& type)
+{
+    for (const TypeName& entry : table) {
+        if (ignoreCase ? iequals(name, entry.name) : name == entry.name) {
+            type = entry.type;
+            return true;
+        }
+    }
+    return false;
+}
+
+} // namespace
+
+// ------------------------------------------------------------------------------------------
+// Legacy VTK
 
 bool
 vtkScalarType(std::string_view name, ScalarType& type)
 {
-    struct Entry { const char* name; ScalarType type; };
     // "long" is 8 bytes as VTK writes it on Linux/macOS; VTK's legacy writer stores
     // vtkIdType arrays as 32-bit int for backward compatibility.
-    static const Entry kTable[] = {
+    static const TypeName kTable[] = {
         {"char", ScalarType::Int8}, {"signed_char", ScalarType::Int8},
         {"vtktypeint8", ScalarType::Int8},
         {"unsigned_char", ScalarType::UInt8}, {"vtktypeuint8", ScalarType::UInt8},
@@ -500,23 +545,7 @@ vtkScalarType(std::string_view name, ScalarType& type)
         {"float", ScalarType::Float32}, {"vtktypefloat32", ScalarType::Float32},
         {"double", ScalarType::Float64}, {"vtktypefloat64", ScalarType::Float64},
     };
-    for (const Entry& entry : kTable) {
-        if (iequals(name, entry.name)) {
-            type = entry.type;
-            return true;
-        }
-    }
-    return false;
-}
-
-std::string
-upper(std::string_view text)
-{
-    std::string result(text);
-    for (char& ch : result) {
-        if (ch >= 'a' && ch <= 'z') ch = char(ch - 'a' + 'A');
-    }
-    return result;
+    return findTypeName(kTable, name, /*ignoreCase=*/true, type);
 }
 
 /// VTK 5 writes names with spaces and other special characters as %XX.
@@ -539,22 +568,24 @@ decodeVtkName(std::string_view name)
     return result;
 }
 
+namespace {
+
+
 class VtkParser
 {
 public:
-    VtkParser(const char* data, size_t size, const std::string& path, bool wantPolygons)
-        : mCursor(data, size), mPath(path), mWantPolygons(wantPolygons) {}
+    VtkParser(ByteInput& input, const std::string& path, bool wantPolygons)
+        : mInput(input), mPath(path), mWantPolygons(wantPolygons) {}
 
     VtkData parse()
     {
         readHeader();
         bool havePoints = false;
         for (;;) {
-            mCursor.skipSpace();
-            if (mCursor.atEnd()) break;
-            const std::string_view headerLine = mCursor.line();
-            mLine = headerLine;
-            const std::vector<std::string_view> words = splitWords(headerLine);
+            mInput.skipSpace();
+            if (mInput.atEnd()) break;
+            mLine = mInput.line();
+            const std::vector<std::string_view> words = splitWords(mLine);
             const std::string key = upper(words.at(0));  // skipSpace() made words non-empty
 
             if (key == "POINTS") {
@@ -585,14 +616,7 @@ public:
                 const ScalarType type = dataType(words[2]);
                 // The LOOKUP_TABLE line is optional from VTK 5; binary data never starts
                 // with that word, so peeking is safe.
-                const size_t saved = mCursor.pos();
-                if (!mReader->binary()) mCursor.skipSpace();
-                if (mCursor.remaining() >= 12 &&
-                    iequals(std::string_view(mCursor.here(), 12), "LOOKUP_TABLE")) {
-                    mCursor.line();
-                } else {
-                    mCursor.setPos(saved);
-                }
+                mInput.skipLineStartingWith("LOOKUP_TABLE", !mReader->binary());
                 readAttribute(key, words[1], type, int(components));
             } else if (key == "VECTORS" || key == "NORMALS") {
                 requireAttributeSection(key);
@@ -649,24 +673,25 @@ public:
 private:
     void readHeader()
     {
-        const std::string_view first = mCursor.line();
-        if (first.substr(0, 14) != "# vtk DataFile") {
+        const std::string first = mInput.line();
+        if (first.compare(0, 14, "# vtk DataFile") != 0) {
             fail(mPath, "not a legacy VTK file: the first line must start with '# vtk DataFile'");
         }
-        mCursor.line();  // title, free text
-        if (mCursor.atEnd()) fail(mPath, "truncated VTK header");
-        const std::string_view format = trim(mCursor.line());
+        mInput.line();  // title, free text
+        if (mInput.atEnd()) fail(mPath, "truncated VTK header");
+        const std::string formatLine = mInput.line();
+        const std::string_view format = trim(formatLine);
         bool binary = false;
         if (iequals(format, "BINARY")) {
             binary = true;
         } else if (!iequals(format, "ASCII")) {
             fail(mPath, "bad VTK file type '" + printable(format) + "'; expected ASCII or BINARY");
         }
-        mReader.reset(new ValueReader(mCursor, binary, /*bigEndian=*/true, mPath));
+        mReader.reset(new ValueReader(mInput, binary, /*bigEndian=*/true, mPath));
 
-        mCursor.skipSpace();
-        if (mCursor.atEnd()) fail(mPath, "truncated VTK header");
-        mLine = mCursor.line();
+        mInput.skipSpace();
+        if (mInput.atEnd()) fail(mPath, "truncated VTK header");
+        mLine = mInput.line();
         const std::vector<std::string_view> words = splitWords(mLine);
         if (words.size() != 2 || !iequals(words[0], "DATASET")) {
             fail(mPath, "expected 'DATASET <type>' in VTK file, got '" + printable(mLine) + "'");
@@ -721,19 +746,10 @@ private:
         }
         if (n > std::numeric_limits<uint64_t>::max() / 3) fail(mPath, "truncated POINTS section");
         mReader->requireRoom(3 * n, type, "POINTS section");
+        static_assert(sizeof(openvdb::Vec3f) == 12, "Vec3f must be three packed floats");
         mData.points.resize(size_t(n));
-        if (type == ScalarType::Float32) {
-            mReader->readInto(size_t(3 * n), type, "POINTS section",
-                reinterpret_cast<unsigned char*>(mData.points.data()));
-        } else {
-            std::vector<double> values(size_t(3 * n));
-            mReader->readInto(values.size(), type, "POINTS section",
-                reinterpret_cast<unsigned char*>(values.data()));
-            for (size_t i = 0; i < size_t(n); ++i) {
-                mData.points[i] = openvdb::Vec3f(
-                    float(values[3 * i]), float(values[3 * i + 1]), float(values[3 * i + 2]));
-            }
-        }
+        mReader->readFloats(size_t(3 * n), type, "POINTS section",
+            reinterpret_cast<float*>(mData.points.data()));
     }
 
     /// Cell sections: VTK ≤ 4.2 stores "n size" then size ints (count, indices...);
@@ -746,10 +762,9 @@ private:
         const bool keep = mWantPolygons && key == "POLYGONS";
         const std::string section = key + " section";
 
-        const size_t saved = mCursor.pos();
-        if (mCursor.peekWord("OFFSETS")) {
-            mCursor.skipSpace();
-            mLine = mCursor.line();
+        if (mInput.peekWord("OFFSETS")) {
+            mInput.skipSpace();
+            mLine = mInput.line();
             const std::vector<std::string_view> offsetWords = splitWords(mLine);
             requireWords(offsetWords, 2);
             const ScalarType offsetType = dataType(offsetWords[1]);
@@ -757,8 +772,8 @@ private:
             if (keep) mReader->read(n, offsetType, section, offsetBytes);
             else mReader->skip(n, offsetType, section);
 
-            mCursor.skipSpace();
-            mLine = mCursor.line();
+            mInput.skipSpace();
+            mLine = mInput.line();
             const std::vector<std::string_view> connWords = splitWords(mLine);
             if (connWords.size() != 2 || !iequals(connWords[0], "CONNECTIVITY")) badHeader();
             const ScalarType connType = dataType(connWords[1]);
@@ -784,8 +799,6 @@ private:
             }
             return;
         }
-        mCursor.setPos(saved);
-
         if (!keep) {
             mReader->skip(size, ScalarType::Int32, section);
             return;
@@ -831,14 +844,14 @@ private:
     void readField(uint64_t arrayCount)
     {
         for (uint64_t i = 0; i < arrayCount; ++i) {
-            mCursor.skipSpace();
-            if (mCursor.atEnd()) fail(mPath, "truncated FIELD section");
-            if (mCursor.peekWord("METADATA")) {
-                mCursor.line();
+            mInput.skipSpace();
+            if (mInput.atEnd()) fail(mPath, "truncated FIELD section");
+            if (mInput.peekWord("METADATA")) {
+                mInput.line();
                 skipMetadata();
-                mCursor.skipSpace();
+                mInput.skipSpace();
             }
-            mLine = mCursor.line();
+            mLine = mInput.line();
             const std::vector<std::string_view> words = splitWords(mLine);
             if (words.size() == 1 && iequals(words[0], "NULL_ARRAY")) continue;
             requireWords(words, 4);
@@ -872,16 +885,16 @@ private:
     /// A METADATA block (VTK 5) is text lines up to the first blank line.
     void skipMetadata()
     {
-        while (!mCursor.atEnd()) {
-            if (trim(mCursor.line()).empty()) break;
+        while (!mInput.atEnd()) {
+            if (trim(mInput.line()).empty()) break;
         }
     }
 
-    Cursor mCursor;
+    ByteInput& mInput;
     const std::string& mPath;
     bool mWantPolygons;
     std::unique_ptr<ValueReader> mReader;
-    std::string_view mLine;       ///< the header line being interpreted, for messages
+    std::string mLine;            ///< the header line being interpreted, for messages
     bool mInPointData = false;
     bool mInCellData = false;
     uint64_t mTupleCount = 0;
@@ -891,21 +904,25 @@ private:
 } // namespace
 
 VtkData
+parseVtk(ByteInput& input, const std::string& path, bool wantPolygons)
+{
+    return VtkParser(input, path, wantPolygons).parse();
+}
+
+VtkData
 parseVtk(const char* data, size_t size, const std::string& path, bool wantPolygons)
 {
-    return VtkParser(data, size, path, wantPolygons).parse();
+    Cursor cursor(data, size);
+    return parseVtk(cursor, path, wantPolygons);
 }
 
 // ------------------------------------------------------------------------------------------
 // PLY
 
-namespace {
-
 bool
 plyScalarType(std::string_view name, ScalarType& type)
 {
-    struct Entry { const char* name; ScalarType type; };
-    static const Entry kTable[] = {
+    static const TypeName kTable[] = {
         {"char", ScalarType::Int8}, {"int8", ScalarType::Int8},
         {"uchar", ScalarType::UInt8}, {"uint8", ScalarType::UInt8},
         {"short", ScalarType::Int16}, {"int16", ScalarType::Int16},
@@ -916,35 +933,137 @@ plyScalarType(std::string_view name, ScalarType& type)
         {"float", ScalarType::Float32}, {"float32", ScalarType::Float32},
         {"double", ScalarType::Float64}, {"float64", ScalarType::Float64},
     };
-    for (const Entry& entry : kTable) {
-        if (name == entry.name) {
-            type = entry.type;
-            return true;
-        }
-    }
-    return false;
+    return findTypeName(kTable, name, /*ignoreCase=*/false, type);
 }
 
-struct PlyProperty
+void
+PlyReaderBase::readHeader()
 {
-    std::string name;
-    ScalarType type = ScalarType::Float32;   ///< value type (of the items, for lists)
-    bool isList = false;
-    ScalarType countType = ScalarType::UInt8;
-};
+    if (trim(mInput.line()) != "ply") fail(mPath, "not a PLY file: the first line must be 'ply'");
+    bool haveFormat = false;
+    for (;;) {
+        if (mInput.atEnd()) fail(mPath, "truncated PLY header: no end_header line");
+        const std::string line = mInput.line();
+        const std::vector<std::string_view> words = splitWords(line);
+        if (words.empty()) continue;
+        const std::string_view key = words[0];
+        if (key == "end_header") break;
+        if (key == "comment" || key == "obj_info") continue;
+        if (key == "format") {
+            if (words.size() != 3) badHeader(line);
+            bool binary = true, bigEndian = false;
+            if (words[1] == "ascii") binary = false;
+            else if (words[1] == "binary_big_endian") bigEndian = true;
+            else if (words[1] != "binary_little_endian") {
+                fail(mPath, "unsupported PLY format '" + printable(words[1]) +
+                    "'; expected ascii, binary_little_endian or binary_big_endian");
+            }
+            mReader.reset(new ValueReader(mInput, binary, bigEndian, mPath));
+            haveFormat = true;
+        } else if (key == "element") {
+            if (words.size() != 3) badHeader(line);
+            PlyElement element;
+            element.name = std::string(words[1]);
+            if (!parseCount(words[2], element.count)) badHeader(line);
+            mElements.push_back(std::move(element));
+        } else if (key == "property") {
+            if (mElements.empty()) badHeader(line);
+            PlyProperty property;
+            if (words.size() == 5 && words[1] == "list") {
+                property.isList = true;
+                if (!plyScalarType(words[2], property.countType) ||
+                    !plyScalarType(words[3], property.type) ||
+                    !isIntegerType(property.countType)) badHeader(line);
+                property.name = std::string(words[4]);
+            } else if (words.size() == 3) {
+                if (!plyScalarType(words[1], property.type)) badHeader(line);
+                property.name = std::string(words[2]);
+            } else {
+                badHeader(line);
+            }
+            mElements.back().properties.push_back(std::move(property));
+        } else {
+            badHeader(line);
+        }
+    }
+    if (!haveFormat) fail(mPath, "PLY header has no format line");
+}
 
-struct PlyElement
+void
+PlyReaderBase::badHeader(std::string_view line) const
 {
-    std::string name;
-    uint64_t count = 0;
-    std::vector<PlyProperty> properties;
-};
+    fail(mPath, "bad PLY header line '" + printable(line) + "'");
+}
 
-class PlyParser
+void
+PlyReaderBase::requireRoom(const PlyElement& element, const std::string& section) const
+{
+    // Binary records need at least their scalars and list lengths; a text value at
+    // least one character and a separator (the last one may lack it).
+    uint64_t minRecord = 0;
+    for (const PlyProperty& property : element.properties) {
+        minRecord += mReader->binary()
+            ? scalarSize(property.isList ? property.countType : property.type) : 2;
+    }
+    const uint64_t room = mInput.remaining() + (mReader->binary() ? 0 : 1);
+    if (minRecord > 0 && element.count > room / minRecord) {
+        fail(mPath, "truncated " + section);
+    }
+}
+
+void
+PlyReaderBase::requireAxes(const PlyElement& element) const
+{
+    for (const char* axis : {"x", "y", "z"}) {
+        const auto found = std::find_if(element.properties.begin(), element.properties.end(),
+            [axis](const PlyProperty& p) { return !p.isList && p.name == axis; });
+        if (found == element.properties.end()) {
+            fail(mPath, std::string("PLY vertex element has no '") + axis + "' property");
+        }
+    }
+}
+
+void
+PlyReaderBase::skipList(const PlyProperty& property, const std::string& section)
+{
+    const int64_t n = mReader->readInteger(property.countType, section);
+    if (n < 0) fail(mPath, "negative list length in " + section);
+    mReader->skip(uint64_t(n), property.type, section);
+}
+
+void
+PlyReaderBase::skipElement(const PlyElement& element)
+{
+    const std::string section = "PLY " + printable(element.name) + " element";
+    if (element.properties.empty()) return;  // nothing stored, whatever the count
+    requireRoom(element, section);
+    bool fixedSize = mReader->binary();
+    uint64_t recordSize = 0;
+    for (const PlyProperty& property : element.properties) {
+        fixedSize = fixedSize && !property.isList;
+        recordSize += scalarSize(property.type);
+    }
+    if (fixedSize) {
+        // requireRoom() checked count × recordSize against the bytes left.
+        mReader->skip(element.count * recordSize, ScalarType::UInt8, section);
+        return;
+    }
+    for (uint64_t i = 0; i < element.count; ++i) {
+        for (const PlyProperty& property : element.properties) {
+            if (property.isList) skipList(property, section);
+            else mReader->skip(1, property.type, section);
+        }
+    }
+}
+
+namespace {
+
+/// The vertex and face elements of a PLY file in memory, as plain arrays.
+class PlyParser : public PlyReaderBase
 {
 public:
-    PlyParser(const char* data, size_t size, const std::string& path, bool wantFaces)
-        : mCursor(data, size), mPath(path), mWantFaces(wantFaces) {}
+    PlyParser(ByteInput& input, const std::string& path, bool wantFaces)
+        : PlyReaderBase(input, path), mWantFaces(wantFaces) {}
 
     PlyData parse()
     {
@@ -967,96 +1086,10 @@ public:
     }
 
 private:
-    void readHeader()
-    {
-        if (trim(mCursor.line()) != "ply") fail(mPath, "not a PLY file: the first line must be 'ply'");
-        bool haveFormat = false;
-        for (;;) {
-            if (mCursor.atEnd()) fail(mPath, "truncated PLY header: no end_header line");
-            const std::string_view line = mCursor.line();
-            const std::vector<std::string_view> words = splitWords(line);
-            if (words.empty()) continue;
-            const std::string_view key = words[0];
-            if (key == "end_header") break;
-            if (key == "comment" || key == "obj_info") continue;
-            if (key == "format") {
-                if (words.size() != 3) badHeader(line);
-                bool binary = true, bigEndian = false;
-                if (words[1] == "ascii") binary = false;
-                else if (words[1] == "binary_big_endian") bigEndian = true;
-                else if (words[1] != "binary_little_endian") {
-                    fail(mPath, "unsupported PLY format '" + printable(words[1]) +
-                        "'; expected ascii, binary_little_endian or binary_big_endian");
-                }
-                mReader.reset(new ValueReader(mCursor, binary, bigEndian, mPath));
-                haveFormat = true;
-            } else if (key == "element") {
-                if (words.size() != 3) badHeader(line);
-                PlyElement element;
-                element.name = std::string(words[1]);
-                if (!parseCount(words[2], element.count)) badHeader(line);
-                mElements.push_back(std::move(element));
-            } else if (key == "property") {
-                if (mElements.empty()) badHeader(line);
-                PlyProperty property;
-                if (words.size() == 5 && words[1] == "list") {
-                    property.isList = true;
-                    if (!plyScalarType(words[2], property.countType) ||
-                        !plyScalarType(words[3], property.type) ||
-                        !isIntegerType(property.countType)) badHeader(line);
-                    property.name = std::string(words[4]);
-                } else if (words.size() == 3) {
-                    if (!plyScalarType(words[1], property.type)) badHeader(line);
-                    property.name = std::string(words[2]);
-                } else {
-                    badHeader(line);
-                }
-                mElements.back().properties.push_back(std::move(property));
-            } else {
-                badHeader(line);
-            }
-        }
-        if (!haveFormat) fail(mPath, "PLY header has no format line");
-    }
-
-    [[noreturn]] void badHeader(std::string_view line) const
-    {
-        fail(mPath, "bad PLY header line '" + printable(line) + "'");
-    }
-
-    /// Fail unless @a element's records can fit in the bytes left (before allocating).
-    void requireRoom(const PlyElement& element, const std::string& section) const
-    {
-        // Binary records need at least their scalars and list lengths; a text value at
-        // least one character and a separator (the last one may lack it).
-        uint64_t minRecord = 0;
-        for (const PlyProperty& property : element.properties) {
-            minRecord += mReader->binary()
-                ? scalarSize(property.isList ? property.countType : property.type) : 2;
-        }
-        const uint64_t room = uint64_t(mCursor.remaining()) + (mReader->binary() ? 0 : 1);
-        if (minRecord > 0 && element.count > room / minRecord) {
-            fail(mPath, "truncated " + section);
-        }
-    }
-
-    void skipList(const PlyProperty& property, const std::string& section)
-    {
-        const int64_t n = mReader->readInteger(property.countType, section);
-        if (n < 0) fail(mPath, "negative list length in " + section);
-        mReader->skip(uint64_t(n), property.type, section);
-    }
-
     void readVertices(const PlyElement& element)
     {
         const std::string section = "PLY vertex element";
-        for (const char* axis : {"x", "y", "z"}) {
-            const auto found = std::find_if(element.properties.begin(), element.properties.end(),
-                [axis](const PlyProperty& p) { return !p.isList && p.name == axis; });
-            if (found == element.properties.end()) {
-                fail(mPath, std::string("PLY vertex element has no '") + axis + "' property");
-            }
-        }
+        requireAxes(element);
         requireRoom(element, section);
         mData.vertexCount = size_t(element.count);
         std::vector<NumericArray*> columns(element.properties.size(), nullptr);
@@ -1133,35 +1166,7 @@ private:
         }
     }
 
-    void skipElement(const PlyElement& element)
-    {
-        const std::string section = "PLY " + printable(element.name) + " element";
-        if (element.properties.empty()) return;  // nothing stored, whatever the count
-        requireRoom(element, section);
-        bool fixedSize = mReader->binary();
-        uint64_t recordSize = 0;
-        for (const PlyProperty& property : element.properties) {
-            fixedSize = fixedSize && !property.isList;
-            recordSize += scalarSize(property.type);
-        }
-        if (fixedSize) {
-            // requireRoom() checked count × recordSize against the bytes left.
-            mReader->skip(element.count * recordSize, ScalarType::UInt8, section);
-            return;
-        }
-        for (uint64_t i = 0; i < element.count; ++i) {
-            for (const PlyProperty& property : element.properties) {
-                if (property.isList) skipList(property, section);
-                else mReader->skip(1, property.type, section);
-            }
-        }
-    }
-
-    Cursor mCursor;
-    const std::string& mPath;
     bool mWantFaces;
-    std::unique_ptr<ValueReader> mReader;
-    std::vector<PlyElement> mElements;
     PlyData mData;
 };
 
@@ -1170,7 +1175,8 @@ private:
 PlyData
 parsePly(const char* data, size_t size, const std::string& path, bool wantFaces)
 {
-    return PlyParser(data, size, path, wantFaces).parse();
+    Cursor cursor(data, size);
+    return PlyParser(cursor, path, wantFaces).parse();
 }
 
 } // namespace io_internal

@@ -4,23 +4,43 @@
 ///        bounds-checked text cursor, and legacy VTK and PLY decoders that return plain
 ///        arrays. Nothing here is public API.
 ///
-/// Every parser works on a buffer holding the whole file, checks every count against the
-/// bytes left before allocating, and reports problems as one-line FileErrors ending in
-/// "(<path>)", so no byte sequence can make it crash, hang or allocate without bound.
+/// Every parser reads a ByteInput (a buffer holding the whole file, or the file stream of
+/// ReadParticles.cc), checks every count against the bytes left before allocating, and
+/// reports problems as one-line FileErrors ending in "(<path>)", so no byte sequence can
+/// make it crash, hang or allocate without bound. The text and type helpers here are the
+/// only copies; the streaming readers use them too.
 
 #ifndef NONBLOPPY_FILE_FORMATS_H
 #define NONBLOPPY_FILE_FORMATS_H
 
 #include <nonbloppy/Particles.h>
 
+#include <charconv>
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <string_view>
 #include <vector>
 
 namespace nonbloppy {
 namespace io_internal {
+
+/// A file opened for reading, with what fstat() said of it.
+struct OpenFile
+{
+    int fd = -1;
+    bool regular = false;   ///< a regular file, whose size means something
+    uint64_t size = 0;      ///< st_size
+};
+
+/// Open @a path for reading (the caller closes OpenFile::fd).
+/// @throw FileError "cannot open <path>: <reason>", or "cannot read <path>: <reason>" if
+///        fstat fails or @a path is a directory.
+OpenFile openFile(const std::string& path);
+
+/// Throw FileError("cannot read <path>: <strerror(errorNumber)>").
+[[noreturn]] void failRead(const std::string& path, int errorNumber);
 
 /// The whole contents of @a path.
 /// @throw FileError "cannot open <path>: <reason>" or "cannot read <path>: <reason>".
@@ -35,6 +55,154 @@ std::string lowerExtension(const std::string& path);
 /// @a text made safe for a one-line message: at most 40 characters, non-printable bytes
 /// replaced by '?'.
 std::string printable(std::string_view text);
+
+// ------------------------------------------------------------------------------------------
+// Text and value helpers shared by the in-memory parsers here and the streaming readers in
+// ReadParticles.cc (so that both accept the same text and say the same words).
+
+constexpr bool kHostIsBigEndian = (__BYTE_ORDER__ == __ORDER_BIG_ENDIAN__);
+
+/// Bytes a streaming reader reads from its file at a time; also the bound on temporary
+/// conversion buffers (ValueReader::readFloats()).
+constexpr size_t kChunkBytes = size_t(1) << 20;
+
+/// The six ASCII white-space characters of isspace() in the C locale (inline: tokenizers
+/// call it for every byte).
+inline bool isSpace(char ch)
+{
+    return ch == ' ' || ch == '\t' || ch == '\n' || ch == '\r' || ch == '\v' || ch == '\f';
+}
+
+/// ASCII lower case; other bytes unchanged.
+inline char toLower(char ch)
+{
+    return (ch >= 'A' && ch <= 'Z') ? char(ch - 'A' + 'a') : ch;
+}
+
+/// ASCII case-insensitive equality.
+bool iequals(std::string_view a, std::string_view b);
+
+/// @a text without leading and trailing white space.
+std::string_view trim(std::string_view text);
+
+/// The white-space separated words of @a text.
+std::vector<std::string_view> splitWords(std::string_view text);
+
+/// A whole decimal number of a type std::from_chars reads (integer or floating point), with
+/// an optional leading '+'; false if anything else is in @a text.
+template<typename NumberT>
+bool parseWhole(std::string_view text, NumberT& value)
+{
+    if (!text.empty() && text.front() == '+') text.remove_prefix(1);
+    const char* end = text.data() + text.size();
+    const auto result = std::from_chars(text.data(), end, value);
+    return !text.empty() && result.ec == std::errc() && result.ptr == end;
+}
+
+/// A whole decimal unsigned count (no sign, nothing after it).
+bool parseCount(std::string_view text, uint64_t& value);
+
+/// One text value of @a type (optional '+'; out-of-range floats become 0 or inf) into native
+/// bytes at @a out; false if @a text is not a whole value of that type.
+bool parseTextValue(std::string_view text, ScalarType type, unsigned char* out);
+
+/// Reverse the bytes of each of @a count values of @a width (1, 2, 4 or 8) bytes at @a data.
+void swapInPlace(unsigned char* data, size_t count, size_t width);
+
+/// True for the eight integer ScalarTypes.
+bool isIntegerType(ScalarType type);
+
+/// Integer value of @a p (native bytes of integer @a type); false if it does not fit int64.
+bool integerValue(const unsigned char* p, ScalarType type, int64_t& value);
+
+/// The native value of @a type at @a p as double.
+double valueAsDouble(const unsigned char* p, ScalarType type);
+
+/// @a text with ASCII lower-case letters made upper case.
+std::string upper(std::string_view text);
+
+/// Map a PLY property type name ("uchar", "float32", ...) to a ScalarType.
+bool plyScalarType(std::string_view name, ScalarType& type);
+
+/// Map a legacy VTK data type name (case-insensitive: "float", "vtktypeint64", ...) to a
+/// ScalarType.
+bool vtkScalarType(std::string_view name, ScalarType& type);
+
+/// A VTK 5 array name with its %XX escapes decoded.
+std::string decodeVtkName(std::string_view name);
+
+// ------------------------------------------------------------------------------------------
+// Inputs and typed values
+
+/// Where the parsers read from: a memory buffer (here) or a file stream (ReadParticles.cc).
+/// Every access stops at the end of the input.
+class ByteInput
+{
+public:
+    virtual ~ByteInput() = default;
+
+    /// Bytes left from the read position to the end of the input.
+    virtual uint64_t remaining() const = 0;
+    virtual bool atEnd() = 0;
+    virtual void skipSpace() = 0;
+    /// The next run of non-space characters (empty at the end); valid until the next call.
+    virtual std::string_view token() = 0;
+    /// The rest of the current line without its line break ("\n" or "\r\n"); moves past it.
+    virtual std::string line() = 0;
+    /// True if the next non-space text is the word @a word (case-insensitive). Moves nothing.
+    virtual bool peekWord(std::string_view word) = 0;
+    /// If the next bytes (after white space when @a skipSpaceFirst) are @a word
+    /// (case-insensitive), move past the rest of that line and return true. Otherwise
+    /// return false having moved nothing, except that an input that cannot move back (the
+    /// file stream) has then moved past the white space.
+    virtual bool skipLineStartingWith(std::string_view word, bool skipSpaceFirst) = 0;
+    /// Copy the next @a n bytes to @a dst; false if the input ends first.
+    virtual bool readBytes(unsigned char* dst, size_t n) = 0;
+    /// Move @a n bytes ahead (at most to the end).
+    virtual void skipBytes(uint64_t n) = 0;
+};
+
+/// Reads typed value arrays from a ByteInput, text or binary, never past its end; every
+/// problem is a FileError "<what> in <section> (<path>)" or "truncated <section> (<path>)".
+class ValueReader
+{
+public:
+    ValueReader(ByteInput& input, bool binary, bool bigEndian, const std::string& path)
+        : mInput(input), mBinary(binary), mSwap(binary && bigEndian != kHostIsBigEndian)
+        , mPath(path) {}
+
+    bool binary() const { return mBinary; }
+    /// True if binary values are byte-swapped to native order.
+    bool swaps() const { return mSwap; }
+
+    /// Fail with "truncated <section> (path)" unless @a count values of @a type can still
+    /// be in the input: checked before allocating, so a corrupt count cannot exhaust memory.
+    void requireRoom(uint64_t count, ScalarType type, const std::string& section) const;
+
+    /// @a count values of @a type, in native byte order, appended to @a out (allocated
+    /// only once the input can hold them).
+    void read(uint64_t count, ScalarType type, const std::string& section,
+              std::vector<unsigned char>& out);
+
+    /// @a count values into @a dst (room for count × scalarSize(type) bytes).
+    void readInto(size_t count, ScalarType type, const std::string& section, unsigned char* dst);
+
+    /// @a count Float32 or Float64 values as floats into @a dst; doubles go through a
+    /// bounded buffer.
+    void readFloats(size_t count, ScalarType type, const std::string& section, float* dst);
+
+    /// Move past @a count values of @a type without keeping them.
+    void skip(uint64_t count, ScalarType type, const std::string& section);
+
+    /// One value of integer @a type (e.g. a PLY list length).
+    int64_t readInteger(ScalarType type, const std::string& section);
+
+private:
+    ByteInput& mInput;
+    bool mBinary;
+    bool mSwap;
+    const std::string& mPath;
+};
 
 /// One array of values from a file, converted to native byte order but kept in its type.
 struct NumericArray
@@ -68,12 +236,54 @@ struct VtkData
 /// @a wantPolygons, in which case POLYGONS are kept.
 VtkData parseVtk(const char* data, size_t size, const std::string& path, bool wantPolygons);
 
+/// parseVtk() reading from @a input (readParticles() passes a file stream).
+VtkData parseVtk(ByteInput& input, const std::string& path, bool wantPolygons);
+
 /// What parsePly() found in a PLY file.
 struct PlyData
 {
     size_t vertexCount = 0;
     std::vector<NumericArray> vertexProperties;  ///< scalar vertex properties, 1 component each
     PolygonList faces;                           ///< face vertex_indices, only if asked for
+};
+
+struct PlyProperty
+{
+    std::string name;
+    ScalarType type = ScalarType::Float32;   ///< value type (of the items, for lists)
+    bool isList = false;
+    ScalarType countType = ScalarType::UInt8;
+};
+
+struct PlyElement
+{
+    std::string name;
+    uint64_t count = 0;
+    std::vector<PlyProperty> properties;
+};
+
+/// The parts of PLY decoding that do not depend on where vertices go: the header, room
+/// checks before allocating, and skipping lists and elements. parsePly() and the streaming
+/// particle reader derive from it.
+class PlyReaderBase
+{
+protected:
+    PlyReaderBase(ByteInput& input, const std::string& path) : mInput(input), mPath(path) {}
+
+    /// Read the header up to end_header into mElements and make mReader.
+    void readHeader();
+    [[noreturn]] void badHeader(std::string_view line) const;
+    /// Fail unless @a element's records can fit in the bytes left (before allocating).
+    void requireRoom(const PlyElement& element, const std::string& section) const;
+    /// Fail unless the vertex @a element has scalar x, y and z properties.
+    void requireAxes(const PlyElement& element) const;
+    void skipList(const PlyProperty& property, const std::string& section);
+    void skipElement(const PlyElement& element);
+
+    ByteInput& mInput;
+    const std::string& mPath;
+    std::unique_ptr<ValueReader> mReader;
+    std::vector<PlyElement> mElements;
 };
 
 /// Decode a PLY file (ascii, binary_little_endian or binary_big_endian).

@@ -132,15 +132,6 @@ struct ObjCorner
     int64_t normal = -1;
 };
 
-bool
-parseFloat(std::string_view text, float& value)
-{
-    if (!text.empty() && text.front() == '+') text.remove_prefix(1);
-    const char* end = text.data() + text.size();
-    const auto result = std::from_chars(text.data(), end, value);
-    return !text.empty() && result.ec == std::errc() && result.ptr == end;
-}
-
 std::vector<std::string_view>
 splitLine(std::string_view line)
 {
@@ -229,7 +220,7 @@ private:
         if (words.size() < 4) failAtLine("expected three coordinates");
         openvdb::Vec3s v;
         for (int i = 0; i < 3; ++i) {
-            if (!parseFloat(words[size_t(i) + 1], v[i])) {
+            if (!parseWhole(words[size_t(i) + 1], v[i])) {
                 failAtLine("bad number '" + printable(words[size_t(i) + 1]) + "'");
             }
         }
