@@ -21,6 +21,7 @@
 
 #include "FileFormats.h"
 #include "ParticleReaders.h"
+#include "StreamReader.h"
 
 #include <algorithm>
 #include <cerrno>
@@ -509,13 +510,17 @@ readParticles(const std::string& path)
         particles = PlyReader(stream, path).read();
     } else if (ext == ".xyz") {
         particles = readXyzParticles(path);
+    } else if (ext == ".bgeo") {
+        particles = readBgeoFile(path);
+    } else if (ext == ".csv" || ext == ".txt") {
+        particles = readTableFile(path);
+    } else if (ext == ".json") {
+        particles = readJsonFile(path);
     } else {
-        // These readers work on the whole file in memory.
+        // VTU is XML (pugixml parses the whole document) and .vdb goes through OpenVDB's own
+        // stream reader: both work on the whole file in memory.
         const std::vector<char> file = loadFile(path);
-        if (ext == ".bgeo") particles = readBgeoParticles(file.data(), file.size(), path);
-        else if (ext == ".vtu" || ext == ".vtp") particles = readVtuParticles(file.data(), file.size(), path);
-        else if (ext == ".csv" || ext == ".txt") particles = readTableParticles(file.data(), file.size(), path);
-        else if (ext == ".json") particles = readJsonParticles(file.data(), file.size(), path);
+        if (ext == ".vtu" || ext == ".vtp") particles = readVtuParticles(file.data(), file.size(), path);
         else particles = readVdbPointsParticles(file.data(), file.size(), path);
     }
 

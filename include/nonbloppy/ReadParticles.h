@@ -30,11 +30,13 @@
 ///           an integer, else float64.
 /// - `.json` `[[x, y, z], ...]` (positions only).
 /// A file with zero particles is read without complaint (the pipeline rejects it later).
-/// Cost: one pass over the file. `.vtk`, `.ply` and `.xyz` are streamed: headers and text
-/// go through a 1 MiB buffer, and binary arrays are read from the file straight into the
-/// final position and attribute arrays (then byte-swapped in place if needed), so memory is
-/// the particle set plus that buffer (12 bytes per particle for x y z; about 0.35 s for
-/// 12.5M binary PLY particles). The other formats hold the whole file in memory as well.
+/// Cost: one pass over the file. `.vtk`, `.ply`, `.xyz`, `.bgeo` (gzip inflated in chunks),
+/// `.csv`/`.txt` and `.json` are streamed: headers and text go through a 1 MiB buffer, and
+/// binary arrays are read from the file straight into the final position and attribute
+/// arrays (then byte-swapped in place if needed), so memory is the particle set plus that
+/// buffer (12 bytes per particle for x y z; about 0.35 s for 12.5M binary PLY particles).
+/// `.vtu`/`.vtp` (an XML document) and `.vdb` (read by OpenVDB) hold the whole file in
+/// memory while they are read.
 /// Text is parsed with std::from_chars; no per-particle heap objects. Every count in a
 /// header is checked against the bytes left in the file (its size) before allocating.
 /// Pipes, whose size is unknown, are read whole first.
