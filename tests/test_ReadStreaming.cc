@@ -90,7 +90,7 @@ record(size_t i)
 {
     const uint32_t h = uint32_t(i) * 2654435761u;
     return {float(i) * 0.001f - 7.5f, float(h % 100000u) * 0.01f, -float(i % 977) * 0.125f,
-            uint8_t(h >> 24), int32_t(h) - int32_t(i), double(i) * 1e-3 - 1e6};
+            uint8_t(h >> 24), int32_t(h - uint32_t(i)), double(i) * 1e-3 - 1e6};
 }
 
 /// Write @a bytes through a FIFO at @a path while @a read runs (pipes have no size).
