@@ -53,13 +53,18 @@ loadFile(const std::string& path)
 {
     const OpenFile file = openFile(path);
     struct FdCloser { int fd; ~FdCloser() { ::close(fd); } } closer{file.fd};
+    // st_size is only a hint (pipes and /proc files report 0).
+    return readToEnd(file.fd, path, file.regular ? size_t(file.size) : 0);
+}
 
-    // st_size is only a hint (pipes and /proc files report 0); read until end of file.
-    std::vector<char> data(file.regular ? size_t(file.size) + 1 : 65536);
+std::vector<char>
+readToEnd(int fd, const std::string& path, size_t sizeHint)
+{
+    std::vector<char> data(sizeHint > 0 ? sizeHint + 1 : 65536);
     size_t used = 0;
     for (;;) {
         if (used == data.size()) data.resize(data.size() * 2);
-        const ssize_t n = ::read(file.fd, data.data() + used, data.size() - used);
+        const ssize_t n = ::read(fd, data.data() + used, data.size() - used);
         if (n < 0) {
             if (errno == EINTR) continue;
             failRead(path, errno);

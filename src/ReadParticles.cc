@@ -68,9 +68,15 @@ public:
             mSize = file.size;
             mBuffer.resize(size_t(std::min<uint64_t>(kChunkBytes, std::max<uint64_t>(mSize, 64))));
         } else {
-            // st_size means nothing for pipes and /proc files: hold the whole contents.
+            // st_size means nothing for pipes and /proc files: hold the whole contents, read
+            // from this descriptor (opening a pipe again would break its writer's pipe).
+            try {
+                mBuffer = readToEnd(mFd, path, 0);
+            } catch (...) {
+                closeFile();
+                throw;
+            }
             closeFile();
-            mBuffer = loadFile(path);
             mTail = mBuffer.size();
             mSize = mTail;
             mEof = true;

@@ -77,8 +77,15 @@ public:
         if (S_ISREG(info.st_mode)) {
             mRawSize = uint64_t(info.st_size);
         } else {
+            // A pipe has no size to check counts against: read it whole, from this
+            // descriptor (opening it again would break the writer's pipe).
+            try {
+                mWhole = readToEnd(mFd, path, 0);
+            } catch (...) {
+                closeFile();
+                throw;
+            }
             closeFile();
-            mWhole = loadFile(path);
             mMemory = mWhole.data();
             mMemorySize = mRawSize = mWhole.size();
         }
