@@ -52,14 +52,14 @@ std::vector<char>
 loadFile(const std::string& path)
 {
     const OpenFile file = openFile(path);
-    struct FdCloser { int fd; ~FdCloser() { ::close(fd); } } closer{file.fd};
     // st_size is only a hint (pipes and /proc files report 0).
-    return readToEnd(file.fd, path, file.regular ? size_t(file.size) : 0);
+    return readToEndAndClose(file.fd, path, file.regular ? size_t(file.size) : 0);
 }
 
 std::vector<char>
-readToEnd(int fd, const std::string& path, size_t sizeHint)
+readToEndAndClose(int fd, const std::string& path, size_t sizeHint)
 {
+    struct FdCloser { int fd; ~FdCloser() { ::close(fd); } } closer{fd};
     std::vector<char> data(sizeHint > 0 ? sizeHint + 1 : 65536);
     size_t used = 0;
     for (;;) {

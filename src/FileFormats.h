@@ -47,9 +47,11 @@ OpenFile openFile(const std::string& path);
 std::vector<char> loadFile(const std::string& path);
 
 /// Everything left to read from the open descriptor @a fd (named @a path in errors), in a
-/// buffer first sized for @a sizeHint bytes (0: unknown, as for a pipe).
+/// buffer first sized for @a sizeHint bytes (0: unknown, as for a pipe); closes @a fd
+/// whatever happens. Readers use it for pipes, which have no size and must not be opened
+/// a second time (that would break the writer's pipe).
 /// @throw FileError "cannot read <path>: <reason>".
-std::vector<char> readToEnd(int fd, const std::string& path, size_t sizeHint);
+std::vector<char> readToEndAndClose(int fd, const std::string& path, size_t sizeHint);
 
 /// The extension of the last path component, lower-cased, with its dot (".vtk"), or "".
 std::string lowerExtension(const std::string& path);

@@ -63,20 +63,13 @@ public:
     explicit FileStream(const std::string& path) : mPath(path)
     {
         const OpenFile file = openFile(path);
-        mFd = file.fd;
         if (file.regular) {
+            mFd = file.fd;
             mSize = file.size;
             mBuffer.resize(size_t(std::min<uint64_t>(kChunkBytes, std::max<uint64_t>(mSize, 64))));
         } else {
-            // st_size means nothing for pipes and /proc files: hold the whole contents, read
-            // from this descriptor (opening a pipe again would break its writer's pipe).
-            try {
-                mBuffer = readToEnd(mFd, path, 0);
-            } catch (...) {
-                closeFile();
-                throw;
-            }
-            closeFile();
+            // st_size means nothing for pipes and /proc files: hold the whole contents.
+            mBuffer = readToEndAndClose(file.fd, path, 0);
             mTail = mBuffer.size();
             mSize = mTail;
             mEof = true;

@@ -4,7 +4,7 @@
 ///        inflating gzip on the fly, for the readers that stream into their final arrays
 ///        (ReadBgeo.cc, ReadTable.cc); and the path-taking entry points of those readers.
 ///
-/// A StreamReader holds one chunk of the data (kStreamChunkBytes; less for a smaller file)
+/// A StreamReader holds one chunk of the data (kChunkBytes; less for a smaller file)
 /// plus, for gzip, a quarter chunk of compressed input. The buffer grows beyond a chunk only
 /// when a caller asks for one contiguous piece longer than that (a very long text line).
 /// Errors are those of loadFile() and decode_internal::gunzip(), word for word.
@@ -29,8 +29,6 @@
 #include <string_view>
 #include <vector>
 
-#include <fcntl.h>
-#include <sys/stat.h>
 #include <unistd.h>
 
 namespace nonbloppy {
@@ -43,9 +41,6 @@ namespace io_internal {
 ParticleSet readBgeoFile(const std::string& path);
 ParticleSet readTableFile(const std::string& path);
 ParticleSet readJsonFile(const std::string& path);
-
-/// Bytes buffered at a time.
-constexpr size_t kStreamChunkBytes = size_t(1) << 20;
 
 /// A read position in a file or memory block, with a bounded buffer of the bytes ahead.
 class StreamReader
@@ -62,34 +57,22 @@ public:
     /// Read the file @a path; a pipe or other non-regular file is loaded whole first.
     StreamReader(const std::string& path, bool inflateGzip) : mPath(path)
     {
-        mFd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
-        if (mFd < 0) throw FileError("cannot open " + path + ": " + std::strerror(errno));
-        struct stat info;
-        if (::fstat(mFd, &info) != 0) {
-            const int error = errno;
-            closeFile();
-            throw readError(error);
-        }
-        if (S_ISDIR(info.st_mode)) {
-            closeFile();
-            throw readError(EISDIR);
-        }
-        if (S_ISREG(info.st_mode)) {
-            mRawSize = uint64_t(info.st_size);
+        const OpenFile file = openFile(path);
+        if (file.regular) {
+            mFd = file.fd;
+            mRawSize = file.size;
         } else {
-            // A pipe has no size to check counts against: read it whole, from this
-            // descriptor (opening it again would break the writer's pipe).
-            try {
-                mWhole = readToEnd(mFd, path, 0);
-            } catch (...) {
-                closeFile();
-                throw;
-            }
-            closeFile();
+            // A pipe has no size to check counts against: read it whole.
+            mWhole = readToEndAndClose(file.fd, path, 0);
             mMemory = mWhole.data();
             mMemorySize = mRawSize = mWhole.size();
         }
-        start(inflateGzip);
+        try {
+            start(inflateGzip);
+        } catch (...) {
+            closeFile();  // the destructor does not run when the constructor throws
+            throw;
+        }
     }
 
     ~StreamReader()
@@ -196,11 +179,6 @@ public:
     };
 
 private:
-    FileError readError(int errorNumber) const
-    {
-        return FileError("cannot read " + mPath + ": " + std::strerror(errorNumber));
-    }
-
     void closeFile()
     {
         if (mFd >= 0) ::close(mFd);
@@ -220,7 +198,7 @@ private:
             const ssize_t got = ::read(mFd, dst, std::min<size_t>(n, size_t(1) << 30));
             if (got < 0) {
                 if (errno == EINTR) continue;
-                throw readError(errno);
+                failRead(mPath, errno);
             }
             mRawPos += uint64_t(got);
             return size_t(got);
@@ -297,8 +275,8 @@ private:
             mHead = 0;
         }
         // A small file gets a buffer of its size, not a whole chunk.
-        size_t size = mGzip ? kStreamChunkBytes
-                            : size_t(std::min<uint64_t>(std::max<uint64_t>(mRawSize, 64), kStreamChunkBytes));
+        size_t size = mGzip ? kChunkBytes
+                            : size_t(std::min<uint64_t>(std::max<uint64_t>(mRawSize, 64), kChunkBytes));
         while (size < want) size *= 2;
         if (size > mBuffer.size()) mBuffer.resize(size);
         const size_t got = produce(reinterpret_cast<unsigned char*>(mBuffer.data()) + mTail,
@@ -316,7 +294,7 @@ private:
             have = size_t(std::min<uint64_t>(2, mMemorySize));
             if (have > 0) std::memcpy(magic, mMemory, have);
         } else {
-            mRawBuffer.resize(size_t(std::min<uint64_t>(std::max<uint64_t>(mRawSize, 64), kStreamChunkBytes / 4)));
+            mRawBuffer.resize(size_t(std::min<uint64_t>(std::max<uint64_t>(mRawSize, 64), kChunkBytes / 4)));
             mPeekUsed = rawRead(mRawBuffer.data(), mRawBuffer.size());
             have = std::min<size_t>(2, mPeekUsed);
             if (have > 0) std::memcpy(magic, mRawBuffer.data(), have);

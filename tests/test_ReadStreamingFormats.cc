@@ -193,13 +193,13 @@ errorOfBoth(const std::string& path, const std::function<ParticleSet(const std::
 TEST_F(ReadStreamingFormatsTest, BgeoPlainAndGzipLargerThanTheBuffer)
 {
     const std::string plain = bgeoBytes(kManyParticles);
-    ASSERT_GT(plain.size(), 4 * io::kStreamChunkBytes);
+    ASSERT_GT(plain.size(), 4 * io::kChunkBytes);
     const std::string plainFile = write("plain.bgeo", plain);
     expectBgeoParticles(io::readBgeoFile(plainFile), kManyParticles);
     expectBgeoParticles(readParticles(plainFile), kManyParticles);
 
     const std::string gz = gzipBytes(plain);
-    ASSERT_GT(gz.size(), io::kStreamChunkBytes);
+    ASSERT_GT(gz.size(), io::kChunkBytes);
     const std::string gzFile = write("gz.bgeo", gz);
     expectBgeoParticles(io::readBgeoFile(gzFile), kManyParticles);
     expectBgeoParticles(readParticles(gzFile), kManyParticles);
@@ -214,7 +214,7 @@ TEST_F(ReadStreamingFormatsTest, BgeoTruncatedDeepInTheFile)
     const std::string plain = bgeoBytes(kManyParticles);
     const size_t pointsStart = 41 + kBgeoTableBytes;
     ASSERT_EQ(plain.substr(pointsStart, 4), bigEndianFloat(record(0).x));
-    const size_t left = 3 * io::kStreamChunkBytes + 7;
+    const size_t left = 3 * io::kChunkBytes + 7;
     const std::string expected = "truncated BGEO points: header claims " + std::to_string(kManyParticles) +
         " points of " + std::to_string(kBgeoPointBytes) + " bytes, " + std::to_string(left) + " bytes left";
     const std::string cut = plain.substr(0, pointsStart + left);
@@ -329,7 +329,7 @@ expectTableParticles(const ParticleSet& particles, size_t count)
 TEST_F(ReadStreamingFormatsTest, TablesLargerThanTheBuffer)
 {
     const std::string csv = tableBytes(kManyParticles, "\n");
-    ASSERT_GT(csv.size(), 4 * io::kStreamChunkBytes);
+    ASSERT_GT(csv.size(), 4 * io::kChunkBytes);
     const std::string csvFile = write("p.csv", csv);
     expectTableParticles(io::readTableFile(csvFile), kManyParticles);
     expectTableParticles(readParticles(csvFile), kManyParticles);
@@ -342,7 +342,7 @@ TEST_F(ReadStreamingFormatsTest, TablesLargerThanTheBuffer)
     // Spaces, and a comment line longer than the buffer in the middle.
     std::string txt = tableBytes(kManyParticles, "\n", ' ');
     const size_t middle = txt.find('\n', txt.size() / 2) + 1;
-    txt.insert(middle, "#" + std::string(3 * io::kStreamChunkBytes, 'c') + "\n");
+    txt.insert(middle, "#" + std::string(3 * io::kChunkBytes, 'c') + "\n");
     expectTableParticles(io::readTableFile(write("p.txt", txt)), kManyParticles);
 }
 
@@ -403,7 +403,7 @@ jsonSyntaxError(const std::string& bytes)
 TEST_F(ReadStreamingFormatsTest, JsonLargerThanTheBuffer)
 {
     const std::string json = jsonBytes(kManyParticles);
-    ASSERT_GT(json.size(), 4 * io::kStreamChunkBytes);
+    ASSERT_GT(json.size(), 4 * io::kChunkBytes);
     const std::string file = write("p.json", json);
     for (const ParticleSet& particles : {io::readJsonFile(file), readParticles(file)}) {
         ASSERT_EQ(particles.size(), kManyParticles);
