@@ -6,6 +6,8 @@
 #ifndef NONBLOPPY_TEST_UTIL_H
 #define NONBLOPPY_TEST_UTIL_H
 
+#include <nonbloppy/Particles.h>
+
 #include <openvdb/openvdb.h>
 
 #include <gtest/gtest.h>
@@ -18,6 +20,7 @@
 #include <functional>
 #include <iterator>
 #include <random>
+#include <stdexcept>
 #include <string>
 #include <utility>
 #include <vector>
@@ -42,6 +45,16 @@ inline void writeBytes(const std::string& path, const std::string& bytes)
     std::ofstream os(path, std::ios::binary | std::ios::trunc);
     os.write(bytes.data(), std::streamsize(bytes.size()));
     if (!os.good()) ADD_FAILURE() << "cannot write " << path;
+}
+
+/// The attribute @a name of @a particles; throws std::runtime_error (failing the test) if
+/// there is none.
+inline const nonbloppy::ParticleAttribute& attribute(const nonbloppy::ParticleSet& particles,
+                                                     const std::string& name)
+{
+    const nonbloppy::ParticleAttribute* found = particles.findAttribute(name);
+    if (!found) throw std::runtime_error("no attribute " + name);
+    return *found;
 }
 
 /// The message of the exception @a ExceptionT that @a f throws ("" if it throws none).

@@ -112,13 +112,7 @@ fileErrorOf(const std::string& path)
     return nonbloppy_test::messageOf<FileError>([&] { readParticles(path); });
 }
 
-const ParticleAttribute&
-attribute(const ParticleSet& particles, const std::string& name)
-{
-    const ParticleAttribute* found = particles.findAttribute(name);
-    if (!found) throw std::runtime_error("no attribute " + name);
-    return *found;
-}
+using nonbloppy_test::attribute;
 
 void
 expectSameParticles(const ParticleSet& a, const ParticleSet& b, bool compareAttributes = true)

@@ -144,16 +144,7 @@ gzipBytes(const std::string& plain)
     return out;
 }
 
-const ParticleAttribute&
-attribute(const ParticleSet& particles, const std::string& name)
-{
-    for (const ParticleAttribute& a : particles.attributes) {
-        if (a.name == name) return a;
-    }
-    static const ParticleAttribute none;
-    ADD_FAILURE() << "no attribute " << name;
-    return none;
-}
+using nonbloppy_test::attribute;
 
 void
 expectBgeoParticles(const ParticleSet& particles, size_t count)
