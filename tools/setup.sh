@@ -7,7 +7,7 @@ cd "$(dirname "$0")/.."
 build_dir="${1:-build}"
 
 packages=(cmake g++ make pkg-config libopenvdb-dev libopenvdb-tools libtbb-dev libblosc-dev
-          zlib1g-dev libpugixml-dev nlohmann-json3-dev clang libclang-rt-14-dev
+          zlib1g-dev libexpat1-dev nlohmann-json3-dev clang libclang-rt-14-dev
           libboost-iostreams-dev googletest libgtest-dev libcli11-dev libbenchmark-dev doxygen)
 missing=()
 for p in "${packages[@]}"; do
