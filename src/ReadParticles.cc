@@ -21,6 +21,7 @@
 
 #include "FileFormats.h"
 #include "ParticleReaders.h"
+#include "ReadVtu.h"
 #include "StreamReader.h"
 
 #include <algorithm>
@@ -515,12 +516,12 @@ readParticles(const std::string& path)
         particles = readTableFile(path);
     } else if (ext == ".json") {
         particles = readJsonFile(path);
+    } else if (ext == ".vtu" || ext == ".vtp") {
+        particles = readVtuFile(path);
     } else {
-        // VTU is XML (pugixml parses the whole document) and .vdb goes through OpenVDB's own
-        // stream reader: both work on the whole file in memory.
+        // .vdb goes through OpenVDB's own stream reader, on the whole file in memory.
         const std::vector<char> file = loadFile(path);
-        if (ext == ".vtu" || ext == ".vtp") particles = readVtuParticles(file.data(), file.size(), path);
-        else particles = readVdbPointsParticles(file.data(), file.size(), path);
+        particles = readVdbPointsParticles(file.data(), file.size(), path);
     }
 
     // Later stages hash positions into voxels; one NaN would poison the whole grid.
