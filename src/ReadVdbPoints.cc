@@ -8,7 +8,8 @@
 /// The bytes are read from memory the way openvdb::io::Stream reads them, grid by grid, so
 /// the reader never opens the file twice and the fuzz target can feed it bytes; before
 /// OpenVDB reads a header, metadata, grid descriptor, transform or a PointDataGrid's tree
-/// topology, every size in it is checked against the bytes present (VdbSizeCheck), and grids
+/// and leaf buffers, every size in it is checked against the bytes present and against what
+/// it describes (VdbSizeCheck), and grids
 /// that are not needed are skipped unread when the file says where they end. Points are
 /// visited leaf by leaf in tree order, so the particle order is the same on every run.
 
@@ -27,12 +28,16 @@
 #include <openvdb/math/Maps.h>
 #include <openvdb/openvdb.h>
 #include <openvdb/points/PointDataGrid.h>
+#include <openvdb/points/StreamCompression.h>
 #pragma GCC visibility pop
 
 #include <algorithm>
+#include <array>
 #include <cctype>
 #include <cstring>
 #include <limits>
+#include <map>
+#include <memory>
 #include <sstream>
 
 namespace nonbloppy {
@@ -82,6 +87,14 @@ convertGrid(const PointDataGrid& grid, const std::string& path)
     // corrupt file might not, and the handles below would then read the wrong arrays).
     uint64_t count = 0;
     for (auto leaf = grid.tree().cbeginLeaf(); leaf; ++leaf) {
+        // A voxel's points are those from the previous voxel's offset up to its own; a
+        // decreasing offset would make the index iterators below visit more points than
+        // pointCount() (the last offset) says, past the arrays and the output.
+        for (openvdb::Index n = 1; n < PointDataGrid::TreeType::LeafNodeType::SIZE; ++n) {
+            if (leaf->getValue(n) < leaf->getValue(n - 1)) {
+                fail(path, "corrupt point offsets in PointDataGrid '" + printable(grid.getName()) + "'");
+            }
+        }
         if (!(leaf->attributeSet().descriptor() == descriptor)) {
             fail(path, "leaves of PointDataGrid '" + printable(grid.getName()) +
                  "' have different attributes");
@@ -147,9 +160,9 @@ convertGrid(const PointDataGrid& grid, const std::string& path)
 ///
 /// For a PointDataGrid it also walks the tree's topology (root, internal and leaf nodes),
 /// where every node's values come as a chunk whose size io::bloscFromStream/unzipFromStream
-/// allocate before reading. It cannot check the leaves' buffers (attribute descriptors,
-/// paged attribute arrays, voxel offsets): that would mean reimplementing OpenVDB's points
-/// I/O (tests/fuzz/README.md).
+/// allocate before reading, and then every leaf's buffers (pointLeafBuffers(): attribute
+/// descriptors, array metadata, page headers, pages, point offsets), where OpenVDB also
+/// asserts on sizes it did not check. The whole grid is walked before OpenVDB reads any of it.
 class VdbSizeCheck
 {
 public:
@@ -171,6 +184,12 @@ public:
         if (version < openvdb::OPENVDB_FILE_VERSION_NODE_MASK_COMPRESSION) {
             corrupt("unsupported file format version " + std::to_string(version) +
                     " (point data grids need 223 or later)");
+        }
+        // OpenVDB reads newer versions after a warning on stderr, as if they were its own.
+        if (version > openvdb::OPENVDB_FILE_VERSION) {
+            corrupt("unsupported file format version " + std::to_string(version) + " (OpenVDB " +
+                    openvdb::getLibraryVersionString() + " reads up to " +
+                    std::to_string(openvdb::OPENVDB_FILE_VERSION) + ")");
         }
         skip(4 + 4, "header");  // library major, minor
         need(1, "header");
@@ -242,29 +261,193 @@ public:
         metaMap(grid);
         transform(grid);
         if (!pointDataGrid) return;
+        // Before multi-pass I/O, a PointDataGrid's leaves were read in one pass that leaves
+        // their attribute arrays half-read; OpenVDB itself never wrote such files.
+        if (version < openvdb::OPENVDB_FILE_VERSION_MULTIPASS_IO) {
+            corrupt(grid + " is a point data grid in file format " + std::to_string(version) +
+                    " (point data grids need 224 or later)");
+        }
         mLeafCount = 0;
         pointTreeTopology(compression, "tree of " + grid);
-        if (version >= openvdb::OPENVDB_FILE_VERSION_MULTIPASS_IO && mLeafCount > 0) {
-            firstAttributeDescriptor("leaf buffers of " + grid);
+        pointLeafBuffers(grid);
+    }
+
+    /// Grid::readBuffers() of a PointDataGrid (PointDataLeafNode::readBuffers): a pass count,
+    /// then every leaf once per pass, in tree order:
+    ///   0          each leaf's voxel buffer size (2 bytes);
+    ///   1          a header byte and an attribute descriptor (until one is marked as shared
+    ///              by all leaves that follow), then the metadata of each attribute array;
+    ///   2 .. A+1   attribute a - 2: the page headers of its paged arrays;
+    ///   A+2        the voxel values (point offsets);
+    ///   A+3 .. 2A+2  attribute a - A - 3: its data (pages, or the array's own bytes).
+    /// OpenVDB trusts every size in there: it allocates what a descriptor, an array or a page
+    /// header says, asserts (and so aborts the process, Debian building libopenvdb with
+    /// assertions) on a zero page size or on an array running past its page, and copies
+    /// arrays out of pages without checking that they are as long as the array. So each size
+    /// is checked here against the bytes left and against what the array must hold (its size,
+    /// stride and storage type), every leaf and every page, before OpenVDB reads any of it.
+    /// One pass over the bytes, without decompressing anything: Blosc chunks are checked by
+    /// their 16-byte headers.
+    void pointLeafBuffers(const std::string& grid)
+    {
+        const std::string what = "leaf buffers of " + grid;
+        const uint16_t passes = u16(what);
+        skip(2 * mLeafCount, what);  // pass 0
+
+        // Pass 1: descriptors and array metadata. A header with bit 0 set makes its leaf's
+        // descriptor the one of every later leaf (none of them stores one); bit 1 announces a
+        // block of bytes to skip, which OpenVDB reads into a vector of that size.
+        std::vector<std::vector<ArrayLayout>> leaves(mLeafCount);
+        std::shared_ptr<const LeafDescriptor> descriptor;
+        bool shared = false;
+        size_t attributes = 0;  // the most attributes of a leaf
+        for (uint64_t leaf = 0; leaf < mLeafCount; ++leaf) {
+            const std::string where = "leaf " + std::to_string(leaf) + " of " + grid;
+            if (!shared) {
+                need(1, where);
+                const uint8_t header = mData[mPos++];
+                if (header > 3) {
+                    corrupt("unknown header flags " + std::to_string(header) + " in " + where);
+                }
+                descriptor = attributeDescriptor("attribute descriptor of " + where);
+                if (header & 2) {
+                    const uint64_t bytes = u64(where);
+                    if (bytes > left()) {
+                        corrupt("block to skip in " + where + " claims " + std::to_string(bytes) +
+                                " bytes, " + std::to_string(left()) + " left");
+                    }
+                    mPos += size_t(bytes);
+                }
+                shared = header & 1;
+            }
+            attributes = std::max(attributes, descriptor->storageBytes.size());
+            leaves[leaf].reserve(descriptor->storageBytes.size());
+            for (size_t a = 0; a < descriptor->storageBytes.size(); ++a) {
+                leaves[leaf].push_back(arrayMetadata(descriptor->storageBytes[a],
+                    "attribute '" + printable(descriptor->names[a]) + "' of " + where));
+            }
+        }
+        // Passes beyond the attributes read nothing; fewer would leave arrays unread. (A tree
+        // without leaves is written with no passes.)
+        if (mLeafCount > 0 && passes < 4 + 2 * attributes) {
+            corrupt(what + " come in " + std::to_string(passes) + " passes; leaves with " +
+                    std::to_string(attributes) + " attributes need " +
+                    std::to_string(4 + 2 * attributes));
+        }
+
+        // Passes 2 .. A+1: the page headers, attribute by attribute. A paged attribute's
+        // arrays are packed into pages in leaf order (compression::PagedInputStream): a new
+        // page header comes when the last page is used up, and each array takes its bytes
+        // from the current page. Every array must lie inside its page (OpenVDB asserts it),
+        // and every page must be used up, else the data pass would not read it and the arrays
+        // in it would be copied from a page that was never loaded.
+        std::vector<std::vector<PageLayout>> pages(attributes);
+        for (size_t a = 0; a < attributes; ++a) {
+            uint64_t used = 0, pageBytes = 0;
+            for (uint64_t leaf = 0; leaf < mLeafCount; ++leaf) {
+                if (a >= leaves[leaf].size() || !leaves[leaf][a].paged) continue;
+                ArrayLayout& array = leaves[leaf][a];
+                const std::string where = "attribute " + std::to_string(a) + " of leaf " +
+                                          std::to_string(leaf) + " of " + grid;
+                if (used == pageBytes) {
+                    pages[a].push_back(pageHeader("page header of " + where));
+                    pageBytes = pages[a].back().uncompressedBytes;
+                    used = 0;
+                }
+                array.page = pages[a].size() - 1;
+                if (array.bytes > pageBytes - used) {
+                    corrupt("array of " + std::to_string(array.bytes) + " bytes in " + where +
+                            " runs past its page (" + std::to_string(pageBytes - used) +
+                            " bytes left in it)");
+                }
+                used += array.bytes;
+            }
+            if (used != pageBytes) {
+                corrupt("last page of attribute " + std::to_string(a) + " in " + what + " holds " +
+                        std::to_string(pageBytes) + " bytes, its arrays " + std::to_string(used));
+            }
+        }
+
+        // Pass A+2: each leaf's value mask and point offsets (io::readCompressedValues for
+        // PointDataIndex32: a 16-bit size, 0xffff for 2048 raw bytes, else a Blosc chunk).
+        for (uint64_t leaf = 0; leaf < mLeafCount; ++leaf) {
+            const std::string where = "point offsets of leaf " + std::to_string(leaf) + " of " + grid;
+            skip(64, where);
+            const uint16_t bytes = u16(where);
+            if (bytes == std::numeric_limits<uint16_t>::max()) skip(2048, where);
+            else bloscChunk(bytes, 2048, where);
+        }
+
+        // Passes A+3 .. 2A+2: the data, attribute by attribute, leaf by leaf. A paged array
+        // reads its page when it is the first array in it.
+        for (size_t a = 0; a < attributes; ++a) {
+            size_t nextPage = 0;
+            for (uint64_t leaf = 0; leaf < mLeafCount; ++leaf) {
+                if (a >= leaves[leaf].size()) continue;
+                const ArrayLayout& array = leaves[leaf][a];
+                const std::string where = "attribute " + std::to_string(a) + " of leaf " +
+                                          std::to_string(leaf) + " of " + grid;
+                if (array.paged) {
+                    if (array.page == nextPage) pageData(pages[a][nextPage++], "page of " + where);
+                    continue;
+                }
+                // TypedAttributeArray::readBuffers(): a non-uniform array says whether it is
+                // Blosc-compressed; raw bytes become the array as they are.
+                bool blosc = false;
+                if (!array.uniform) {
+                    need(1, where);
+                    blosc = mData[mPos++] == 1;
+                }
+                if (blosc) {
+                    bloscChunk(array.bytes, array.expectedBytes, "data of " + where);
+                } else {
+                    if (array.bytes != array.expectedBytes) {
+                        corrupt("data of " + where + " has " + std::to_string(array.bytes) +
+                                " bytes, expected " + std::to_string(array.expectedBytes));
+                    }
+                    skip(array.bytes, "data of " + where);
+                }
+            }
         }
     }
 
-    /// Grid::readBuffers() of a PointDataGrid up to the first leaf's attribute descriptor
-    /// (AttributeSet::Descriptor::read, which sizes its arrays from the counts in it): the
-    /// pass count, pass 0 (two bytes per leaf), the first leaf's header byte.
-    void firstAttributeDescriptor(const std::string& what)
+    /// What a leaf's later passes need to know of its attribute descriptor.
+    struct LeafDescriptor
     {
-        skip(2 + 2 * mLeafCount + 1, what);
-        const std::string descriptor = "attribute descriptor in " + what;
+        std::vector<std::string> names;     ///< by attribute index
+        std::vector<size_t> storageBytes;   ///< sizeof(StorageType) of each attribute's array
+    };
+
+    /// AttributeSet::Descriptor::read(): the attribute count (OpenVDB sizes a vector by it),
+    /// the type and codec names, the names with their indices, the groups, a MetaMap.
+    /// Every type must be a registered attribute type (AttributeSet::readMetadata creates the
+    /// arrays by it), and the names must number the attributes 0..n-1, each once: the reader
+    /// looks arrays up by these indices.
+    std::shared_ptr<const LeafDescriptor> attributeDescriptor(const std::string& descriptor)
+    {
         const uint64_t attributes = u64(descriptor);
         // An attribute takes a type, a codec and a name (three string lengths) and an index.
         if (attributes > left() / 20) {
             corrupt(descriptor + " claims " + std::to_string(attributes) + " attributes");
         }
-        for (uint64_t a = 0; a < 2 * attributes; ++a) string("type name in " + descriptor);
+        auto result = std::make_shared<LeafDescriptor>();
+        result->names.resize(size_t(attributes));
+        result->storageBytes.resize(size_t(attributes));
         for (uint64_t a = 0; a < attributes; ++a) {
-            string("attribute name in " + descriptor);
-            skip(8, descriptor);
+            const std::string type = string("type name in " + descriptor);
+            const std::string codec = string("codec name in " + descriptor);
+            result->storageBytes[a] = storageBytes({type, codec}, descriptor);
+        }
+        std::vector<bool> named(size_t(attributes), false);
+        for (uint64_t a = 0; a < attributes; ++a) {
+            const std::string name = string("attribute name in " + descriptor);
+            const uint64_t index = u64(descriptor);
+            if (index >= attributes || named[index]) {
+                corrupt("attribute '" + printable(name) + "' in " + descriptor + " has index " +
+                        std::to_string(index) + " (" + std::to_string(attributes) + " attributes)");
+            }
+            named[index] = true;
+            result->names[index] = name;
         }
         const uint64_t groups = u64(descriptor);
         if (groups > left() / 12) corrupt(descriptor + " claims " + std::to_string(groups) + " groups");
@@ -273,6 +456,147 @@ public:
             skip(8, descriptor);
         }
         metaMap(descriptor);
+        return result;
+    }
+
+    /// sizeof(StorageType) of the attribute array type @a type (value type, codec), from an
+    /// array of one value made by OpenVDB's registry; remembered per type.
+    size_t storageBytes(const openvdb::NamePair& type, const std::string& descriptor)
+    {
+        const auto known = mStorageBytes.find(type);
+        if (known != mStorageBytes.end()) return known->second;
+        if (!openvdb::points::AttributeArray::isRegistered(type)) {
+            corrupt("unknown attribute type '" + printable(type.first) + "' with codec '" +
+                    printable(type.second) + "' in " + descriptor);
+        }
+        const size_t bytes = openvdb::points::AttributeArray::create(type, 1)->storageTypeSize();
+        mStorageBytes.emplace(type, bytes);
+        return bytes;
+    }
+
+    /// One attribute array of one leaf, as TypedAttributeArray::readMetadata() leaves it.
+    struct ArrayLayout
+    {
+        uint64_t bytes = 0;          ///< bytes of data: paged or raw, the array itself
+        uint64_t expectedBytes = 0;  ///< what the array holds: its data size × storage size
+        bool paged = false;
+        bool uniform = false;
+        size_t page = 0;             ///< paged: index of its page among the attribute's pages
+    };
+
+    /// TypedAttributeArray::readMetadata(): a byte count (including the 2 flag bytes and the
+    /// 4-byte size that follow), flags, serialization flags, size, and the stride (or total
+    /// size) when strided. The array's data is its data size (1 if uniform; size × stride,
+    /// or the total size when the stride varies, as OpenVDB's 32-bit dataSize() computes it)
+    /// times @a storageBytes; a paged array's byte count must say exactly that, since it is
+    /// all OpenVDB copies out of the page for it.
+    ArrayLayout arrayMetadata(size_t storageBytes, const std::string& where)
+    {
+        using openvdb::points::AttributeArray;
+        const uint64_t bytes = u64("metadata of " + where);
+        need(2, "metadata of " + where);
+        const uint8_t flags = mData[mPos++];
+        const uint8_t serialization = mData[mPos++];
+        const uint32_t size = u32("metadata of " + where);
+        if (bytes < 6) corrupt(where + " claims " + std::to_string(bytes) + " bytes, less than its header");
+        // Flags from 0x20 up are not OpenVDB's (0x20 is its own "partially read" state).
+        if (flags >= AttributeArray::PARTIALREAD) {
+            corrupt(where + " has unknown flags " + std::to_string(flags));
+        }
+        if (serialization >= 2 * AttributeArray::WRITEPAGED) {
+            corrupt(where + " has unknown serialization flags " + std::to_string(serialization));
+        }
+        uint32_t strideOrTotal = 1;
+        if (serialization & AttributeArray::WRITESTRIDED) strideOrTotal = u32("metadata of " + where);
+        ArrayLayout array;
+        array.bytes = bytes - 6;
+        array.paged = serialization & AttributeArray::WRITEPAGED;
+        array.uniform = serialization & AttributeArray::WRITEUNIFORM;
+        const bool constantStride = flags & AttributeArray::CONSTANTSTRIDE;
+        if (size == 0 || strideOrTotal == 0 || (!constantStride && strideOrTotal < size)) {
+            corrupt(where + " has size " + std::to_string(size) + " and " +
+                    (constantStride ? "stride " : "total size ") + std::to_string(strideOrTotal));
+        }
+        const uint64_t values = array.uniform ? 1
+                              : constantStride ? uint64_t(size) * strideOrTotal : strideOrTotal;
+        if (values > std::numeric_limits<uint32_t>::max()) {
+            corrupt(where + " has " + std::to_string(size) + " values of stride " +
+                    std::to_string(strideOrTotal) + ", more than 2^32");
+        }
+        array.expectedBytes = values * storageBytes;
+        if (array.paged && array.bytes != array.expectedBytes) {
+            corrupt(where + " claims " + std::to_string(array.bytes) + " bytes, expected " +
+                    std::to_string(array.expectedBytes) + " for " + std::to_string(values) +
+                    " values of " + std::to_string(storageBytes) + " bytes");
+        }
+        return array;
+    }
+
+    /// A page of a paged attribute (compression::Page): compressed size and, if it is
+    /// positive (Blosc), the uncompressed size; a negative size means that many raw bytes.
+    struct PageLayout
+    {
+        int32_t compressedBytes = 0;
+        uint64_t uncompressedBytes = 0;
+    };
+
+    /// compression::Page::readHeader(), which asserts that neither size is 0.
+    PageLayout pageHeader(const std::string& where)
+    {
+        PageLayout page;
+        page.compressedBytes = int32_t(u32(where));
+        if (page.compressedBytes > 0) {
+            const int32_t uncompressed = int32_t(u32(where));
+            if (uncompressed <= 0) {
+                corrupt(where + " gives uncompressed size " + std::to_string(uncompressed));
+            }
+            page.uncompressedBytes = uint64_t(uncompressed);
+        } else if (page.compressedBytes == 0 || page.compressedBytes == std::numeric_limits<int32_t>::min()) {
+            corrupt(where + " gives compressed size " + std::to_string(page.compressedBytes));
+        } else {
+            page.uncompressedBytes = uint64_t(-int64_t(page.compressedBytes));
+        }
+        return page;
+    }
+
+    /// compression::Page::readBuffers(): the page's bytes, raw or one Blosc chunk.
+    void pageData(const PageLayout& page, const std::string& where)
+    {
+        if (page.compressedBytes < 0) skip(page.uncompressedBytes, where);
+        else bloscChunk(uint64_t(page.compressedBytes), page.uncompressedBytes, where);
+    }
+
+    /// A Blosc chunk of @a bytes that must decompress to @a uncompressed bytes. Blosc trusts
+    /// its 16-byte header (uncompressed size at byte 4, block size at 8, compressed size at
+    /// 12): OpenVDB allocates twice the uncompressed size it gives and copies the array out
+    /// of that, and Blosc reads as many bytes as its compressed size says, so both must agree
+    /// with the sizes the file gave OpenVDB. (OpenVDB pads inputs shorter than
+    /// compression::BLOSC_PAD_BYTES to that length with zeros before compressing them.)
+    /// Blosc's codecs do not compress more than 1032:1 (deflate's limit; OpenVDB writes LZ4,
+    /// at most about 255:1), which bounds what a small file can make OpenVDB allocate.
+    void bloscChunk(uint64_t bytes, uint64_t uncompressed, const std::string& where)
+    {
+        need(bytes, where);
+        if (bytes < 16) {
+            corrupt("Blosc chunk of " + std::to_string(bytes) + " bytes in " + where +
+                    " is shorter than its header");
+        }
+        uint32_t header[3];
+        std::memcpy(header, mData + mPos + 4, sizeof(header));
+        const uint64_t pad = uint64_t(openvdb::compression::BLOSC_PAD_BYTES);
+        const bool padded = header[0] == pad && uncompressed <= pad;
+        // Blosc divides by the block size and allocates by it; it writes 1 for no bytes.
+        if ((header[0] != uncompressed && !padded) || header[2] != bytes || header[1] == 0
+            || header[1] > std::max<uint32_t>(header[0], 1)) {
+            corrupt("Blosc chunk in " + where + " says " + std::to_string(header[0]) + " bytes from " +
+                    std::to_string(header[2]) + " in blocks of " + std::to_string(header[1]) +
+                    "; expected " + std::to_string(uncompressed) + " bytes from " + std::to_string(bytes));
+        }
+        if (uncompressed / 1032 > bytes) {
+            corrupt("Blosc chunk in " + where + " claims " + std::to_string(uncompressed) +
+                    " bytes from " + std::to_string(bytes) + ", more than 1032:1");
+        }
+        mPos += size_t(bytes);
     }
 
     /// math::Transform::read(): the map's type name, then its fields (a frustum map nests
@@ -304,7 +628,10 @@ public:
     /// buffer count, root background, tiles, then each child's subtree.
     void pointTreeTopology(uint32_t compression, const std::string& what)
     {
-        skip(4, what);  // buffer count
+        // Trees of more than one buffer are gone from OpenVDB; it would warn on stderr and
+        // read on as if there were one.
+        const uint32_t buffers = u32(what);
+        if (buffers != 1) corrupt(what + " has " + std::to_string(buffers) + " buffers; point grids have 1");
         // Leaves are made with the background as their value, and a PointDataLeafNode
         // asserts that it is 0 (its values are point offsets), aborting the process.
         const uint32_t background = u32(what);
@@ -323,10 +650,27 @@ public:
             corrupt(what + " claims " + std::to_string(children) + " root children in " +
                     std::to_string(left()) + " bytes");
         }
+        // RootNode keeps its children in a map by origin and reads their buffers in that
+        // order; OpenVDB writes them in it. Out of order (or twice, which replaces the first),
+        // the leaf buffers would belong to other leaves than the ones walked here.
+        std::array<int32_t, 3> previous{};
         for (uint32_t i = 0; i < children; ++i) {
-            skip(12, what);
+            need(12, what);
+            std::array<int32_t, 3> origin;
+            std::memcpy(origin.data(), mData + mPos, 12);
+            mPos += 12;
+            if (i > 0 && !(previous < origin)) {
+                corrupt("root children of " + what + " are not in order: (" + coord(origin) +
+                        ") after (" + coord(previous) + ")");
+            }
+            previous = origin;
             internalNode(5, compression, what);
         }
+    }
+
+    static std::string coord(const std::array<int32_t, 3>& xyz)
+    {
+        return std::to_string(xyz[0]) + ", " + std::to_string(xyz[1]) + ", " + std::to_string(xyz[2]);
     }
 
     /// InternalNode::readTopology(): child and value masks, the values, then the children
@@ -379,7 +723,10 @@ public:
             corrupt("compressed chunk in " + what + " claims " + std::to_string(chunk) +
                     " bytes, " + std::to_string(left()) + " left");
         }
-        mPos += size_t(chunk);
+        // Blosc takes precedence over zip (io::readData); Blosc reads as much as its own
+        // header says, whatever the chunk size said.
+        if (compression & openvdb::io::COMPRESS_BLOSC) bloscChunk(uint64_t(chunk), bytes, what);
+        else mPos += size_t(chunk);
     }
 
     static size_t bitCount(const unsigned char* bytes, size_t size)
@@ -395,6 +742,15 @@ public:
         uint64_t value;
         std::memcpy(&value, mData + mPos, 8);
         mPos += 8;
+        return value;
+    }
+
+    uint16_t u16(const std::string& what)
+    {
+        need(2, what);
+        uint16_t value;
+        std::memcpy(&value, mData + mPos, 2);
+        mPos += 2;
         return value;
     }
 
@@ -470,6 +826,8 @@ private:
     const std::string& mPath;
     bool mHasGridOffsets = false;
     uint64_t mLeafCount = 0;  ///< leaves in the topology walked last
+    /// sizeof(StorageType) per attribute array type seen (storageBytes())
+    std::map<openvdb::NamePair, size_t> mStorageBytes;
 };
 
 /// io::Stream's reading, grid by grid, with VdbSizeCheck run on each part before OpenVDB
@@ -492,7 +850,11 @@ public:
             return size_t(pos);
         };
         auto expectAt = [&](size_t pos, const char* what) {
-            if (position() != pos) check.corrupt(std::string("unexpected layout of ") + what);
+            const size_t read = position();
+            if (read != pos) {
+                check.corrupt(std::string("unexpected layout of ") + what + " (OpenVDB read up to byte " +
+                              std::to_string(read) + ", the check walked up to " + std::to_string(pos) + ")");
+            }
         };
 
         const uint32_t version = check.header();
@@ -542,6 +904,7 @@ public:
             check.grid(descriptor.uniqueName(), pointDataGrid && !descriptor.isInstance(), version);
             grid->setSaveFloatAsHalf(descriptor.saveFloatAsHalf());
             readGrid(grid, descriptor, is);
+            if (pointDataGrid && !descriptor.isInstance()) expectAt(check.pos(), "a point data grid");
             grids.push_back(grid);
             namedGrids[descriptor.uniqueName()] = grid;
             connectInstance(descriptor, namedGrids);
@@ -560,6 +923,11 @@ readVdbPointsParticles(const char* data, size_t size, const std::string& path)
     openvdb::GridPtrVec grids;
     try {
         grids = CheckedVdbStream().read(data, size, path);
+        for (const openvdb::GridBase::Ptr& grid : grids) {
+            if (const auto points = openvdb::gridConstPtrCast<PointDataGrid>(grid)) {
+                return convertGrid(*points, path);
+            }
+        }
     } catch (const Error&) {
         throw;
     } catch (const std::bad_alloc&) {
@@ -572,11 +940,6 @@ readVdbPointsParticles(const char* data, size_t size, const std::string& path)
             if (static_cast<unsigned char>(ch) < 0x20 || static_cast<unsigned char>(ch) >= 0x7f) ch = '?';
         }
         fail(path, "cannot read .vdb file: " + message);
-    }
-    for (const openvdb::GridBase::Ptr& grid : grids) {
-        if (const auto points = openvdb::gridConstPtrCast<PointDataGrid>(grid)) {
-            return convertGrid(*points, path);
-        }
     }
     fail(path, "no PointDataGrid in this .vdb file (grids: " +
          [&] {

@@ -7,16 +7,25 @@
 // reader must reject them before allocating for those points. This file replaces the global
 // operator new to record the largest single request made while a file is being read.
 
+#include "TestUtil.h"
+
 #include <nonbloppy/Error.h>
 #include <nonbloppy/ReadParticles.h>
+
+#include <openvdb/openvdb.h>
+#include <openvdb/points/PointConversion.h>
+#include <openvdb/points/PointGroup.h>
 
 #include <gtest/gtest.h>
 
 #include <dirent.h>
 
 #include <algorithm>
+#include <chrono>
+#include <cmath>
 #include <cstdlib>
 #include <new>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -102,10 +111,18 @@ struct Expected
 };
 
 const Expected kExpected[] = {
-    // fuzz_vdb_points: a stream OpenVDB rejects halfway through a grid (libopenvdb leaks a
-    // node on that path, upstream; see tests/fuzz/lsan.supp).
+    // fuzz_vdb_points: a stream OpenVDB rejected halfway through a grid's tree, leaking a
+    // node (upstream; see tests/fuzz/lsan.supp): a Blosc chunk of an internal node whose own
+    // header says 0 bytes. The check of Blosc headers in the tree now rejects it first.
     {"vdb_points_corrupt_stream_openvdb_leak.vdb",
-     "cannot read .vdb file: RuntimeError: Expected to decompress 8 bytes, got 0 bytes"},
+     "cannot read .vdb file: Blosc chunk in tree of grid 'points' says 0 bytes from 16 in blocks "
+     "of 1; expected 8 bytes from 16"},
+    // fuzz_vdb_points: two bytes changed inside the Blosc data of the P attribute's page. Every
+    // size is right, so the walk lets it through and Blosc itself fails; the reader turns
+    // OpenVDB's exception into a FileError naming the file.
+    {"vdb_points_corrupt_blosc_data_openvdb_error.vdb",
+     "cannot read .vdb file: RuntimeError: Expected to decompress 128 bytes, got "
+     "18446744073709551615 bytes"},
     // A grid metadata type name claiming 2 GB: libopenvdb allocated it before failing, until
     // the reader checked every string length against the bytes left (VdbSizeCheck).
     {"vdb_points_metadata_type_name_2gb.vdb",
@@ -137,25 +154,60 @@ const Expected kExpected[] = {
      "cannot read .vdb file: compressed chunk in tree of grid 'points' claims 7349874591868649472 "
      "bytes, 494 left"},
     // fuzz_vdb_points, 300 s runs: the first leaf's attribute descriptor claims billions of
-    // attributes; AttributeSet::Descriptor::read sized a vector by it (up to 1.2 TB).
+    // attributes; AttributeSet::Descriptor::read sized a vector by it (up to 1.2 TB). Its
+    // header byte, which OpenVDB checks only after reading the descriptor, is rejected first.
     {"vdb_points_leaf_descriptor_attribute_count_1tb.vdb",
-     "cannot read .vdb file: attribute descriptor in leaf buffers of grid 'points' claims "
-     "18881471093 attributes"},
+     "cannot read .vdb file: unknown header flags 111 in leaf 0 of grid 'points'"},
     {"vdb_points_leaf_descriptor_attribute_count_563t.vdb",
-     "cannot read .vdb file: attribute descriptor in leaf buffers of grid 'points' claims "
-     "562949954234675 attributes"},
+     "cannot read .vdb file: unknown header flags 99 in leaf 0 of grid 'points'"},
     // fuzz_vdb_points, 120 s run: a non-zero root background; leaves are made with it and
     // PointDataLeafNode asserts it is 0, so Debian's libopenvdb (built with assertions) aborted.
     {"vdb_points_tree_nonzero_background_assert.vdb",
      "cannot read .vdb file: tree of grid 'points' has background 3735552; point grids need 0"},
+    // fuzz_vdb_points, runs 8-12 (tests/fuzz/README.md), in the leaf buffers past the first
+    // descriptor, which libopenvdb read unchecked until the walk covered every leaf. A zero
+    // page size or an array running past its page failed an assert in libopenvdb's
+    // compression::Page::readHeader / PagedInputStream, and Debian's libopenvdb keeps
+    // assertions, so the process aborted; the fourth leaf's own descriptor asked for 5 PB.
+    // Each is now rejected by the first check its bytes fail.
+    {"vdb_points_array_size_zero_page_size_zero_assert.vdb",
+     "cannot read .vdb file: attribute 'velocity' of leaf 0 of grid 'points' has size 0 and stride 1"},
+    {"vdb_points_page_uncompressed_size_zero_assert.vdb",
+     "cannot read .vdb file: page header of attribute 0 of leaf 0 of grid 'points' gives "
+     "uncompressed size 0"},
+    {"vdb_points_array_byte_count_16mb_page_overrun_assert.vdb",
+     "cannot read .vdb file: attribute 'velocity' of leaf 0 of grid 'points' claims 16253120 "
+     "bytes, expected 192 for 8 values of 24 bytes"},
+    {"vdb_points_leaf3_header_flags_descriptor_alloc_5pb.vdb",
+     "cannot read .vdb file: unknown header flags 31 in leaf 3 of grid 'points'"},
+    // Hand-made from tests/fuzz/seeds/cube_8_points.vdb (one field of the P attribute's page
+    // changed), one per check of the page walk: the compressed size of its page header 0
+    // (the assert above), its uncompressed size 48 for a 96-byte array (PagedInputStream's
+    // assert) or 200 (the data pass would never load the page, and the array would be
+    // copied from a page with no buffer), and the compressed size in the Blosc chunk's own
+    // header 4000 for a 58-byte chunk (Blosc would read past it).
+    {"vdb_points_page_compressed_size_zero_assert.vdb",
+     "cannot read .vdb file: page header of attribute 0 of leaf 0 of grid 'points' gives "
+     "compressed size 0"},
+    {"vdb_points_array_past_page_end_assert.vdb",
+     "cannot read .vdb file: array of 96 bytes in attribute 0 of leaf 0 of grid 'points' runs "
+     "past its page (48 bytes left in it)"},
+    {"vdb_points_page_longer_than_its_arrays.vdb",
+     "cannot read .vdb file: last page of attribute 0 in leaf buffers of grid 'points' holds "
+     "200 bytes, its arrays 96"},
+    {"vdb_points_blosc_header_compressed_size_4000.vdb",
+     "cannot read .vdb file: Blosc chunk in page of attribute 0 of leaf 0 of grid 'points' says "
+     "128 bytes from 4000 in blocks of 128; expected 96 bytes from 58"},
     // A billion points claimed in about 1 KB, one file per reader that reads a count
-    // (.vdb: the P attribute array of the only leaf says 1e9 values; the leaf holds 8).
+    // (.vdb: the P attribute array of the only leaf says 1e9 values; its byte count, 96).
     {"billion_points_header.bgeo",
      "truncated BGEO points: header claims 1000000000 points of 16 bytes, 983 bytes left"},
     {"billion_points_header.vtu", "truncated Points: the file is too small for 1000000000 tuples"},
     {"billion_points_header.vtk", "truncated POINTS section"},
     {"billion_points_header.ply", "truncated PLY vertex element"},
-    {"billion_points_header.vdb", "corrupt attribute array in PointDataGrid 'points'"},
+    {"billion_points_header.vdb",
+     "cannot read .vdb file: attribute 'P' of leaf 0 of grid 'points' claims 96 bytes, expected "
+     "12000000000 for 1000000000 values of 12 bytes"},
 };
 
 const Expected*
@@ -214,7 +266,7 @@ TEST(FuzzRegressions, EveryFileGivesItsExactError)
 // fuzz_vdb_points: the reader turns OpenVDB's exception into a FileError naming the file.
 TEST(FuzzRegressions, VdbCorruptStream)
 {
-    expectMessage("vdb_points_corrupt_stream_openvdb_leak.vdb");
+    expectMessage("vdb_points_corrupt_blosc_data_openvdb_error.vdb");
 }
 
 // "A file that claims a billion points in a 1 KB file is rejected before any allocation":
@@ -228,6 +280,98 @@ TEST(FuzzRegressions, BillionPointHeadersAreRejectedBeforeAllocating)
         expectMessage(file);
         const ReadOutcome outcome = readFuzzFile(fuzzPath(file));
         EXPECT_LT(outcome.largestAllocation, size_t(1) << 20) << file;
+    }
+}
+
+// The inputs that aborted the process inside libopenvdb (or made it ask for petabytes) are
+// rejected before libopenvdb reads the leaf buffers: nothing of 1 MB or more is requested.
+TEST(FuzzRegressions, VdbLeafBuffersAreCheckedBeforeOpenVdbReadsThem)
+{
+    for (const char* file : {"vdb_points_array_size_zero_page_size_zero_assert.vdb",
+                             "vdb_points_page_uncompressed_size_zero_assert.vdb",
+                             "vdb_points_array_byte_count_16mb_page_overrun_assert.vdb",
+                             "vdb_points_leaf3_header_flags_descriptor_alloc_5pb.vdb",
+                             "vdb_points_page_compressed_size_zero_assert.vdb",
+                             "vdb_points_array_past_page_end_assert.vdb",
+                             "vdb_points_page_longer_than_its_arrays.vdb",
+                             "vdb_points_blosc_header_compressed_size_4000.vdb"}) {
+        expectMessage(file);
+        const ReadOutcome outcome = readFuzzFile(fuzzPath(file));
+        EXPECT_LT(outcome.largestAllocation, size_t(1) << 20) << file;
+    }
+}
+
+// The leaf-buffer walk of src/ReadVdbPoints.cc checks every page and array size against
+// what OpenVDB writes; it must not reject what OpenVDB writes. Point grids with each of
+// io::File's compressions (Blosc: paged arrays; zip and none: arrays read whole), several
+// pages per attribute (2.4 MB of positions, 1 MB pages), arrays shorter than Blosc's padding,
+// a leaf whose array is larger than a page, uniform, strided and group attributes.
+class VdbLeafBuffers : public nonbloppy_test::ScratchDirTest
+{
+protected:
+    /// @a count points in a cube of side @a extent (voxel size 1), with a float
+    /// "temperature" (the point's number / 2), a uniform int "id", a non-uniform float
+    /// pair "pair" (stride 2) and a group "tagged".
+    std::string writePoints(size_t count, double extent, uint32_t compression, const std::string& name)
+    {
+        openvdb::initialize();
+        std::mt19937 random(11);
+        std::uniform_real_distribution<double> coordinate(0.0, extent);
+        std::vector<openvdb::Vec3R> positions(count);
+        for (openvdb::Vec3R& p : positions) p = openvdb::Vec3R(coordinate(random), coordinate(random), coordinate(random));
+        const openvdb::points::PointAttributeVector<openvdb::Vec3R> wrapper(positions);
+        auto transform = openvdb::math::Transform::createLinearTransform(1.0);
+        auto index = openvdb::tools::createPointIndexGrid<openvdb::tools::PointIndexGrid>(wrapper, *transform);
+        auto grid = openvdb::points::createPointDataGrid<openvdb::points::NullCodec,
+            openvdb::points::PointDataGrid>(*index, wrapper, *transform);
+        grid->setName("points");
+        std::vector<float> temperature(count);
+        for (size_t i = 0; i < count; ++i) temperature[i] = float(i) * 0.5f;
+        openvdb::points::appendAttribute<float>(grid->tree(), "temperature");
+        openvdb::points::populateAttribute<openvdb::points::PointDataTree, openvdb::tools::PointIndexTree,
+            openvdb::points::PointAttributeVector<float>>(grid->tree(), index->tree(), "temperature",
+                openvdb::points::PointAttributeVector<float>(temperature));
+        openvdb::points::appendAttribute<int32_t>(grid->tree(), "id", 7);
+        openvdb::points::appendAttribute<float>(grid->tree(), "pair", 0.0f, /*stride=*/2);
+        for (auto leaf = grid->tree().beginLeaf(); leaf; ++leaf) {
+            openvdb::points::AttributeWriteHandle<float> pair(leaf->attributeArray("pair"));
+            pair.expand();
+            for (openvdb::Index i = 0; i < pair.size(); ++i) pair.set(i, 1, float(i));
+        }
+        openvdb::points::appendGroup(grid->tree(), "tagged");
+        openvdb::points::setGroup(grid->tree(), "tagged", true);
+        const std::string file = path(name);
+        openvdb::io::File out(file);
+        out.setCompression(compression);
+        out.write({grid});
+        out.close();
+        return file;
+    }
+
+    static void expectPoints(const std::string& file, size_t count)
+    {
+        const nonbloppy::ParticleSet particles = nonbloppy::readParticles(file);
+        ASSERT_EQ(particles.size(), count) << file;
+        const nonbloppy::ParticleAttribute& t = nonbloppy_test::attribute(particles, "temperature");
+        std::vector<double> values(count);
+        for (size_t n = 0; n < count; ++n) values[n] = t.asDouble(n);
+        std::sort(values.begin(), values.end());
+        for (size_t n = 0; n < count; ++n) ASSERT_EQ(values[n], double(float(n) * 0.5f)) << file;
+    }
+};
+
+TEST_F(VdbLeafBuffers, WhatOpenVdbWritesStillReads)
+{
+    using namespace openvdb::io;
+    for (const uint32_t compression : {uint32_t(COMPRESS_BLOSC | COMPRESS_ACTIVE_MASK),
+                                       uint32_t(COMPRESS_ZIP | COMPRESS_ACTIVE_MASK), uint32_t(COMPRESS_NONE)}) {
+        const std::string tag = std::to_string(compression);
+        // 200 000 points in 40³ voxels: ~600 leaves, positions over three pages.
+        expectPoints(writePoints(200000, 40.0, compression, "many_leaves_" + tag + ".vdb"), 200000);
+        // 8 points in one leaf: arrays shorter than Blosc's 128-byte padding.
+        expectPoints(writePoints(8, 2.0, compression, "eight_points_" + tag + ".vdb"), 8);
+        // 100 000 points in one voxel: one leaf whose arrays exceed a page.
+        expectPoints(writePoints(100000, 0.9, compression, "one_leaf_" + tag + ".vdb"), 100000);
     }
 }
 
