@@ -12,7 +12,7 @@
 /// `</AppendedData>` is found from the end of the file, the rest of the document parsed
 /// after it, and then every appended array is read from its offset (raw ones with pread()
 /// directly into the final arrays). Peak memory: the particles, one 1 MiB chunk, expat's
-/// own buffer and a 64 KiB inflate buffer.
+/// own buffer, a 64 KiB inflate buffer and, for zlib blocks in base64, one compressed block.
 ///
 /// The messages, and which one a file with several faults gets, are those of the earlier
 /// whole-buffer reader (pugixml on the file with the raw appended bytes cut out): faults in
@@ -317,6 +317,7 @@ public:
     }
 
 private:
+    /// Where this array's first byte goes (looked up on every call: pieces grow the vectors).
     unsigned char* base()
     {
         if (mTarget == kPositions) return reinterpret_cast<unsigned char*>(mParticles->positions.data() + mStart);
@@ -457,6 +458,7 @@ public:
 private:
     enum class State { Idle, Header, Sizes, Data, Block, Done };
 
+    /// Throw FileError "<message> (<path>)".
     [[noreturn]] void failHere(const std::string& message) const { fail(*mLayout.path, message); }
 
     /// Header word @a index, in the file's byte order and header width.
@@ -750,11 +752,14 @@ public:
         fail(mPath, "truncated base64 data in " + mWhat);
     }
 
+    /// Base64Reader::read()'s check: @a count bytes must be decodable from what is left.
     void beginRead(uint64_t count, const std::string& what) override
     {
         requireRemaining(count, "truncated base64 data in " + what);
     }
 
+    /// Fail now (known length) or once the text has ended (inline) if fewer than @a count
+    /// bytes could be decoded from the rest of the text.
     void requireRemaining(uint64_t count, const std::string& message) override
     {
         // Base64Reader::maxRemaining(): 3 bytes per 4 characters left, plus 3, plus the
@@ -883,11 +888,13 @@ public:
         }
     }
 
+    /// The raw source's read check: @a count bytes must be left in the appended data.
     void beginRead(uint64_t count, const std::string& what) override
     {
         if (count > mSize - mPos) fail(mPath, "truncated appended data in " + what);
     }
 
+    /// Fail with @a message unless @a count bytes are left in the appended data.
     void requireRemaining(uint64_t count, const std::string& message) override
     {
         if (count > mSize - mPos) fail(mPath, message);
@@ -1009,6 +1016,7 @@ public:
     }
 
 private:
+    /// The separators of ascii arrays (as the whole-buffer reader had them).
     static bool isBlank(char c) { return c == ' ' || c == '\n' || c == '\r' || c == '\t'; }
 
     /// One value into the sink, or a "bad value" fault.
@@ -1187,6 +1195,7 @@ private:
         return std::string();
     }
 
+    /// expat's callbacks, forwarded to the reader they were registered with.
     static void XMLCALL onStart(void* self, const XML_Char* name, const XML_Char** attributes)
     {
         static_cast<VtuReader*>(self)->startElement(name, attributes);
@@ -1200,6 +1209,9 @@ private:
         static_cast<VtuReader*>(self)->text(text, size_t(length));
     }
 
+    /// An element starts: recognise the VTKFile / grid / Piece / Points / PointData /
+    /// DataArray path the reader uses (first grid, first Points and PointData per piece),
+    /// start its checks and decoders, or stop at AppendedData.
     void startElement(const char* name, const XML_Char** attributes)
     {
         if (mQuiet) return;
@@ -1247,6 +1259,8 @@ private:
         mNames.emplace_back(name);
     }
 
+    /// An element ends: finish an inline array, or make the end-of-piece, grid and root
+    /// checks.
     void endElement(const char*)
     {
         if (mQuiet || mKinds.empty()) return;
@@ -1277,6 +1291,7 @@ private:
         }
     }
 
+    /// Character data: fed to the inline array being read, if it is its direct text.
     void text(const char* data, size_t length)
     {
         if (mQuiet || mKinds.empty() || mKinds.back() != Kind::Array || !mArray.sink) return;
@@ -1287,6 +1302,7 @@ private:
         if (!ok) mArray = InlineArray();  // the fault is recorded; skip the rest of its text
     }
 
+    /// The next sequence number, in document order.
     uint64_t nextSeq() { return mNextSeq++; }
 
     /// The VTKFile element: type, byte order, header width and compressor.
