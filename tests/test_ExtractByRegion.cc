@@ -1,0 +1,165 @@
+// SPDX-License-Identifier: Apache-2.0
+/// @file test_ExtractByRegion.cc
+/// @brief Region-by-region extraction (src/SurfaceStages.h, extractByRegion): the very
+///        vertices and polygons of a whole-grid volumeToMesh, stitched exactly at every seam,
+///        the same order at any thread count, and a cancel checked between regions.
+
+#include "TestUtil.h"
+
+#include "../src/SurfaceStages.h"
+
+#include <nonbloppy/Error.h>
+#include <nonbloppy/ExtractSurface.h>
+#include <nonbloppy/ParticleIndex.h>
+#include <nonbloppy/RasterizeDensity.h>
+#include <nonbloppy/ReadParticles.h>
+
+#include <openvdb/util/NullInterrupter.h>
+#include <tbb/task_arena.h>
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <string>
+#include <vector>
+
+using namespace nonbloppy;
+using surface_stages_internal::extractByRegion;
+using nonbloppy_test::messageOf;
+
+namespace {
+
+constexpr double kVoxelSize = 0.025, kRadius = 0.1, kThreshold = 6.666;
+
+/// The density of the real dam-break frame (24,389 particles, 1,000-odd leaves).
+const openvdb::FloatGrid& damBreakDensity()
+{
+    static const openvdb::FloatGrid::Ptr grid = [] {
+        const ParticleSet frame =
+            readParticles(std::string(NONBLOPPY_TEST_DATA_DIR) + "/dam_break_frame_23_24389_particles.vtk");
+        const ParticleIndex index = ParticleIndex::build(frame.positions, kRadius / 2);
+        DensitySettings settings;
+        settings.effectiveRadius = kRadius;
+        settings.voxelSize = kVoxelSize;
+        return rasterizeDensity(index, settings);
+    }();
+    return *grid;
+}
+
+using Quad = std::array<std::array<float, 3>, 4>;
+
+/// Every quad as its four vertex positions, rotated to start at the smallest one (so the
+/// winding is kept), sorted: equal for two meshes with the same polygons in any order.
+std::vector<Quad> canonicalQuads(const SurfaceMesh& mesh)
+{
+    std::vector<Quad> quads;
+    quads.reserve(mesh.quads.size());
+    for (const openvdb::Vec4I& q : mesh.quads) {
+        Quad corners;
+        for (int i = 0; i < 4; ++i) {
+            for (int k = 0; k < 3; ++k) corners[i][k] = mesh.points[q[i]][k];
+        }
+        const int start = int(std::min_element(corners.begin(), corners.end()) - corners.begin());
+        Quad rotated;
+        for (int i = 0; i < 4; ++i) rotated[i] = corners[(start + i) % 4];
+        quads.push_back(rotated);
+    }
+    std::sort(quads.begin(), quads.end());
+    return quads;
+}
+
+/// Stops at its @a stopAt-th question and counts the questions.
+class CountingInterrupter : public openvdb::util::NullInterrupter
+{
+public:
+    explicit CountingInterrupter(int stopAt) : mStopAt(stopAt) {}
+    bool wasInterrupted(int = -1) override { return ++mQuestions >= mStopAt; }
+    int questions() const { return mQuestions; }
+private:
+    int mStopAt;
+    int mQuestions = 0;
+};
+
+} // namespace
+
+TEST(ExtractByRegion, GivesTheVerticesAndPolygonsOfTheWholeGridAtEveryRegionSize)
+{
+    const SurfaceMesh whole = extractSurface(damBreakDensity(), kThreshold);
+    ASSERT_GT(whole.quads.size(), 30000u);
+    const std::vector<Quad> expected = canonicalQuads(whole);
+    // 1 kept leaf per region makes a seam at every leaf layer; 100000 makes one region.
+    for (const size_t leavesPerRegion : {size_t(1), size_t(8), size_t(100), size_t(100000)}) {
+        SurfaceMesh regions;
+        extractByRegion(damBreakDensity(), kThreshold, regions, nullptr, leavesPerRegion);
+        EXPECT_EQ(regions.points.size(), whole.points.size()) << leavesPerRegion << " leaves per region";
+        EXPECT_TRUE(regions.triangles.empty());
+        EXPECT_TRUE(canonicalQuads(regions) == expected) << leavesPerRegion << " leaves per region";
+        // No vertex twice: a seam vertex welded into one.
+        std::vector<std::array<float, 3>> points;
+        for (const openvdb::Vec3s& p : regions.points) points.push_back({p[0], p[1], p[2]});
+        std::sort(points.begin(), points.end());
+        EXPECT_TRUE(std::adjacent_find(points.begin(), points.end()) == points.end());
+    }
+}
+
+TEST(ExtractByRegion, LeavesOutAndTilesLeavesNoCrossingTouchesWithoutChangingTheMesh)
+{
+    // A solid block of particles: a deep interior (tiles after tileDeepInterior(), "above"
+    // leaves in every region) and a thick outer fringe below r_0 (left out).
+    std::vector<openvdb::Vec3f> block;
+    for (int i = 0; i < 48; ++i)
+        for (int j = 0; j < 40; ++j)
+            for (int k = 0; k < 32; ++k)
+                block.emplace_back(0.05f * float(i), 0.05f * float(j), 0.05f * float(k));
+    const ParticleIndex index = ParticleIndex::build(block, kRadius / 2);
+    DensitySettings settings;
+    settings.effectiveRadius = kRadius;
+    settings.voxelSize = kVoxelSize;
+    const openvdb::FloatGrid::Ptr density = rasterizeDensity(index, settings);
+    const std::vector<Quad> expected = canonicalQuads(extractSurface(*density, kThreshold));
+    ASSERT_GT(expected.size(), 10000u);
+    SurfaceMesh regions;
+    extractByRegion(*density, kThreshold, regions, nullptr, 16);
+    EXPECT_TRUE(canonicalQuads(regions) == expected);
+
+    openvdb::FloatGrid::Ptr tiled = density->deepCopy();
+    ASSERT_GT(tileDeepInterior(*tiled, kThreshold), 0u);
+    extractByRegion(*tiled, kThreshold, regions, nullptr, 16);
+    EXPECT_TRUE(canonicalQuads(regions) == expected);
+}
+
+TEST(ExtractByRegion, SameOrderAtOneAndTwoThreads)
+{
+    SurfaceMesh one, two;
+    tbb::task_arena(1).execute([&] { extractByRegion(damBreakDensity(), kThreshold, one, nullptr, 64); });
+    tbb::task_arena(2).execute([&] { extractByRegion(damBreakDensity(), kThreshold, two, nullptr, 64); });
+    ASSERT_EQ(one.points.size(), two.points.size());
+    EXPECT_TRUE(one.points == two.points);
+    EXPECT_TRUE(one.quads == two.quads);
+}
+
+TEST(ExtractByRegion, AsksTheInterrupterBetweenRegionsAndStops)
+{
+    CountingInterrupter never(1 << 30);
+    SurfaceMesh mesh;
+    extractByRegion(damBreakDensity(), kThreshold, mesh, &never, 50);
+    // Once before the work and once before each region: the frame's 400-odd leaves that a
+    // crossing touches make eight regions of 50 or more (a region ends on a whole layer).
+    EXPECT_GE(never.questions(), 9);
+
+    CountingInterrupter third(3);
+    EXPECT_EQ(messageOf<CancelledError>([&] {
+        extractByRegion(damBreakDensity(), kThreshold, mesh, &third, 50);
+    }), "interrupted during extract surface");
+    EXPECT_EQ(third.questions(), 3);
+}
+
+TEST(ExtractByRegion, RejectsANonFiniteThreshold)
+{
+    SurfaceMesh mesh;
+    EXPECT_EQ(messageOf<ParameterError>([&] {
+        extractByRegion(damBreakDensity(), std::nan(""), mesh, nullptr, 100);
+    }), "--threshold must be finite, got nan");
+}
