@@ -39,6 +39,7 @@
 #include <map>
 #include <memory>
 #include <sstream>
+#include <type_traits>
 
 namespace nonbloppy {
 namespace io_internal {
@@ -296,24 +297,27 @@ public:
 
         // Pass 1: descriptors and array metadata. A header with bit 0 set makes its leaf's
         // descriptor the one of every later leaf (none of them stores one); bit 1 announces a
-        // block of bytes to skip, which OpenVDB reads into a vector of that size.
-        std::vector<std::vector<ArrayLayout>> leaves(mLeafCount);
+        // block of bytes to skip, which OpenVDB reads into a vector of that size. The arrays
+        // of all leaves go into one vector, leaf after leaf (firstArray[leaf] is where each
+        // leaf's start).
+        std::vector<ArrayLayout> arrays;
+        std::vector<size_t> firstArray;
+        firstArray.reserve(size_t(mLeafCount) + 1);
         std::shared_ptr<const LeafDescriptor> descriptor;
         bool shared = false;
         size_t attributes = 0;  // the most attributes of a leaf
         for (uint64_t leaf = 0; leaf < mLeafCount; ++leaf) {
-            const std::string where = "leaf " + std::to_string(leaf) + " of " + grid;
+            const auto where = [&] { return "leaf " + std::to_string(leaf) + " of " + grid; };
             if (!shared) {
-                need(1, where);
-                const uint8_t header = mData[mPos++];
+                const uint8_t header = u8(where);
                 if (header > 3) {
-                    corrupt("unknown header flags " + std::to_string(header) + " in " + where);
+                    corrupt("unknown header flags " + std::to_string(header) + " in " + where());
                 }
-                descriptor = attributeDescriptor("attribute descriptor of " + where);
+                descriptor = attributeDescriptor("attribute descriptor of " + where());
                 if (header & 2) {
                     const uint64_t bytes = u64(where);
                     if (bytes > left()) {
-                        corrupt("block to skip in " + where + " claims " + std::to_string(bytes) +
+                        corrupt("block to skip in " + where() + " claims " + std::to_string(bytes) +
                                 " bytes, " + std::to_string(left()) + " left");
                     }
                     mPos += size_t(bytes);
@@ -321,12 +325,18 @@ public:
                 shared = header & 1;
             }
             attributes = std::max(attributes, descriptor->storageBytes.size());
-            leaves[leaf].reserve(descriptor->storageBytes.size());
+            firstArray.push_back(arrays.size());
             for (size_t a = 0; a < descriptor->storageBytes.size(); ++a) {
-                leaves[leaf].push_back(arrayMetadata(descriptor->storageBytes[a],
-                    "attribute '" + printable(descriptor->names[a]) + "' of " + where));
+                arrays.push_back(arrayMetadata(descriptor->storageBytes[a], [&] {
+                    return "attribute '" + printable(descriptor->names[a]) + "' of " + where();
+                }));
             }
         }
+        firstArray.push_back(arrays.size());
+        const auto arrayOf = [&](uint64_t leaf, size_t a) -> ArrayLayout* {
+            const size_t first = firstArray[size_t(leaf)];
+            return a < firstArray[size_t(leaf) + 1] - first ? &arrays[first + a] : nullptr;
+        };
         // Passes beyond the attributes read nothing; fewer would leave arrays unread. (A tree
         // without leaves is written with no passes.)
         if (mLeafCount > 0 && passes < 4 + 2 * attributes) {
@@ -345,22 +355,24 @@ public:
         for (size_t a = 0; a < attributes; ++a) {
             uint64_t used = 0, pageBytes = 0;
             for (uint64_t leaf = 0; leaf < mLeafCount; ++leaf) {
-                if (a >= leaves[leaf].size() || !leaves[leaf][a].paged) continue;
-                ArrayLayout& array = leaves[leaf][a];
-                const std::string where = "attribute " + std::to_string(a) + " of leaf " +
-                                          std::to_string(leaf) + " of " + grid;
+                ArrayLayout* array = arrayOf(leaf, a);
+                if (!array || !array->paged) continue;
+                const auto where = [&] {
+                    return "attribute " + std::to_string(a) + " of leaf " + std::to_string(leaf) +
+                           " of " + grid;
+                };
                 if (used == pageBytes) {
-                    pages[a].push_back(pageHeader("page header of " + where));
+                    pages[a].push_back(pageHeader([&] { return "page header of " + where(); }));
                     pageBytes = pages[a].back().uncompressedBytes;
                     used = 0;
                 }
-                array.page = pages[a].size() - 1;
-                if (array.bytes > pageBytes - used) {
-                    corrupt("array of " + std::to_string(array.bytes) + " bytes in " + where +
+                array->page = pages[a].size() - 1;
+                if (array->bytes > pageBytes - used) {
+                    corrupt("array of " + std::to_string(array->bytes) + " bytes in " + where() +
                             " runs past its page (" + std::to_string(pageBytes - used) +
                             " bytes left in it)");
                 }
-                used += array.bytes;
+                used += array->bytes;
             }
             if (used != pageBytes) {
                 corrupt("last page of attribute " + std::to_string(a) + " in " + what + " holds " +
@@ -371,7 +383,9 @@ public:
         // Pass A+2: each leaf's value mask and point offsets (io::readCompressedValues for
         // PointDataIndex32: a 16-bit size, 0xffff for 2048 raw bytes, else a Blosc chunk).
         for (uint64_t leaf = 0; leaf < mLeafCount; ++leaf) {
-            const std::string where = "point offsets of leaf " + std::to_string(leaf) + " of " + grid;
+            const auto where = [&] {
+                return "point offsets of leaf " + std::to_string(leaf) + " of " + grid;
+            };
             skip(64, where);
             const uint16_t bytes = u16(where);
             if (bytes == std::numeric_limits<uint16_t>::max()) skip(2048, where);
@@ -383,29 +397,30 @@ public:
         for (size_t a = 0; a < attributes; ++a) {
             size_t nextPage = 0;
             for (uint64_t leaf = 0; leaf < mLeafCount; ++leaf) {
-                if (a >= leaves[leaf].size()) continue;
-                const ArrayLayout& array = leaves[leaf][a];
-                const std::string where = "attribute " + std::to_string(a) + " of leaf " +
-                                          std::to_string(leaf) + " of " + grid;
-                if (array.paged) {
-                    if (array.page == nextPage) pageData(pages[a][nextPage++], "page of " + where);
+                const ArrayLayout* array = arrayOf(leaf, a);
+                if (!array) continue;
+                const auto where = [&] {
+                    return "attribute " + std::to_string(a) + " of leaf " + std::to_string(leaf) +
+                           " of " + grid;
+                };
+                if (array->paged) {
+                    if (array->page == nextPage) {
+                        pageData(pages[a][nextPage++], [&] { return "page of " + where(); });
+                    }
                     continue;
                 }
                 // TypedAttributeArray::readBuffers(): a non-uniform array says whether it is
                 // Blosc-compressed; raw bytes become the array as they are.
-                bool blosc = false;
-                if (!array.uniform) {
-                    need(1, where);
-                    blosc = mData[mPos++] == 1;
-                }
+                const auto data = [&] { return "data of " + where(); };
+                const bool blosc = !array->uniform && u8(data) == 1;
                 if (blosc) {
-                    bloscChunk(array.bytes, array.expectedBytes, "data of " + where);
+                    bloscChunk(array->bytes, array->expectedBytes, data);
                 } else {
-                    if (array.bytes != array.expectedBytes) {
-                        corrupt("data of " + where + " has " + std::to_string(array.bytes) +
-                                " bytes, expected " + std::to_string(array.expectedBytes));
+                    if (array->bytes != array->expectedBytes) {
+                        corrupt(data() + " has " + std::to_string(array->bytes) + " bytes, expected " +
+                                std::to_string(array->expectedBytes));
                     }
-                    skip(array.bytes, "data of " + where);
+                    skip(array->bytes, data);
                 }
             }
         }
@@ -490,42 +505,43 @@ public:
     /// or the total size when the stride varies, as OpenVDB's 32-bit dataSize() computes it)
     /// times @a storageBytes; a paged array's byte count must say exactly that, since it is
     /// all OpenVDB copies out of the page for it.
-    ArrayLayout arrayMetadata(size_t storageBytes, const std::string& where)
+    template<typename WhatT>
+    ArrayLayout arrayMetadata(size_t storageBytes, const WhatT& where)
     {
         using openvdb::points::AttributeArray;
-        const uint64_t bytes = u64("metadata of " + where);
-        need(2, "metadata of " + where);
-        const uint8_t flags = mData[mPos++];
-        const uint8_t serialization = mData[mPos++];
-        const uint32_t size = u32("metadata of " + where);
-        if (bytes < 6) corrupt(where + " claims " + std::to_string(bytes) + " bytes, less than its header");
+        const auto metadata = [&] { return "metadata of " + where(); };
+        const uint64_t bytes = u64(metadata);
+        const uint8_t flags = u8(metadata);
+        const uint8_t serialization = u8(metadata);
+        const uint32_t size = u32(metadata);
+        if (bytes < 6) corrupt(where() + " claims " + std::to_string(bytes) + " bytes, less than its header");
         // Flags from 0x20 up are not OpenVDB's (0x20 is its own "partially read" state).
         if (flags >= AttributeArray::PARTIALREAD) {
-            corrupt(where + " has unknown flags " + std::to_string(flags));
+            corrupt(where() + " has unknown flags " + std::to_string(flags));
         }
         if (serialization >= 2 * AttributeArray::WRITEPAGED) {
-            corrupt(where + " has unknown serialization flags " + std::to_string(serialization));
+            corrupt(where() + " has unknown serialization flags " + std::to_string(serialization));
         }
         uint32_t strideOrTotal = 1;
-        if (serialization & AttributeArray::WRITESTRIDED) strideOrTotal = u32("metadata of " + where);
+        if (serialization & AttributeArray::WRITESTRIDED) strideOrTotal = u32(metadata);
         ArrayLayout array;
         array.bytes = bytes - 6;
         array.paged = serialization & AttributeArray::WRITEPAGED;
         array.uniform = serialization & AttributeArray::WRITEUNIFORM;
         const bool constantStride = flags & AttributeArray::CONSTANTSTRIDE;
         if (size == 0 || strideOrTotal == 0 || (!constantStride && strideOrTotal < size)) {
-            corrupt(where + " has size " + std::to_string(size) + " and " +
+            corrupt(where() + " has size " + std::to_string(size) + " and " +
                     (constantStride ? "stride " : "total size ") + std::to_string(strideOrTotal));
         }
         const uint64_t values = array.uniform ? 1
                               : constantStride ? uint64_t(size) * strideOrTotal : strideOrTotal;
         if (values > std::numeric_limits<uint32_t>::max()) {
-            corrupt(where + " has " + std::to_string(size) + " values of stride " +
+            corrupt(where() + " has " + std::to_string(size) + " values of stride " +
                     std::to_string(strideOrTotal) + ", more than 2^32");
         }
         array.expectedBytes = values * storageBytes;
         if (array.paged && array.bytes != array.expectedBytes) {
-            corrupt(where + " claims " + std::to_string(array.bytes) + " bytes, expected " +
+            corrupt(where() + " claims " + std::to_string(array.bytes) + " bytes, expected " +
                     std::to_string(array.expectedBytes) + " for " + std::to_string(values) +
                     " values of " + std::to_string(storageBytes) + " bytes");
         }
@@ -541,18 +557,19 @@ public:
     };
 
     /// compression::Page::readHeader(), which asserts that neither size is 0.
-    PageLayout pageHeader(const std::string& where)
+    template<typename WhatT>
+    PageLayout pageHeader(const WhatT& where)
     {
         PageLayout page;
         page.compressedBytes = int32_t(u32(where));
         if (page.compressedBytes > 0) {
             const int32_t uncompressed = int32_t(u32(where));
             if (uncompressed <= 0) {
-                corrupt(where + " gives uncompressed size " + std::to_string(uncompressed));
+                corrupt(where() + " gives uncompressed size " + std::to_string(uncompressed));
             }
             page.uncompressedBytes = uint64_t(uncompressed);
         } else if (page.compressedBytes == 0 || page.compressedBytes == std::numeric_limits<int32_t>::min()) {
-            corrupt(where + " gives compressed size " + std::to_string(page.compressedBytes));
+            corrupt(where() + " gives compressed size " + std::to_string(page.compressedBytes));
         } else {
             page.uncompressedBytes = uint64_t(-int64_t(page.compressedBytes));
         }
@@ -560,7 +577,8 @@ public:
     }
 
     /// compression::Page::readBuffers(): the page's bytes, raw or one Blosc chunk.
-    void pageData(const PageLayout& page, const std::string& where)
+    template<typename WhatT>
+    void pageData(const PageLayout& page, const WhatT& where)
     {
         if (page.compressedBytes < 0) skip(page.uncompressedBytes, where);
         else bloscChunk(uint64_t(page.compressedBytes), page.uncompressedBytes, where);
@@ -574,11 +592,12 @@ public:
     /// compression::BLOSC_PAD_BYTES to that length with zeros before compressing them.)
     /// Blosc's codecs do not compress more than 1032:1 (deflate's limit; OpenVDB writes LZ4,
     /// at most about 255:1), which bounds what a small file can make OpenVDB allocate.
-    void bloscChunk(uint64_t bytes, uint64_t uncompressed, const std::string& where)
+    template<typename WhatT>
+    void bloscChunk(uint64_t bytes, uint64_t uncompressed, const WhatT& where)
     {
         need(bytes, where);
         if (bytes < 16) {
-            corrupt("Blosc chunk of " + std::to_string(bytes) + " bytes in " + where +
+            corrupt("Blosc chunk of " + std::to_string(bytes) + " bytes in " + describe(where) +
                     " is shorter than its header");
         }
         uint32_t header[3];
@@ -588,12 +607,12 @@ public:
         // Blosc divides by the block size and allocates by it; it writes 1 for no bytes.
         if ((header[0] != uncompressed && !padded) || header[2] != bytes || header[1] == 0
             || header[1] > std::max<uint32_t>(header[0], 1)) {
-            corrupt("Blosc chunk in " + where + " says " + std::to_string(header[0]) + " bytes from " +
+            corrupt("Blosc chunk in " + describe(where) + " says " + std::to_string(header[0]) + " bytes from " +
                     std::to_string(header[2]) + " in blocks of " + std::to_string(header[1]) +
                     "; expected " + std::to_string(uncompressed) + " bytes from " + std::to_string(bytes));
         }
         if (uncompressed / 1032 > bytes) {
-            corrupt("Blosc chunk in " + where + " claims " + std::to_string(uncompressed) +
+            corrupt("Blosc chunk in " + describe(where) + " claims " + std::to_string(uncompressed) +
                     " bytes from " + std::to_string(bytes) + ", more than 1032:1");
         }
         mPos += size_t(bytes);
@@ -736,7 +755,11 @@ public:
         return n;
     }
 
-    uint64_t u64(const std::string& what)
+    /// The readers below name what they read for the error message with @a what: a string,
+    /// or (in the per-leaf walk, run for every leaf) a callable returning one, called only
+    /// when there is an error to report.
+    template<typename WhatT>
+    uint64_t u64(const WhatT& what)
     {
         need(8, what);
         uint64_t value;
@@ -745,7 +768,8 @@ public:
         return value;
     }
 
-    uint16_t u16(const std::string& what)
+    template<typename WhatT>
+    uint16_t u16(const WhatT& what)
     {
         need(2, what);
         uint16_t value;
@@ -755,7 +779,8 @@ public:
     }
 
     /// Also used for the grid count.
-    uint32_t u32(const std::string& what)
+    template<typename WhatT>
+    uint32_t u32(const WhatT& what)
     {
         need(4, what);
         uint32_t value;
@@ -772,20 +797,36 @@ public:
     }
 
 private:
-    void need(uint64_t bytes, const std::string& what) const
+    template<typename WhatT>
+    static std::string describe(const WhatT& what)
     {
-        if (bytes > left()) corrupt("truncated " + what);
+        if constexpr (std::is_invocable_v<const WhatT&>) return what();
+        else return std::string(what);
     }
-    void skip(uint64_t bytes, const std::string& what)
+
+    template<typename WhatT>
+    void need(uint64_t bytes, const WhatT& what) const
+    {
+        if (bytes > left()) corrupt("truncated " + describe(what));
+    }
+    template<typename WhatT>
+    void skip(uint64_t bytes, const WhatT& what)
     {
         need(bytes, what);
         mPos += size_t(bytes);
     }
-    std::string string(const std::string& what)
+    template<typename WhatT>
+    uint8_t u8(const WhatT& what)
+    {
+        need(1, what);
+        return mData[mPos++];
+    }
+    template<typename WhatT>
+    std::string string(const WhatT& what)
     {
         const uint32_t length = u32(what);
         if (length > left()) {
-            corrupt(what + " claims " + std::to_string(length) + " bytes, " +
+            corrupt(describe(what) + " claims " + std::to_string(length) + " bytes, " +
                     std::to_string(left()) + " left");
         }
         std::string text(reinterpret_cast<const char*>(mData + mPos), length);
