@@ -23,7 +23,7 @@ cd "$(dirname "$0")/../.."
 seconds="${1:-60}"
 shift || true
 targets=("$@")
-((${#targets[@]})) || targets=(bgeo vtu table json vdb_points vtk ply vtk_file ply_file)
+((${#targets[@]})) || targets=(bgeo vtu table json vdb_points vtk ply vtk_file ply_file bgeo_file table_file json_file)
 build_dir="${BUILD_DIR:-/tmp/nonbloppy-fuzz-build}"
 out="${OUT:-/tmp/nonbloppy-fuzz}"
 parallel="${PARALLEL:-1}"
@@ -36,10 +36,10 @@ cmake --build "$build_dir" -j"${JOBS:-1}" --target $(printf 'fuzz_%s ' "${target
 # Seeds per target: the data files it reads, the hand-made seeds, and the regression files.
 seeds_for() {
   case "$1" in
-    bgeo) echo "tests/data/*.bgeo tests/fuzz/seeds/*.bgeo tests/data/fuzz/*.bgeo" ;;
+    bgeo|bgeo_file) echo "tests/data/*.bgeo tests/fuzz/seeds/*.bgeo tests/data/fuzz/*.bgeo" ;;
     vtu) echo "tests/data/*.vtu tests/fuzz/seeds/*.vtu tests/data/fuzz/*.vtu" ;;
-    table) echo "tests/fuzz/seeds/*.csv tests/fuzz/seeds/*.txt tests/data/fuzz/*.csv tests/data/fuzz/*.txt" ;;
-    json) echo "tests/fuzz/seeds/*.json tests/data/fuzz/*.json" ;;
+    table|table_file) echo "tests/fuzz/seeds/*.csv tests/fuzz/seeds/*.txt tests/data/fuzz/*.csv tests/data/fuzz/*.txt" ;;
+    json|json_file) echo "tests/fuzz/seeds/*.json tests/data/fuzz/*.json" ;;
     vdb_points) echo "tests/fuzz/seeds/*.vdb tests/data/fuzz/*.vdb" ;;
     vtk|vtk_file) echo "tests/data/cube_8_particles.vtk tests/data/free_particles_125_particles.vtk tests/data/fuzz/*.vtk" ;;
     ply|ply_file) echo "tests/fuzz/seeds/*.ply tests/data/fuzz/*.ply" ;;
