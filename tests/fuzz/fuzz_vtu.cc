@@ -14,6 +14,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <string>
 
 namespace {
@@ -31,11 +32,16 @@ outcomeOf(ReadT&& read, nonbloppy::ParticleSet& out)
     }
 }
 
-/// True if @a a and @a b hold the same positions and attributes, byte for byte.
+/// True if @a a and @a b hold the same positions and attributes, byte for byte (NaN
+/// coordinates included, which compare unequal as values).
 bool
 sameParticles(const nonbloppy::ParticleSet& a, const nonbloppy::ParticleSet& b)
 {
-    if (a.positions != b.positions || a.attributes.size() != b.attributes.size()) return false;
+    if (a.positions.size() != b.positions.size() || a.attributes.size() != b.attributes.size()
+        || (!a.positions.empty() && std::memcmp(a.positions.data(), b.positions.data(),
+                                                a.positions.size() * sizeof(a.positions[0])) != 0)) {
+        return false;
+    }
     for (size_t k = 0; k < a.attributes.size(); ++k) {
         const nonbloppy::ParticleAttribute& x = a.attributes[k];
         const nonbloppy::ParticleAttribute& y = b.attributes[k];
