@@ -20,9 +20,11 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <memory>
 #include <unordered_map>
 #include <utility>
 #include <sstream>
@@ -231,10 +233,11 @@ std::vector<std::pair<int, int>> slabsOf(const std::vector<int>& keptPerLayer, s
 }
 
 /// Planes of voxels a slab's shell keeps beyond each face of the slab. A quad claimed by a
-/// slab has its centroid in the slab, so its cells lie at most two voxels outside it and
-/// their corners at most three; the voxels beyond are dropped, and the false crossings that
-/// the cut makes lie far enough out that no claimed quad uses them.
-constexpr int kShellPlanes = 3;
+/// slab has its centroid in the slab, so its cells lie at most two voxels below the slab or
+/// one above it, and their corners at most two planes out either side. The voxels beyond
+/// are dropped; the false crossings the cut makes give quads whose centroids lie at least
+/// half a voxel outside the slab, which it never claims.
+constexpr int kShellPlanes = 2;
 
 /// See the comment above LeafRole. Returns false (and does nothing) when the grid has tiles
 /// larger than a leaf or makes a single slab; otherwise fills @a mesh, oriented outwards.
@@ -285,7 +288,10 @@ bool extractByRegionImpl(const openvdb::FloatGrid& density, double threshold, Su
     // Vertices near the seam with the next slab, by exact position, and their mesh index.
     std::unordered_map<PositionKey, uint32_t, PositionKeyHash> seam;
     std::vector<uint32_t> remap;
-    std::vector<uint8_t> used;
+    std::unique_ptr<std::atomic<uint8_t>[]> used;
+    std::vector<size_t> newBefore;
+    size_t totalKept = 0;
+    for (int count : keptPerLayer) totalKept += size_t(count);
     std::vector<size_t> claimedBefore;
     constexpr uint32_t kNew = std::numeric_limits<uint32_t>::max();
     for (size_t s = 0; s < slabs.size(); ++s) {
@@ -346,6 +352,16 @@ bool extractByRegionImpl(const openvdb::FloatGrid& density, double threshold, Su
             });
         for (size_t p = 0; p < poolCount; ++p) claimedBefore[p + 1] += claimedBefore[p];
         const size_t quadBase = mesh.quads.size();
+        if (first) {
+            // Room for the whole mesh, extrapolated from this slab's share of the kept leaves
+            // (closed surfaces have about as many vertices as quads), so that the arrays are
+            // seldom moved while they grow.
+            size_t keptHere = 0;
+            for (int layer = slabs[s].first; layer < slabs[s].second; ++layer) keptHere += size_t(keptPerLayer[size_t(layer)]);
+            const double expected = 1.05 * double(claimedBefore[poolCount]) * double(totalKept) / double(std::max<size_t>(keptHere, 1));
+            mesh.quads.reserve(size_t(expected));
+            mesh.points.reserve(size_t(expected));
+        }
         mesh.quads.resize(quadBase + claimedBefore[poolCount]);
         tbb::parallel_for(tbb::blocked_range<size_t>(0, poolCount),
             [&](const tbb::blocked_range<size_t>& range) {
@@ -361,10 +377,14 @@ bool extractByRegionImpl(const openvdb::FloatGrid& density, double threshold, Su
         // The claimed quads' vertices, welded by exact position to the previous slab's
         // near the seam (a cell's vertices are the same bits in every grid holding its corners).
         const size_t pointCount = mesher.pointListSize();
-        used.assign(pointCount, 0);
-        for (size_t q = quadBase; q < mesh.quads.size(); ++q) {
-            for (int k = 0; k < 4; ++k) used[mesh.quads[q][k]] = 1;
-        }
+        used.reset(new std::atomic<uint8_t>[pointCount]());
+        tbb::parallel_for(tbb::blocked_range<size_t>(quadBase, mesh.quads.size()),
+            [&](const tbb::blocked_range<size_t>& range) {
+                for (size_t q = range.begin(); q < range.end(); ++q) {
+                    for (int k = 0; k < 4; ++k) used[mesh.quads[q][k]].store(1, std::memory_order_relaxed);
+                }
+            });
+        const auto isUsed = [&](size_t n) { return used[n].load(std::memory_order_relaxed) != 0; };
         // Shared cells lie within two voxels of the seam: look up only the vertices there.
         const double weldBelow = worldOf(slabBegin + 2), keepFrom = worldOf(slabEnd - 3);
         remap.assign(pointCount, kNew);
@@ -372,28 +392,49 @@ bool extractByRegionImpl(const openvdb::FloatGrid& density, double threshold, Su
             tbb::parallel_for(tbb::blocked_range<size_t>(0, pointCount),
                 [&](const tbb::blocked_range<size_t>& range) {
                     for (size_t n = range.begin(); n < range.end(); ++n) {
-                        if (!used[n] || !(double(points[n][axis]) < weldBelow)) continue;
+                        if (!isUsed(n) || !(double(points[n][axis]) < weldBelow)) continue;
                         const auto found = seam.find(keyOf(points[n]));
                         if (found != seam.end()) remap[n] = found->second;
                     }
                 });
         }
-        size_t pointBase = mesh.points.size();
-        for (size_t n = 0; n < pointCount; ++n) {
-            if (used[n] && remap[n] == kNew) remap[n] = uint32_t(pointBase++);
-        }
+        // New vertices numbered in slab order: a count per block, then its prefix sum.
+        constexpr size_t kBlock = 16384;
+        const size_t blocks = (pointCount + kBlock - 1) / kBlock;
+        newBefore.assign(blocks + 1, 0);
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, blocks),
+            [&](const tbb::blocked_range<size_t>& range) {
+                for (size_t b = range.begin(); b < range.end(); ++b) {
+                    size_t count = 0;
+                    for (size_t n = b * kBlock, end = std::min(n + kBlock, pointCount); n < end; ++n) {
+                        count += isUsed(n) && remap[n] == kNew;
+                    }
+                    newBefore[b + 1] = count;
+                }
+            });
+        for (size_t b = 0; b < blocks; ++b) newBefore[b + 1] += newBefore[b];
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, blocks),
+            [&](const tbb::blocked_range<size_t>& range) {
+                for (size_t b = range.begin(); b < range.end(); ++b) {
+                    uint32_t next = uint32_t(mesh.points.size() + newBefore[b]);
+                    for (size_t n = b * kBlock, end = std::min(n + kBlock, pointCount); n < end; ++n) {
+                        if (isUsed(n) && remap[n] == kNew) remap[n] = next++;
+                    }
+                }
+            });
+        const size_t pointBase = mesh.points.size() + newBefore[blocks];
         const size_t firstNew = mesh.points.size();
         mesh.points.resize(pointBase);
         tbb::parallel_for(tbb::blocked_range<size_t>(0, pointCount),
             [&](const tbb::blocked_range<size_t>& range) {
                 for (size_t n = range.begin(); n < range.end(); ++n) {
-                    if (used[n] && remap[n] >= firstNew) mesh.points[remap[n]] = points[n];
+                    if (isUsed(n) && remap[n] >= firstNew) mesh.points[remap[n]] = points[n];
                 }
             });
         seam.clear();
         if (!last) {
             for (size_t n = 0; n < pointCount; ++n) {
-                if (used[n] && double(points[n][axis]) >= keepFrom) seam.emplace(keyOf(points[n]), remap[n]);
+                if (isUsed(n) && double(points[n][axis]) >= keepFrom) seam.emplace(keyOf(points[n]), remap[n]);
             }
         }
         // Mesh indices, each polygon reversed (see orientOutwards()).

@@ -62,7 +62,7 @@ enum class UnrelaxedBuffer
 /// rasterize density (metadata holding the parameters), extract surface (into result.mesh's
 /// vectors, which keep their capacity), relax vertices, fold repair, compute normals and the
 /// volume correction, timing each in result.timings. result.density is reset when
-/// @a keepDensity is false (its deep interior is tiled before extraction, the same mesh).
+/// @a keepDensity is false.
 /// @param index        the frame's particle index, cell size kCellOverRadius·r_e
 /// @param unrelaxed    scratch for the vertex positions before relaxation (fold repair)
 /// @param whenRepaired whether @a unrelaxed is freed or kept once fold repair is done
