@@ -8,7 +8,8 @@
 /// (about 0.1 ms of work at ~10 ns per item). OpenVDB's volumeToMesh and
 /// createPointIndexGrid take no interrupter and cannot be stopped safely from outside
 /// (cancelling their TBB context leaves uninitialised counts that they then allocate
-/// from), so they are only checked before and after.
+/// from), so they are only checked before and after; the extraction stage therefore calls
+/// volumeToMesh on slabs of the grid (extractByRegion() in SurfaceStages.h).
 
 #ifndef NONBLOPPY_CANCELLATION_H
 #define NONBLOPPY_CANCELLATION_H

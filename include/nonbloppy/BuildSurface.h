@@ -43,8 +43,9 @@ struct SurfaceResult
 /// @param interrupter  optional; every stage is announced with start(name) … end() under
 ///                     the names of the timings, and every loop of nonbloppy's own asks
 ///                     wasInterrupted() about every 0.1 ms of work (see each stage's
-///                     header). Not interruptible: OpenVDB's volumeToMesh (all of "extract
-///                     surface" but the deep-interior tiling) and its point partitioner
+///                     header). "extract surface" meshes slabs of about 4096 leaves
+///                     and asks between them (volumeToMesh itself takes no
+///                     interrupter). Not interruptible: OpenVDB's point partitioner
 ///                     (part of "index particles" and of "estimate parameters"), the
 ///                     threshold calibration (~10 ms) and measureMesh() in the volume
 ///                     correction. A stop throws CancelledError("interrupted during

@@ -25,8 +25,9 @@ namespace nonbloppy {
 /// Cost: O(active voxels), parallel inside OpenVDB; deterministic. Not interruptible:
 /// volumeToMesh takes no interrupter, and stopping it through its TBB context is unsafe
 /// (its serial steps then size arrays from uninitialised counts: measured, up to 1.4·10⁹
-/// points allocated and zeroed). buildSurface() checks before and after it, so this is the
-/// longest wait for a cancel (the whole extraction, see BuildSurface.h).
+/// points allocated and zeroed). buildSurface() and SurfaceReconstructor therefore mesh
+/// their own density grids slab by slab, asking the interrupter in between; the result has
+/// the same vertices and polygons as this function's, in another order.
 /// Thread-safety: reentrant; the grid is only read.
 /// @throw ParameterError if adaptivity lies outside [0,1] or threshold is not finite.
 NONBLOPPY_API SurfaceMesh extractSurface(const openvdb::FloatGrid& density, double threshold,
