@@ -9,9 +9,9 @@
 /// the reader never opens the file twice and the fuzz target can feed it bytes; before
 /// OpenVDB reads a header, metadata, grid descriptor, transform or a PointDataGrid's tree
 /// and leaf buffers, every size in it is checked against the bytes present and against what
-/// it describes (VdbSizeCheck), and grids
-/// that are not needed are skipped unread when the file says where they end. Points are
-/// visited leaf by leaf in tree order, so the particle order is the same on every run.
+/// it describes (VdbSizeCheck), and grids that are not needed are skipped unread when the
+/// file says where they end. Points are visited leaf by leaf in tree order, so the particle
+/// order is the same on every run.
 
 #include "FileFormats.h"
 #include "ParticleReaders.h"
