@@ -107,13 +107,14 @@ bool neighbourFaceIs(const openvdb::FloatTree& tree, const FloatLeaf& leaf, int 
     origin[axis] += dir * int(FloatLeaf::DIM);
     const FloatLeaf* neighbour = tree.probeConstLeaf(origin);
     if (!neighbour) return (tree.getValue(origin) < iso) == below;
+    const float* values = neighbour->buffer().data();
     openvdb::Coord local;
     local[axis] = dir > 0 ? 0 : int(FloatLeaf::DIM) - 1;
     for (int u = 0; u < int(FloatLeaf::DIM); ++u) {
         for (int v = 0; v < int(FloatLeaf::DIM); ++v) {
             local[(axis + 1) % 3] = u;
             local[(axis + 2) % 3] = v;
-            if ((neighbour->getValue(FloatLeaf::coordToOffset(local)) < iso) != below) return false;
+            if ((values[FloatLeaf::coordToOffset(local)] < iso) != below) return false;
         }
     }
     return true;
@@ -126,10 +127,16 @@ bool neighbourFaceIs(const openvdb::FloatTree& tree, const FloatLeaf& leaf, int 
 LeafRole roleOf(const openvdb::FloatTree& tree, const FloatLeaf& leaf, float iso, float& minValue)
 {
     const float* values = leaf.buffer().data();
-    const auto [low, high] = std::minmax_element(values, values + FloatLeaf::SIZE);
-    minValue = *low;
-    const bool allBelow = *high < iso;
-    const bool allAbove = !(*low < iso);
+    // Counts rather than min/max: a branch-free loop the compiler vectorises.
+    openvdb::Index below = 0;
+    float low = values[0];
+    for (openvdb::Index i = 0; i < FloatLeaf::SIZE; ++i) {
+        below += values[i] < iso;
+        low = std::min(low, values[i]);
+    }
+    minValue = low;
+    const bool allBelow = below == FloatLeaf::SIZE;
+    const bool allAbove = below == 0;
     if (!allBelow && !allAbove) return LeafRole::Kept;
     if (allBelow && !(tree.background() < iso)) return LeafRole::Kept;
     for (int axis = 0; axis < 3; ++axis) {
