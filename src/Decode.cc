@@ -96,19 +96,6 @@ inflateZlib(const unsigned char* data, size_t size, size_t expectedSize,
 
 namespace {
 
-/// 0..63 for base64 characters, 64 for '=', 65 for whitespace, 255 otherwise.
-int
-base64Value(unsigned char c)
-{
-    if (c >= 'A' && c <= 'Z') return c - 'A';
-    if (c >= 'a' && c <= 'z') return c - 'a' + 26;
-    if (c >= '0' && c <= '9') return c - '0' + 52;
-    if (c == '+') return 62;
-    if (c == '/') return 63;
-    if (c == '=') return 64;
-    if (c == ' ' || c == '\n' || c == '\r' || c == '\t') return 65;
-    return 255;
-}
 
 } // namespace
 

@@ -64,6 +64,20 @@ private:
     size_t mPendingPos = 0;
 };
 
+/// 0..63 for base64 characters, 64 for '=', 65 for the white space VTK puts between lines,
+/// 255 for anything else.
+inline int base64Value(unsigned char c)
+{
+    if (c >= 'A' && c <= 'Z') return c - 'A';
+    if (c >= 'a' && c <= 'z') return c - 'a' + 26;
+    if (c >= '0' && c <= '9') return c - '0' + 52;
+    if (c == '+') return 62;
+    if (c == '/') return 63;
+    if (c == '=') return 64;
+    if (c == ' ' || c == '\n' || c == '\r' || c == '\t') return 65;
+    return 255;
+}
+
 /// Decode a whole base64 text (segments as in Base64Reader).
 std::vector<unsigned char> decodeBase64(std::string_view text, const std::string& path,
                                         const std::string& what);

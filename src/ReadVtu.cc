@@ -626,21 +626,6 @@ private:
     std::vector<unsigned char> mBlockBytes;  ///< the compressed block, with mWholeBlocks
 };
 
-/// 0..63 for base64 characters, 64 for '=', 65 for the white space VTK puts between lines,
-/// 255 for anything else.
-inline int
-base64Value(unsigned char c)
-{
-    if (c >= 'A' && c <= 'Z') return c - 'A';
-    if (c >= 'a' && c <= 'z') return c - 'a' + 26;
-    if (c >= '0' && c <= '9') return c - '0' + 52;
-    if (c == '+') return 62;
-    if (c == '/') return 63;
-    if (c == '=') return 64;
-    if (c == ' ' || c == '\n' || c == '\r' || c == '\t') return 65;
-    return 255;
-}
-
 /// A check on the length of a text that is still arriving: it must reach @a chars
 /// characters, or the array fails with @a message.
 struct LengthRequirement

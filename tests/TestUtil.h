@@ -87,6 +87,12 @@ protected:
     std::string dir() const { return mDir; }
     /// @a name inside the test's directory.
     std::string path(const std::string& name) const { return mDir + "/" + name; }
+    /// Write @a bytes to @a name inside the test's directory; returns its path.
+    std::string write(const std::string& name, const std::string& bytes) const
+    {
+        writeBytes(path(name), bytes);
+        return path(name);
+    }
 
 private:
     std::string mDir;

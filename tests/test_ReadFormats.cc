@@ -95,14 +95,9 @@ bytesOf(T value, bool bigEndian = false)
     return bytes;
 }
 
+/// Each test in a fresh directory; write() is ScratchDirTest's.
 class ReadFormatsTest : public nonbloppy_test::ScratchDirTest
 {
-protected:
-    std::string write(const std::string& name, const std::string& bytes) const
-    {
-        writeBytes(path(name), bytes);
-        return path(name);
-    }
 };
 
 /// The FileError message readParticles(@a path) throws ("" if none).

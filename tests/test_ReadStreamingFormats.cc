@@ -43,14 +43,9 @@ using nonbloppy_test::messageOf;
 using nonbloppy_test::readBytes;
 using nonbloppy_test::writeBytes;
 
+/// Each test in a fresh directory; write() is ScratchDirTest's.
 class ReadStreamingFormatsTest : public nonbloppy_test::ScratchDirTest
 {
-protected:
-    std::string write(const std::string& name, const std::string& bytes)
-    {
-        writeBytes(path(name), bytes);
-        return path(name);
-    }
 };
 
 /// More particles than fit in a 1 MiB buffer in every layout below.

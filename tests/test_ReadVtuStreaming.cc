@@ -65,14 +65,9 @@ using nonbloppy_test::messageOf;
 using nonbloppy_test::readBytes;
 using nonbloppy_test::writeBytes;
 
+/// Each test in a fresh directory; write() is ScratchDirTest's.
 class ReadVtuStreamingTest : public nonbloppy_test::ScratchDirTest
 {
-protected:
-    std::string write(const std::string& name, const std::string& bytes)
-    {
-        writeBytes(path(name), bytes);
-        return path(name);
-    }
 };
 
 /// Particle @a i of a synthetic frame: position, a Float32 density, an Int64 id and a
