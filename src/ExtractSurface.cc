@@ -218,15 +218,17 @@ bool collectPieces(const openvdb::FloatTree& tree, float iso, std::vector<Piece>
 }
 
 /// The slabs, as ranges [first, last) of leaf layers along @a axis, that each hold about
-/// @a leavesPerRegion kept leaves (a last small remainder joins the slab before it).
-std::vector<std::pair<int, int>> slabsOf(const std::vector<int>& keptPerLayer, size_t leavesPerRegion)
+/// @a leavesPerRegion kept leaves and at least @a minLayers layers (a last small remainder
+/// joins the slab before it).
+std::vector<std::pair<int, int>> slabsOf(const std::vector<int>& keptPerLayer, size_t leavesPerRegion,
+                                         int minLayers)
 {
     std::vector<std::pair<int, int>> slabs;
     int first = 0;
     size_t count = 0;
     for (int layer = 0; layer < int(keptPerLayer.size()); ++layer) {
         count += size_t(keptPerLayer[layer]);
-        if (count >= leavesPerRegion) {
+        if (count >= leavesPerRegion && layer + 1 - first >= minLayers) {
             slabs.emplace_back(first, layer + 1);
             first = layer + 1;
             count = 0;
@@ -249,7 +251,7 @@ constexpr int kShellPlanes = 2;
 /// See the comment above LeafRole. Returns false (and does nothing) when the grid has tiles
 /// larger than a leaf or makes a single slab; otherwise fills @a mesh, oriented outwards.
 bool extractByRegionImpl(const openvdb::FloatGrid& density, double threshold, SurfaceMesh& mesh,
-                         cancellation_internal::CancelPoll& poll, size_t leavesPerRegion)
+                         cancellation_internal::CancelPoll& poll, size_t leavesPerRegion, int minLayers)
 {
     const openvdb::FloatTree& tree = density.tree();
     // volumeToMesh compares values with float(threshold) but places crossings with the
@@ -271,7 +273,7 @@ bool extractByRegionImpl(const openvdb::FloatGrid& density, double threshold, Su
         if (pieces[n].leaf && pieces[n].role == LeafRole::Kept) ++keptPerLayer[layer];
         if (pieces[n].role != LeafRole::Below) piecesPerLayer[layer].push_back(uint32_t(n));
     }
-    const std::vector<std::pair<int, int>> slabs = slabsOf(keptPerLayer, leavesPerRegion);
+    const std::vector<std::pair<int, int>> slabs = slabsOf(keptPerLayer, leavesPerRegion, minLayers);
     if (slabs.size() < 2) return false;
 
     // Seams are compared in world space, which needs a transform without rotation.
@@ -532,12 +534,14 @@ void extractSurfaceInto(const openvdb::FloatGrid& density, double threshold, dou
 }
 
 void extractByRegion(const openvdb::FloatGrid& density, double threshold, SurfaceMesh& mesh,
-                     openvdb::util::NullInterrupter* interrupter, size_t leavesPerRegion)
+                     openvdb::util::NullInterrupter* interrupter, size_t leavesPerRegion,
+                     int minLayersPerRegion)
 {
     checkExtractParameters(threshold, 0.0);
     cancellation_internal::CancelPoll poll(interrupter, "extract surface");
     poll.throwIfStopped();
-    if (!extractByRegionImpl(density, threshold, mesh, poll, std::max<size_t>(leavesPerRegion, 1))) {
+    if (!extractByRegionImpl(density, threshold, mesh, poll, std::max<size_t>(leavesPerRegion, 1),
+                             std::max(minLayersPerRegion, 1))) {
         extractInto(density, threshold, 0.0, mesh);
         return;
     }

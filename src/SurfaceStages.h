@@ -75,6 +75,10 @@ void runSurfaceStages(const ParticleIndex& index, bool keepDensity, SurfaceResul
 /// Kept leaves (those a crossing edge may touch) per region of extractByRegion(): at about
 /// 13 µs per leaf on two cores, a region takes some 50 ms, the longest wait for a cancel.
 constexpr size_t kLeavesPerRegion = 4096;
+/// Leaf layers (8 voxels each) per region at least: each region also meshes two voxel planes
+/// either side, 12% more work at four layers. Large cross-sections (the 512× benchmark input
+/// holds more than 4096 such leaves per layer) then make regions larger than kLeavesPerRegion.
+constexpr int kMinLayersPerRegion = 4;
 
 /// extractSurface() into @a mesh's existing vectors (which keep their capacity); normals and
 /// attributes are cleared. Same checks and orientation as extractSurface(); with adaptivity 0
@@ -86,7 +90,7 @@ void extractSurfaceInto(const openvdb::FloatGrid& density, double threshold, dou
                         SurfaceMesh& mesh, openvdb::util::NullInterrupter* interrupter);
 
 /// The surface φ = @a threshold of a density grid (adaptivity 0), meshed in slabs of about
-/// @a leavesPerRegion kept leaves across the grid's longest axis: volumeToMesh on a copy of
+/// @a leavesPerRegion kept leaves, and @a minLayersPerRegion leaf layers at least, across the grid's longest axis: volumeToMesh on a copy of
 /// each slab's leaves plus three voxel planes either side, keeping the quads whose centroid
 /// lies in the slab, the vertices at a seam welded by exact position (a cell's vertices
 /// depend only on its corner values). Leaves that no crossing edge touches are left out, or
@@ -100,7 +104,8 @@ void extractSurfaceInto(const openvdb::FloatGrid& density, double threshold, dou
 /// only read.
 /// @throw ParameterError if @a threshold is not finite; CancelledError as above
 void extractByRegion(const openvdb::FloatGrid& density, double threshold, SurfaceMesh& mesh,
-                     openvdb::util::NullInterrupter* interrupter, size_t leavesPerRegion);
+                     openvdb::util::NullInterrupter* interrupter, size_t leavesPerRegion,
+                     int minLayersPerRegion = kMinLayersPerRegion);
 
 } // namespace surface_stages_internal
 } // namespace nonbloppy

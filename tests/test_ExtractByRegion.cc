@@ -89,10 +89,10 @@ TEST(ExtractByRegion, GivesTheVerticesAndPolygonsOfTheWholeGridAtEveryRegionSize
     const SurfaceMesh whole = extractSurface(damBreakDensity(), kThreshold);
     ASSERT_GT(whole.quads.size(), 30000u);
     const std::vector<Quad> expected = canonicalQuads(whole);
-    // 1 kept leaf per region makes a seam at every leaf layer; 100000 makes one region.
+    // 1 kept leaf and 1 layer per region make a seam at every leaf layer; 100000 one region.
     for (const size_t leavesPerRegion : {size_t(1), size_t(8), size_t(100), size_t(100000)}) {
         SurfaceMesh regions;
-        extractByRegion(damBreakDensity(), kThreshold, regions, nullptr, leavesPerRegion);
+        extractByRegion(damBreakDensity(), kThreshold, regions, nullptr, leavesPerRegion, 1);
         EXPECT_EQ(regions.points.size(), whole.points.size()) << leavesPerRegion << " leaves per region";
         EXPECT_TRUE(regions.triangles.empty());
         EXPECT_TRUE(canonicalQuads(regions) == expected) << leavesPerRegion << " leaves per region";
@@ -102,6 +102,10 @@ TEST(ExtractByRegion, GivesTheVerticesAndPolygonsOfTheWholeGridAtEveryRegionSize
         std::sort(points.begin(), points.end());
         EXPECT_TRUE(std::adjacent_find(points.begin(), points.end()) == points.end());
     }
+    // The default least thickness (kMinLayersPerRegion layers) with small regions.
+    SurfaceMesh regions;
+    extractByRegion(damBreakDensity(), kThreshold, regions, nullptr, 8);
+    EXPECT_TRUE(canonicalQuads(regions) == expected);
 }
 
 TEST(ExtractByRegion, LeavesOutAndTilesLeavesNoCrossingTouchesWithoutChangingTheMesh)
@@ -121,20 +125,20 @@ TEST(ExtractByRegion, LeavesOutAndTilesLeavesNoCrossingTouchesWithoutChangingThe
     const std::vector<Quad> expected = canonicalQuads(extractSurface(*density, kThreshold));
     ASSERT_GT(expected.size(), 10000u);
     SurfaceMesh regions;
-    extractByRegion(*density, kThreshold, regions, nullptr, 16);
+    extractByRegion(*density, kThreshold, regions, nullptr, 16, 1);
     EXPECT_TRUE(canonicalQuads(regions) == expected);
 
     openvdb::FloatGrid::Ptr tiled = density->deepCopy();
     ASSERT_GT(tileDeepInterior(*tiled, kThreshold), 0u);
-    extractByRegion(*tiled, kThreshold, regions, nullptr, 16);
+    extractByRegion(*tiled, kThreshold, regions, nullptr, 16, 1);
     EXPECT_TRUE(canonicalQuads(regions) == expected);
 }
 
 TEST(ExtractByRegion, SameOrderAtOneAndTwoThreads)
 {
     SurfaceMesh one, two;
-    tbb::task_arena(1).execute([&] { extractByRegion(damBreakDensity(), kThreshold, one, nullptr, 64); });
-    tbb::task_arena(2).execute([&] { extractByRegion(damBreakDensity(), kThreshold, two, nullptr, 64); });
+    tbb::task_arena(1).execute([&] { extractByRegion(damBreakDensity(), kThreshold, one, nullptr, 64, 1); });
+    tbb::task_arena(2).execute([&] { extractByRegion(damBreakDensity(), kThreshold, two, nullptr, 64, 1); });
     ASSERT_EQ(one.points.size(), two.points.size());
     EXPECT_TRUE(one.points == two.points);
     EXPECT_TRUE(one.quads == two.quads);
@@ -144,14 +148,14 @@ TEST(ExtractByRegion, AsksTheInterrupterBetweenRegionsAndStops)
 {
     CountingInterrupter never(1 << 30);
     SurfaceMesh mesh;
-    extractByRegion(damBreakDensity(), kThreshold, mesh, &never, 50);
+    extractByRegion(damBreakDensity(), kThreshold, mesh, &never, 50, 1);
     // Once before the work and once before each region: the frame's 400-odd leaves that a
     // crossing touches make eight regions of 50 or more (a region ends on a whole layer).
     EXPECT_GE(never.questions(), 9);
 
     CountingInterrupter third(3);
     EXPECT_EQ(messageOf<CancelledError>([&] {
-        extractByRegion(damBreakDensity(), kThreshold, mesh, &third, 50);
+        extractByRegion(damBreakDensity(), kThreshold, mesh, &third, 50, 1);
     }), "interrupted during extract surface");
     EXPECT_EQ(third.questions(), 3);
 }
