@@ -15,6 +15,7 @@
 #include <unistd.h>
 
 #include <cmath>
+#include <cstdint>
 #include <filesystem>
 #include <fstream>
 #include <functional>
@@ -134,6 +135,26 @@ inline std::vector<openvdb::Vec3f> latticeParticles(double spacing, double exten
                 positions.emplace_back(p);
             }
     return positions;
+}
+
+/// @a bytes in base64 (RFC 4648, '=' padding); with @a wrap a newline after every 76
+/// characters, as VTK's writers break long inline arrays.
+inline std::string base64(const std::string& bytes, bool wrap = false)
+{
+    static const char* alphabet = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    std::string out;
+    out.reserve(bytes.size() / 3 * 4 + bytes.size() / 57 + 8);
+    for (size_t i = 0; i < bytes.size(); i += 3) {
+        uint32_t bits = uint32_t(static_cast<unsigned char>(bytes[i])) << 16;
+        if (i + 1 < bytes.size()) bits |= uint32_t(static_cast<unsigned char>(bytes[i + 1])) << 8;
+        if (i + 2 < bytes.size()) bits |= uint32_t(static_cast<unsigned char>(bytes[i + 2]));
+        out += alphabet[(bits >> 18) & 63];
+        out += alphabet[(bits >> 12) & 63];
+        out += i + 1 < bytes.size() ? alphabet[(bits >> 6) & 63] : '=';
+        out += i + 2 < bytes.size() ? alphabet[bits & 63] : '=';
+        if (wrap && (i / 3 + 1) % 19 == 0) out += '\n';
+    }
+    return out;
 }
 
 } // namespace nonbloppy_test

@@ -32,6 +32,7 @@
 namespace {
 
 using nonbloppy_test::dataPath;
+using nonbloppy_test::base64;
 using nonbloppy_test::readBytes;
 using nonbloppy_test::writeBytes;
 
@@ -65,23 +66,6 @@ zlibBytes(const std::string& raw)
     EXPECT_EQ(compress(reinterpret_cast<Bytef*>(out.data()), &size,
                        reinterpret_cast<const Bytef*>(raw.data()), uLong(raw.size())), Z_OK);
     out.resize(size);
-    return out;
-}
-
-std::string
-base64(const std::string& bytes)
-{
-    static const char* alphabet = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-    std::string out;
-    for (size_t i = 0; i < bytes.size(); i += 3) {
-        uint32_t bits = uint32_t(static_cast<unsigned char>(bytes[i])) << 16;
-        if (i + 1 < bytes.size()) bits |= uint32_t(static_cast<unsigned char>(bytes[i + 1])) << 8;
-        if (i + 2 < bytes.size()) bits |= uint32_t(static_cast<unsigned char>(bytes[i + 2]));
-        out += alphabet[(bits >> 18) & 63];
-        out += alphabet[(bits >> 12) & 63];
-        out += i + 1 < bytes.size() ? alphabet[(bits >> 6) & 63] : '=';
-        out += i + 2 < bytes.size() ? alphabet[bits & 63] : '=';
-    }
     return out;
 }
 

@@ -62,6 +62,7 @@ using nonbloppy::readParticles;
 namespace io = nonbloppy::io_internal;
 
 using nonbloppy_test::messageOf;
+using nonbloppy_test::base64;
 using nonbloppy_test::readBytes;
 using nonbloppy_test::writeBytes;
 
@@ -120,25 +121,6 @@ zlibBytes(const char* data, size_t size)
                        reinterpret_cast<const Bytef*>(data), uLong(size)), Z_OK);
     compressed.resize(out);
     return compressed;
-}
-
-std::string
-base64(const std::string& bytes, bool wrap)
-{
-    static const char* alphabet = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-    std::string out;
-    out.reserve(bytes.size() / 3 * 4 + bytes.size() / 57 + 8);
-    for (size_t i = 0; i < bytes.size(); i += 3) {
-        uint32_t bits = uint32_t(static_cast<unsigned char>(bytes[i])) << 16;
-        if (i + 1 < bytes.size()) bits |= uint32_t(static_cast<unsigned char>(bytes[i + 1])) << 8;
-        if (i + 2 < bytes.size()) bits |= uint32_t(static_cast<unsigned char>(bytes[i + 2]));
-        out += alphabet[(bits >> 18) & 63];
-        out += alphabet[(bits >> 12) & 63];
-        out += i + 1 < bytes.size() ? alphabet[(bits >> 6) & 63] : '=';
-        out += i + 2 < bytes.size() ? alphabet[bits & 63] : '=';
-        if (wrap && (i / 3 + 1) % 19 == 0) out += '\n';
-    }
-    return out;
 }
 
 /// The [header][data] block of @a raw as VTK writes it, base64-encoded if @a encode.
