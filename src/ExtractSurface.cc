@@ -243,10 +243,12 @@ std::vector<std::pair<int, int>> slabsOf(const std::vector<int>& keptPerLayer, s
 
 /// Planes of voxels a slab's shell keeps beyond each face of the slab. A quad claimed by a
 /// slab has its centroid in the slab, so its cells lie at most two voxels below the slab or
-/// one above it, and their corners at most two planes out either side. The voxels beyond
-/// are dropped; the false crossings the cut makes give quads whose centroids lie at least
-/// half a voxel outside the slab, which it never claims.
-constexpr int kShellPlanes = 2;
+/// one above it, and their corners at most two planes out either side; volumeToMesh also
+/// resolves a cell's ambiguous face from the signs of the cell across it, one plane further
+/// (correctCellSigns in tools/VolumeToMesh.h), hence three. The voxels beyond are dropped;
+/// the false crossings the cut makes give quads whose centroids lie at least half a voxel
+/// outside the slab, which it never claims.
+constexpr int kShellPlanes = 3;
 
 /// See the comment above LeafRole. Returns false (and does nothing) when the grid has tiles
 /// larger than a leaf or makes a single slab; otherwise fills @a mesh, oriented outwards.

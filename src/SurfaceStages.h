@@ -75,8 +75,8 @@ void runSurfaceStages(const ParticleIndex& index, bool keepDensity, SurfaceResul
 /// Kept leaves (those a crossing edge may touch) per region of extractByRegion(): at about
 /// 13 µs per leaf on two cores, a region takes some 50 ms, the longest wait for a cancel.
 constexpr size_t kLeavesPerRegion = 4096;
-/// Leaf layers (8 voxels each) per region at least: each region also meshes two voxel planes
-/// either side, 12% more work at four layers. Large cross-sections (the 512× benchmark input
+/// Leaf layers (8 voxels each) per region at least: each region also meshes three voxel
+/// planes either side, 19% more work at four layers. Large cross-sections (the 512× benchmark input
 /// holds more than 4096 such leaves per layer) then make regions larger than kLeavesPerRegion.
 constexpr int kMinLayersPerRegion = 4;
 

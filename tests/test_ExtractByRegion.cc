@@ -108,6 +108,31 @@ TEST(ExtractByRegion, GivesTheVerticesAndPolygonsOfTheWholeGridAtEveryRegionSize
     EXPECT_TRUE(canonicalQuads(regions) == expected);
 }
 
+TEST(ExtractByRegion, ResolvesAmbiguousFacesAtASeamAsTheWholeGridDoes)
+{
+    // Noise around the iso-value makes ambiguous faces everywhere. volumeToMesh resolves a
+    // cell's ambiguous face from the signs of the cell beyond it, so a claimed cell two
+    // voxels outside a slab reads a third plane of the shell: with two planes, seams lose
+    // quads (it did on the 64x benchmark input, 5 to 10 of 6.6 M).
+    openvdb::FloatGrid::Ptr noise = openvdb::FloatGrid::create(0.0f);
+    noise->setTransform(openvdb::math::Transform::createLinearTransform(kVoxelSize));
+    uint32_t state = 12345u;  // a fixed linear congruential sequence: the same field everywhere
+    auto accessor = noise->getAccessor();
+    for (int i = 0; i < 64; ++i)
+        for (int j = 0; j < 16; ++j)
+            for (int k = 0; k < 16; ++k) {
+                state = state * 1664525u + 1013904223u;
+                accessor.setValue(openvdb::Coord(i, j, k), 2.0f * float(state >> 8) / float(1u << 24));
+            }
+    const std::vector<Quad> expected = canonicalQuads(extractSurface(*noise, 1.0));
+    ASSERT_GT(expected.size(), 10000u);
+    for (const size_t leavesPerRegion : {size_t(1), size_t(8)}) {
+        SurfaceMesh regions;
+        extractByRegion(*noise, 1.0, regions, nullptr, leavesPerRegion, 1);
+        EXPECT_TRUE(canonicalQuads(regions) == expected) << leavesPerRegion << " leaves per region";
+    }
+}
+
 TEST(ExtractByRegion, LeavesOutAndTilesLeavesNoCrossingTouchesWithoutChangingTheMesh)
 {
     // A solid block of particles: a deep interior (tiles after tileDeepInterior(), "above"
