@@ -3,8 +3,9 @@
 /// @brief Stage "extract surface". The only translation unit that includes
 ///        tools/VolumeToMesh.h (heavy to compile).
 ///
-/// Large grids are meshed region by region (extractByRegion below): slabs of leaves, each
-/// handed to volumeToMesh with a thin shell, then stitched exactly. That bounds the time
+/// Large grids are meshed region by region (extractByRegion below): blocks of leaves (slabs,
+/// cut again into bands where they hold many leaves), each handed to volumeToMesh with a
+/// thin shell, then stitched exactly. That bounds the time
 /// between two cancellation checks (volumeToMesh itself cannot be stopped) and lets every
 /// region skip the leaves that no surface crossing touches.
 
@@ -25,7 +26,6 @@
 #include <cstring>
 #include <limits>
 #include <memory>
-#include <unordered_map>
 #include <utility>
 #include <sstream>
 
@@ -82,12 +82,13 @@ void extractInto(const GridT& density, double threshold, double adaptivity, Surf
 // whose corners straddle the iso-value, at the mean of the crossings on the cell's edges, and
 // one quad around every crossing edge, joining the four cells that share it. A cell's
 // vertices depend on its eight corner values only, so any grid holding those corners yields
-// bit-identical vertices for it. Hence a slab of leaf layers can be meshed alone from a copy
-// of its leaves plus kShellPlanes voxel planes either side: each slab keeps the quads whose
-// centroid lies in it (both slabs at a seam compute the same bits for a quad near it, so
+// bit-identical vertices for it (and for the signs of its neighbours, which settle its
+// ambiguous faces). Hence a block of leaves can be meshed alone from a copy of its leaves
+// plus kShellPlanes voxel planes beyond each cut face: each region keeps the quads whose
+// centroid lies in it (both regions at a seam compute the same bits for a quad near it, so
 // exactly one keeps it), and the vertices those quads share across a seam are welded by
 // exact position. volumeToMesh's own surface mask would do the clipping too, but measured
-// 20-30% slower: it rescans every crossing of the slab.
+// 20-30% slower: it rescans every crossing of the region.
 
 /// How a leaf takes part in region-by-region extraction.
 enum class LeafRole : uint8_t
@@ -162,15 +163,77 @@ struct PositionKey
     std::array<uint32_t, 3> bits;
     bool operator==(const PositionKey& other) const { return bits == other.bits; }
 };
-struct PositionKeyHash
+
+/// Vertex index by exact position, for the seam vertices of extractByRegionImpl(): open
+/// addressing with linear probing in one array (a seam holds tens of thousands of vertices
+/// per region, and std::unordered_map's node per entry cost a fifth of the extraction).
+/// Cost: insert() and find() O(1) expected; clear() O(capacity), keeping the memory.
+/// Thread-safety: find() from many threads at once while nobody inserts.
+class SeamTable
 {
-    size_t operator()(const PositionKey& key) const
+public:
+    static constexpr uint32_t kNone = std::numeric_limits<uint32_t>::max();
+
+    /// Remember @a index for @a key (a key already present keeps its first index).
+    void insert(const PositionKey& key, uint32_t index)
+    {
+        if (2 * (mSize + 1) > mSlots.size()) grow();
+        if (place(mSlots, key, index)) ++mSize;
+    }
+    /// The index remembered for @a key, or kNone.
+    uint32_t find(const PositionKey& key) const
+    {
+        if (mSlots.empty()) return kNone;
+        for (size_t slot = hashOf(key) & (mSlots.size() - 1);; slot = (slot + 1) & (mSlots.size() - 1)) {
+            const Slot& s = mSlots[slot];
+            if (s.index == kNone) return kNone;
+            if (s.key == key) return s.index;
+        }
+    }
+    void clear()
+    {
+        for (Slot& s : mSlots) s.index = kNone;
+        mSize = 0;
+    }
+    void swap(SeamTable& other)
+    {
+        mSlots.swap(other.mSlots);
+        std::swap(mSize, other.mSize);
+    }
+
+private:
+    struct Slot
+    {
+        PositionKey key;
+        uint32_t index = kNone;
+    };
+    static size_t hashOf(const PositionKey& key)
     {
         uint64_t h = 0x9E3779B97F4A7C15ull;
         for (uint32_t b : key.bits) h = (h ^ b) * 0x100000001B3ull;
         return size_t(h ^ (h >> 29));
     }
+    static bool place(std::vector<Slot>& slots, const PositionKey& key, uint32_t index)
+    {
+        for (size_t slot = hashOf(key) & (slots.size() - 1);; slot = (slot + 1) & (slots.size() - 1)) {
+            Slot& s = slots[slot];
+            if (s.index == kNone) { s.key = key; s.index = index; return true; }
+            if (s.key == key) return false;
+        }
+    }
+    void grow()
+    {
+        std::vector<Slot> larger(std::max<size_t>(1024, 2 * mSlots.size()));
+        for (const Slot& s : mSlots) {
+            if (s.index != kNone) place(larger, s.key, s.index);
+        }
+        mSlots.swap(larger);
+    }
+
+    std::vector<Slot> mSlots;  // a power of two, at most half full
+    size_t mSize = 0;
 };
+
 PositionKey keyOf(const openvdb::Vec3s& p)
 {
     PositionKey key;
@@ -217,9 +280,9 @@ bool collectPieces(const openvdb::FloatTree& tree, float iso, std::vector<Piece>
     return true;
 }
 
-/// The slabs, as ranges [first, last) of leaf layers along @a axis, that each hold about
-/// @a leavesPerRegion kept leaves and at least @a minLayers layers (a last small remainder
-/// joins the slab before it).
+/// Cuts of a row of leaf layers (along one axis) into ranges [first, last) that each hold
+/// about @a leavesPerRegion kept leaves (@a keptPerLayer) and at least @a minLayers layers
+/// (a last small remainder joins the range before it).
 std::vector<std::pair<int, int>> slabsOf(const std::vector<int>& keptPerLayer, size_t leavesPerRegion,
                                          int minLayers)
 {
@@ -241,17 +304,27 @@ std::vector<std::pair<int, int>> slabsOf(const std::vector<int>& keptPerLayer, s
     return slabs;
 }
 
-/// Planes of voxels a slab's shell keeps beyond each face of the slab. A quad claimed by a
-/// slab has its centroid in the slab, so its cells lie at most two voxels below the slab or
+/// Planes of voxels a region's shell keeps beyond each cut face. A quad claimed by a region
+/// has its centroid in the region, so its cells lie at most two voxels below a face or
 /// one above it, and their corners at most two planes out either side; volumeToMesh also
 /// resolves a cell's ambiguous face from the signs of the cell across it, one plane further
 /// (correctCellSigns in tools/VolumeToMesh.h), hence three. The voxels beyond are dropped;
 /// the false crossings the cut makes give quads whose centroids lie at least half a voxel
-/// outside the slab, which it never claims.
+/// outside the region, which it never claims.
 constexpr int kShellPlanes = 3;
 
+/// One region of extractByRegionImpl(): a range of leaf layers along the grid's longest axis
+/// (a slab) times a range along its second longest (a band), each [first, last).
+struct Region
+{
+    std::pair<int, int> slab, band;
+    bool firstSlab, lastSlab, firstBand, lastBand;
+    size_t kept;  ///< kept leaves inside
+};
+
 /// See the comment above LeafRole. Returns false (and does nothing) when the grid has tiles
-/// larger than a leaf or makes a single slab; otherwise fills @a mesh, oriented outwards.
+/// larger than a leaf, a transform that is not an axis-aligned scale, or makes a single
+/// region; otherwise fills @a mesh, oriented outwards.
 bool extractByRegionImpl(const openvdb::FloatGrid& density, double threshold, SurfaceMesh& mesh,
                          cancellation_internal::CancelPoll& poll, size_t leavesPerRegion, int minLayers)
 {
@@ -262,74 +335,115 @@ bool extractByRegionImpl(const openvdb::FloatGrid& density, double threshold, Su
     std::vector<Piece> pieces;
     if (!collectPieces(tree, iso, pieces, poll) || pieces.empty()) return false;
 
-    // Slabs across the longest axis, balanced by kept leaves (the ones volumeToMesh works on).
+    // Slabs across the longest axis, balanced by kept leaves (the ones volumeToMesh works on);
+    // a slab with more than leavesPerRegion of them is cut again into bands across the second
+    // longest axis (the dam-break frames hold 2,000 kept leaves in one layer of their floor).
     openvdb::CoordBBox bounds;
     for (const Piece& piece : pieces) bounds.expand(piece.origin);
-    const int axis = int(bounds.extents().maxIndex());
+    const openvdb::Coord extents = bounds.extents();
+    const int axis = int(extents.maxIndex());
+    const int cross = extents[(axis + 1) % 3] >= extents[(axis + 2) % 3] ? (axis + 1) % 3 : (axis + 2) % 3;
     const int dim = int(FloatLeaf::DIM);
+    const auto layerOf = [&](const Piece& piece, int along) {
+        return (piece.origin[along] - bounds.min()[along]) / dim;
+    };
     const int layerCount = (bounds.max()[axis] - bounds.min()[axis]) / dim + 1;
+    const int crossCount = (bounds.max()[cross] - bounds.min()[cross]) / dim + 1;
     std::vector<int> keptPerLayer(static_cast<size_t>(layerCount), 0);
     std::vector<std::vector<uint32_t>> piecesPerLayer(static_cast<size_t>(layerCount));
     for (size_t n = 0; n < pieces.size(); ++n) {
-        const size_t layer = size_t((pieces[n].origin[axis] - bounds.min()[axis]) / dim);
+        const size_t layer = size_t(layerOf(pieces[n], axis));
         if (pieces[n].leaf && pieces[n].role == LeafRole::Kept) ++keptPerLayer[layer];
         if (pieces[n].role != LeafRole::Below) piecesPerLayer[layer].push_back(uint32_t(n));
     }
-    const std::vector<std::pair<int, int>> slabs = slabsOf(keptPerLayer, leavesPerRegion, minLayers);
-    if (slabs.size() < 2) return false;
+    std::vector<Region> regions;
+    size_t totalKept = 0;
+    {
+        const std::vector<std::pair<int, int>> slabs = slabsOf(keptPerLayer, leavesPerRegion, minLayers);
+        std::vector<int> keptPerBandLayer(static_cast<size_t>(crossCount));
+        for (size_t s = 0; s < slabs.size(); ++s) {
+            std::fill(keptPerBandLayer.begin(), keptPerBandLayer.end(), 0);
+            for (int layer = slabs[s].first; layer < slabs[s].second; ++layer) {
+                for (uint32_t n : piecesPerLayer[size_t(layer)]) {
+                    if (pieces[n].leaf && pieces[n].role == LeafRole::Kept) ++keptPerBandLayer[size_t(layerOf(pieces[n], cross))];
+                }
+            }
+            const std::vector<std::pair<int, int>> bands = slabsOf(keptPerBandLayer, leavesPerRegion, minLayers);
+            for (size_t b = 0; b < bands.size(); ++b) {
+                size_t kept = 0;
+                for (int layer = bands[b].first; layer < bands[b].second; ++layer) kept += size_t(keptPerBandLayer[size_t(layer)]);
+                totalKept += kept;
+                regions.push_back(Region{slabs[s], bands[b], s == 0, s + 1 == slabs.size(), b == 0,
+                                         b + 1 == bands.size(), kept});
+            }
+        }
+    }
+    if (regions.size() < 2) return false;
 
-    // Seams are compared in world space, which needs a transform without rotation.
+    // Seams are compared in world space, which needs an axis-aligned scale that grows with
+    // the index (a claim is "centroid at or above the seam").
     const openvdb::math::Transform& transform = density.transform();
     const openvdb::math::MapBase& map = *transform.baseMap();
     if (!(map.isType<openvdb::math::UniformScaleTranslateMap>() || map.isType<openvdb::math::UniformScaleMap>()
-          || map.isType<openvdb::math::ScaleTranslateMap>() || map.isType<openvdb::math::ScaleMap>())
-        || !(transform.voxelSize()[axis] > 0.0)) {
+          || map.isType<openvdb::math::ScaleTranslateMap>() || map.isType<openvdb::math::ScaleMap>())) {
         return false;
     }
-    /// The world coordinate along the axis of voxel plane @a plane.
-    const auto worldOf = [&](int plane) {
+    /// The world coordinate along @a along of voxel plane @a plane.
+    const auto worldOf = [&](int along, int plane) {
         openvdb::Vec3d index(0.0);
-        index[axis] = double(plane);
-        return transform.indexToWorld(index)[axis];
+        index[along] = double(plane);
+        return transform.indexToWorld(index)[along];
     };
+    if (!(worldOf(axis, 1) > worldOf(axis, 0)) || !(worldOf(cross, 1) > worldOf(cross, 0))) return false;
 
     mesh.points.clear();
     mesh.triangles.clear();
     mesh.quads.clear();
-    // Vertices near the seam with the next slab, by exact position, and their mesh index.
-    std::unordered_map<PositionKey, uint32_t, PositionKeyHash> seam;
+    // Vertices near the upper faces of the regions meshed so far, by exact position, and
+    // their mesh index: those of the current slab, and of the slab before it (a seam
+    // vertex lies within three planes of a face, and a slab is at least a leaf thick).
+    SeamTable seamThisSlab, seamSlabBefore;
     std::vector<uint32_t> remap;
     std::unique_ptr<std::atomic<uint8_t>[]> used;
     std::vector<size_t> newBefore;
-    size_t totalKept = 0;
-    for (int count : keptPerLayer) totalKept += size_t(count);
     std::vector<size_t> claimedBefore;
-    constexpr uint32_t kNew = std::numeric_limits<uint32_t>::max();
-    for (size_t s = 0; s < slabs.size(); ++s) {
+    constexpr uint32_t kNew = SeamTable::kNone;  // not in a seam table: a vertex of its own
+    for (size_t r = 0; r < regions.size(); ++r) {
         poll.throwIfStopped();
-        const bool first = s == 0, last = s + 1 == slabs.size();
-        const int slabBegin = bounds.min()[axis] + slabs[s].first * dim;   // first voxel plane
-        const int slabEnd = bounds.min()[axis] + slabs[s].second * dim;    // one past the last
+        const Region& region = regions[r];
+        if (r > 0 && region.firstBand) {
+            seamSlabBefore.swap(seamThisSlab);
+            seamThisSlab.clear();
+        }
+        // First voxel plane and one past the last, along each axis.
+        const int slabBegin = bounds.min()[axis] + region.slab.first * dim;
+        const int slabEnd = bounds.min()[axis] + region.slab.second * dim;
+        const int bandBegin = bounds.min()[cross] + region.band.first * dim;
+        const int bandEnd = bounds.min()[cross] + region.band.second * dim;
 
-        // The slab's pieces plus kShellPlanes planes of the leaf layer either side.
-        openvdb::FloatGrid::Ptr region = openvdb::FloatGrid::create(tree.background());
-        region->setTransform(transform.copy());
-        region->setGridClass(density.getGridClass());
-        openvdb::FloatTree& regionTree = region->tree();
-        for (int layer = std::max(slabs[s].first - 1, 0);
-             layer <= std::min(slabs[s].second, layerCount - 1); ++layer) {
-            const bool shell = layer < slabs[s].first || layer >= slabs[s].second;
+        // The region's pieces plus kShellPlanes planes of the leaf layers around it.
+        openvdb::FloatGrid::Ptr regionGrid = openvdb::FloatGrid::create(tree.background());
+        regionGrid->setTransform(transform.copy());
+        regionGrid->setGridClass(density.getGridClass());
+        openvdb::FloatTree& regionTree = regionGrid->tree();
+        for (int layer = std::max(region.slab.first - 1, 0);
+             layer <= std::min(region.slab.second, layerCount - 1); ++layer) {
             for (uint32_t n : piecesPerLayer[size_t(layer)]) {
                 const Piece& piece = pieces[n];
+                const int bandLayer = layerOf(piece, cross);
+                if (bandLayer < region.band.first - 1 || bandLayer > region.band.second) continue;
                 if (!piece.leaf || piece.role == LeafRole::Above) {
                     regionTree.addTile(1, piece.origin, piece.value, /*active=*/true);
                     continue;
                 }
                 auto* copy = new FloatLeaf(*piece.leaf);
+                const bool shell = layer < region.slab.first || layer >= region.slab.second
+                                   || bandLayer < region.band.first || bandLayer >= region.band.second;
                 if (shell) {
                     for (openvdb::Index i = 0; i < FloatLeaf::SIZE; ++i) {
-                        const int plane = copy->offsetToGlobalCoord(i)[axis];
-                        if (plane < slabBegin - kShellPlanes || plane >= slabEnd + kShellPlanes) {
+                        const openvdb::Coord ijk = copy->offsetToGlobalCoord(i);
+                        if (ijk[axis] < slabBegin - kShellPlanes || ijk[axis] >= slabEnd + kShellPlanes
+                            || ijk[cross] < bandBegin - kShellPlanes || ijk[cross] >= bandEnd + kShellPlanes) {
                             copy->setValueOff(i, tree.background());
                         }
                     }
@@ -338,19 +452,24 @@ bool extractByRegionImpl(const openvdb::FloatGrid& density, double threshold, Su
             }
         }
         openvdb::tools::VolumeToMesh mesher(threshold, 0.0);
-        mesher(*region);
-        region.reset();
+        mesher(*regionGrid);
+        regionGrid.reset();
 
-        // Claim the quads whose centroid lies in the slab: both slabs at a seam compute the
-        // same bits for a quad there, so exactly one of them claims it.
+        // Claim the quads whose centroid lies in the region: both regions at a seam compute
+        // the same bits for a quad there, so exactly one of them claims it.
         const size_t poolCount = mesher.polygonPoolListSize();
         const openvdb::tools::PolygonPoolList& pools = mesher.polygonPoolList();
         const openvdb::Vec3s* points = mesher.pointList().get();
-        const double claimBegin = worldOf(slabBegin), claimEnd = worldOf(slabEnd);
+        const double slabClaimBegin = worldOf(axis, slabBegin), slabClaimEnd = worldOf(axis, slabEnd);
+        const double bandClaimBegin = worldOf(cross, bandBegin), bandClaimEnd = worldOf(cross, bandEnd);
+        const auto centroid = [&](const openvdb::Vec4I& quad, int along) {
+            return (double(points[quad[0]][along]) + double(points[quad[1]][along])
+                    + double(points[quad[2]][along]) + double(points[quad[3]][along])) * 0.25;
+        };
         const auto claims = [&](const openvdb::Vec4I& quad) {
-            const double centroid = (double(points[quad[0]][axis]) + double(points[quad[1]][axis])
-                                     + double(points[quad[2]][axis]) + double(points[quad[3]][axis])) * 0.25;
-            return (first || centroid >= claimBegin) && (last || centroid < claimEnd);
+            const double alongSlab = centroid(quad, axis), alongBand = centroid(quad, cross);
+            return (region.firstSlab || alongSlab >= slabClaimBegin) && (region.lastSlab || alongSlab < slabClaimEnd)
+                && (region.firstBand || alongBand >= bandClaimBegin) && (region.lastBand || alongBand < bandClaimEnd);
         };
         claimedBefore.assign(poolCount + 1, 0);
         tbb::parallel_for(tbb::blocked_range<size_t>(0, poolCount),
@@ -363,13 +482,12 @@ bool extractByRegionImpl(const openvdb::FloatGrid& density, double threshold, Su
             });
         for (size_t p = 0; p < poolCount; ++p) claimedBefore[p + 1] += claimedBefore[p];
         const size_t quadBase = mesh.quads.size();
-        if (first) {
-            // Room for the whole mesh, extrapolated from this slab's share of the kept leaves
-            // (closed surfaces have about as many vertices as quads), so that the arrays are
-            // seldom moved while they grow.
-            size_t keptHere = 0;
-            for (int layer = slabs[s].first; layer < slabs[s].second; ++layer) keptHere += size_t(keptPerLayer[size_t(layer)]);
-            const double expected = 1.05 * double(claimedBefore[poolCount]) * double(totalKept) / double(std::max<size_t>(keptHere, 1));
+        if (r == 0) {
+            // Room for the whole mesh, extrapolated from this region's share of the kept
+            // leaves (closed surfaces have about as many vertices as quads), so that the
+            // arrays are seldom moved while they grow.
+            const double expected = 1.05 * double(claimedBefore[poolCount]) * double(totalKept)
+                                    / double(std::max<size_t>(region.kept, 1));
             mesh.quads.reserve(size_t(expected));
             mesh.points.reserve(size_t(expected));
         }
@@ -380,13 +498,13 @@ bool extractByRegionImpl(const openvdb::FloatGrid& density, double threshold, Su
                     size_t out = quadBase + claimedBefore[p];
                     for (size_t q = 0; q < pools[p].numQuads(); ++q) {
                         const openvdb::Vec4I& quad = pools[p].quad(q);
-                        if (claims(quad)) mesh.quads[out++] = quad;  // slab-local indices for now
+                        if (claims(quad)) mesh.quads[out++] = quad;  // region-local indices for now
                     }
                 }
             });
 
-        // The claimed quads' vertices, welded by exact position to the previous slab's
-        // near the seam (a cell's vertices are the same bits in every grid holding its corners).
+        // The claimed quads' vertices, welded by exact position to those of the regions before
+        // (a cell's vertices are the same bits in every grid holding its corners).
         const size_t pointCount = mesher.pointListSize();
         used.reset(new std::atomic<uint8_t>[pointCount]());
         tbb::parallel_for(tbb::blocked_range<size_t>(quadBase, mesh.quads.size()),
@@ -396,20 +514,30 @@ bool extractByRegionImpl(const openvdb::FloatGrid& density, double threshold, Su
                 }
             });
         const auto isUsed = [&](size_t n) { return used[n].load(std::memory_order_relaxed) != 0; };
-        // Shared cells lie within two voxels of the seam: look up only the vertices there.
-        const double weldBelow = worldOf(slabBegin + 2), keepFrom = worldOf(slabEnd - 3);
+        // Shared cells lie within two voxels of a seam: look up and keep only the vertices there.
+        const double slabWeldBelow = worldOf(axis, slabBegin + 2), slabKeepFrom = worldOf(axis, slabEnd - 3);
+        const double bandWeldBelow = worldOf(cross, bandBegin + 2), bandKeepFrom = worldOf(cross, bandEnd - 3);
+        const auto nearLowerSeam = [&](const openvdb::Vec3s& p) {
+            return (!region.firstSlab && double(p[axis]) < slabWeldBelow)
+                || (!region.firstBand && double(p[cross]) < bandWeldBelow);
+        };
+        const auto nearUpperSeam = [&](const openvdb::Vec3s& p) {
+            return (!region.lastSlab && double(p[axis]) >= slabKeepFrom)
+                || (!region.lastBand && double(p[cross]) >= bandKeepFrom);
+        };
         remap.assign(pointCount, kNew);
-        if (!first) {
+        if (!(region.firstSlab && region.firstBand)) {
             tbb::parallel_for(tbb::blocked_range<size_t>(0, pointCount),
                 [&](const tbb::blocked_range<size_t>& range) {
                     for (size_t n = range.begin(); n < range.end(); ++n) {
-                        if (!isUsed(n) || !(double(points[n][axis]) < weldBelow)) continue;
-                        const auto found = seam.find(keyOf(points[n]));
-                        if (found != seam.end()) remap[n] = found->second;
+                        if (!isUsed(n) || !nearLowerSeam(points[n])) continue;
+                        const PositionKey key = keyOf(points[n]);
+                        const uint32_t found = seamThisSlab.find(key);
+                        remap[n] = found != SeamTable::kNone ? found : seamSlabBefore.find(key);
                     }
                 });
         }
-        // New vertices numbered in slab order: a count per block, then its prefix sum.
+        // New vertices numbered in region order: a count per block, then its prefix sum.
         constexpr size_t kBlock = 16384;
         const size_t blocks = (pointCount + kBlock - 1) / kBlock;
         newBefore.assign(blocks + 1, 0);
@@ -442,10 +570,13 @@ bool extractByRegionImpl(const openvdb::FloatGrid& density, double threshold, Su
                     if (isUsed(n) && remap[n] >= firstNew) mesh.points[remap[n]] = points[n];
                 }
             });
-        seam.clear();
-        if (!last) {
+        // This region's new vertices that a later region may share. A vertex welded here
+        // came from a region before, whose map still holds it for as long as it is needed.
+        if (!(region.lastSlab && region.lastBand)) {
             for (size_t n = 0; n < pointCount; ++n) {
-                if (isUsed(n) && double(points[n][axis]) >= keepFrom) seam.emplace(keyOf(points[n]), remap[n]);
+                if (isUsed(n) && remap[n] >= firstNew && nearUpperSeam(points[n])) {
+                    seamThisSlab.insert(keyOf(points[n]), remap[n]);
+                }
             }
         }
         // Mesh indices, each polygon reversed (see orientOutwards()).

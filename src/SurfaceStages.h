@@ -72,12 +72,16 @@ void runSurfaceStages(const ParticleIndex& index, bool keepDensity, SurfaceResul
                       std::vector<openvdb::Vec3s>& unrelaxed, UnrelaxedBuffer whenRepaired,
                       openvdb::util::NullInterrupter* interrupter);
 
-/// Kept leaves (those a crossing edge may touch) per region of extractByRegion(): at about
-/// 13 µs per leaf on two cores, a region takes some 50 ms, the longest wait for a cancel.
-constexpr size_t kLeavesPerRegion = 4096;
-/// Leaf layers (8 voxels each) per region at least: each region also meshes three voxel
-/// planes either side, 19% more work at four layers. Large cross-sections (the 512× benchmark input
-/// holds more than 4096 such leaves per layer) then make regions larger than kLeavesPerRegion.
+/// Kept leaves (those a crossing edge may touch) per region of extractByRegion(). A region
+/// is meshed in one uninterruptible volumeToMesh call, the longest wait for a cancel: on
+/// the 64× benchmark input, 1024 leaves take 75-120 ms (two busy cores), 2048 leaves
+/// 110-200 ms, 4096 leaves 200-370 ms. The price is the shells meshed twice: extraction
+/// CPU time 1.53× that of one whole-grid volumeToMesh at 1024 leaves, 1.39× at 2048, 1.25×
+/// at 4096 (scratch memory falls with the region size).
+constexpr size_t kLeavesPerRegion = 1024;
+/// Leaf layers (8 voxels each) per region at least, along each axis it is cut on: each
+/// region also meshes three voxel planes beyond each cut face, 19% more work per axis at
+/// four layers.
 constexpr int kMinLayersPerRegion = 4;
 
 /// extractSurface() into @a mesh's existing vectors (which keep their capacity); normals and
@@ -89,19 +93,22 @@ constexpr int kMinLayersPerRegion = 4;
 void extractSurfaceInto(const openvdb::FloatGrid& density, double threshold, double adaptivity,
                         SurfaceMesh& mesh, openvdb::util::NullInterrupter* interrupter);
 
-/// The surface φ = @a threshold of a density grid (adaptivity 0), meshed in slabs of about
-/// @a leavesPerRegion kept leaves, and @a minLayersPerRegion leaf layers at least, across the grid's longest axis: volumeToMesh on a copy of
-/// each slab's leaves plus three voxel planes either side, keeping the quads whose centroid
-/// lies in the slab, the vertices at a seam welded by exact position (a cell's vertices
-/// depend only on its corner values). Leaves that no crossing edge touches are left out, or
-/// become tiles, so the slabs scan fewer voxels than the whole grid holds. The result holds
-/// exactly the vertices and polygons of extractSurface() (tested), oriented the same way,
-/// ordered slab by slab; deterministic at any thread count. A grid that makes one slab, has
-/// tiles larger than a leaf or a rotated transform is meshed whole, as extractSurface().
+/// The surface φ = @a threshold of a density grid (adaptivity 0), meshed region by region:
+/// slabs across the grid's longest axis, each cut again across the second longest when it
+/// holds more than @a leavesPerRegion kept leaves, every cut at least @a minLayersPerRegion
+/// leaf layers apart. Each region is a volumeToMesh call on a copy of its leaves plus three
+/// voxel planes beyond each cut face; it keeps the quads whose centroid lies in it, and the
+/// vertices at a seam are welded by exact position (a cell's vertices depend only on its
+/// corner values and the signs of the cells next to it). Leaves that no crossing edge
+/// touches are left out, or become tiles, so the regions scan fewer voxels than the whole
+/// grid holds. The result holds exactly the vertices and polygons of extractSurface()
+/// (tested), oriented the same way, ordered region by region; deterministic at any thread
+/// count. A grid that makes one region, has tiles larger than a leaf or a transform that is
+/// not an axis-aligned scale is meshed whole, as extractSurface().
 /// Cost: O(voxels) as extractSurface(), plus copying the leaves a crossing touches and, per
-/// slab, its shell; scratch memory is one slab's. The interrupter (may be null) is asked
-/// while leaves are classified and before each slab. Thread-safety: reentrant; the grid is
-/// only read.
+/// region, its shell (see kLeavesPerRegion); scratch memory is one region's plus the seam
+/// vertices of two slabs. The interrupter (may be null) is asked while leaves are
+/// classified and before each region. Thread-safety: reentrant; the grid is only read.
 /// @throw ParameterError if @a threshold is not finite; CancelledError as above
 void extractByRegion(const openvdb::FloatGrid& density, double threshold, SurfaceMesh& mesh,
                      openvdb::util::NullInterrupter* interrupter, size_t leavesPerRegion,
