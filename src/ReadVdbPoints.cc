@@ -179,7 +179,7 @@ public:
         static const unsigned char kMagic[8] = {0x20, 0x42, 0x44, 0x56, 0, 0, 0, 0};
         if (mSize < 8 || std::memcmp(mData, kMagic, 8) != 0) corrupt("not a VDB file");
         mPos = 8;
-        const uint32_t version = u32("header");
+        const uint32_t version = load<uint32_t>("header");
         // PointDataGrids came with file format 223 or later; the per-grid compression
         // flags (222) are the oldest layout walked here.
         if (version < openvdb::OPENVDB_FILE_VERSION_NODE_MASK_COMPRESSION) {
@@ -210,7 +210,7 @@ public:
     /// @a owner is "the file" or "grid '<name>'".
     void metaMap(const std::string& owner)
     {
-        const uint32_t count = u32("metadata of " + owner);
+        const uint32_t count = load<uint32_t>("metadata of " + owner);
         // An item takes at least 12 bytes (two string lengths and a value size).
         if (count > left() / 12) {
             corrupt("metadata of " + owner + " claims " + std::to_string(count) + " items");
@@ -219,7 +219,7 @@ public:
             const std::string name = string("a metadata name of " + owner);
             const std::string item = "metadata '" + printable(name) + "' of " + owner;
             const std::string type = string("type name of " + item);
-            const uint32_t bytes = u32(item);
+            const uint32_t bytes = load<uint32_t>(item);
             if (bytes > left()) {
                 corrupt(item + " claims " + std::to_string(bytes) + " bytes, " +
                         std::to_string(left()) + " left");
@@ -258,7 +258,7 @@ public:
     void grid(const std::string& name, bool pointDataGrid, uint32_t version)
     {
         const std::string grid = "grid '" + printable(name) + "'";
-        const uint32_t compression = u32(grid + " compression flags");
+        const uint32_t compression = load<uint32_t>(grid + " compression flags");
         metaMap(grid);
         transform(grid);
         if (!pointDataGrid) return;
@@ -292,7 +292,7 @@ public:
     void pointLeafBuffers(const std::string& grid)
     {
         const std::string what = "leaf buffers of " + grid;
-        const uint16_t passes = u16(what);
+        const uint16_t passes = load<uint16_t>(what);
         skip(2 * mLeafCount, what);  // pass 0
 
         // Pass 1: descriptors and array metadata. A header with bit 0 set makes its leaf's
@@ -309,13 +309,13 @@ public:
         for (uint64_t leaf = 0; leaf < mLeafCount; ++leaf) {
             const auto where = [&] { return "leaf " + std::to_string(leaf) + " of " + grid; };
             if (!shared) {
-                const uint8_t header = u8(where);
+                const uint8_t header = load<uint8_t>(where);
                 if (header > 3) {
                     corrupt("unknown header flags " + std::to_string(header) + " in " + where());
                 }
                 descriptor = attributeDescriptor("attribute descriptor of " + where());
                 if (header & 2) {
-                    const uint64_t bytes = u64(where);
+                    const uint64_t bytes = load<uint64_t>(where);
                     if (bytes > left()) {
                         corrupt("block to skip in " + where() + " claims " + std::to_string(bytes) +
                                 " bytes, " + std::to_string(left()) + " left");
@@ -387,7 +387,7 @@ public:
                 return "point offsets of leaf " + std::to_string(leaf) + " of " + grid;
             };
             skip(64, where);
-            const uint16_t bytes = u16(where);
+            const uint16_t bytes = load<uint16_t>(where);
             if (bytes == std::numeric_limits<uint16_t>::max()) skip(2048, where);
             else bloscChunk(bytes, 2048, where);
         }
@@ -412,7 +412,7 @@ public:
                 // TypedAttributeArray::readBuffers(): a non-uniform array says whether it is
                 // Blosc-compressed; raw bytes become the array as they are.
                 const auto data = [&] { return "data of " + where(); };
-                const bool blosc = !array->uniform && u8(data) == 1;
+                const bool blosc = !array->uniform && load<uint8_t>(data) == 1;
                 if (blosc) {
                     bloscChunk(array->bytes, array->expectedBytes, data);
                 } else {
@@ -440,7 +440,7 @@ public:
     /// looks arrays up by these indices.
     std::shared_ptr<const LeafDescriptor> attributeDescriptor(const std::string& descriptor)
     {
-        const uint64_t attributes = u64(descriptor);
+        const uint64_t attributes = load<uint64_t>(descriptor);
         // An attribute takes a type, a codec and a name (three string lengths) and an index.
         if (attributes > left() / 20) {
             corrupt(descriptor + " claims " + std::to_string(attributes) + " attributes");
@@ -456,7 +456,7 @@ public:
         std::vector<bool> named(size_t(attributes), false);
         for (uint64_t a = 0; a < attributes; ++a) {
             const std::string name = string("attribute name in " + descriptor);
-            const uint64_t index = u64(descriptor);
+            const uint64_t index = load<uint64_t>(descriptor);
             if (index >= attributes || named[index]) {
                 corrupt("attribute '" + printable(name) + "' in " + descriptor + " has index " +
                         std::to_string(index) + " (" + std::to_string(attributes) + " attributes)");
@@ -464,7 +464,7 @@ public:
             named[index] = true;
             result->names[index] = name;
         }
-        const uint64_t groups = u64(descriptor);
+        const uint64_t groups = load<uint64_t>(descriptor);
         if (groups > left() / 12) corrupt(descriptor + " claims " + std::to_string(groups) + " groups");
         for (uint64_t g = 0; g < groups; ++g) {
             string("group name in " + descriptor);
@@ -510,10 +510,10 @@ public:
     {
         using openvdb::points::AttributeArray;
         const auto metadata = [&] { return "metadata of " + where(); };
-        const uint64_t bytes = u64(metadata);
-        const uint8_t flags = u8(metadata);
-        const uint8_t serialization = u8(metadata);
-        const uint32_t size = u32(metadata);
+        const uint64_t bytes = load<uint64_t>(metadata);
+        const uint8_t flags = load<uint8_t>(metadata);
+        const uint8_t serialization = load<uint8_t>(metadata);
+        const uint32_t size = load<uint32_t>(metadata);
         if (bytes < 6) corrupt(where() + " claims " + std::to_string(bytes) + " bytes, less than its header");
         // Flags from 0x20 up are not OpenVDB's (0x20 is its own "partially read" state).
         if (flags >= AttributeArray::PARTIALREAD) {
@@ -523,7 +523,7 @@ public:
             corrupt(where() + " has unknown serialization flags " + std::to_string(serialization));
         }
         uint32_t strideOrTotal = 1;
-        if (serialization & AttributeArray::WRITESTRIDED) strideOrTotal = u32(metadata);
+        if (serialization & AttributeArray::WRITESTRIDED) strideOrTotal = load<uint32_t>(metadata);
         ArrayLayout array;
         array.bytes = bytes - 6;
         array.paged = serialization & AttributeArray::WRITEPAGED;
@@ -561,9 +561,9 @@ public:
     PageLayout pageHeader(const WhatT& where)
     {
         PageLayout page;
-        page.compressedBytes = int32_t(u32(where));
+        page.compressedBytes = int32_t(load<uint32_t>(where));
         if (page.compressedBytes > 0) {
-            const int32_t uncompressed = int32_t(u32(where));
+            const int32_t uncompressed = int32_t(load<uint32_t>(where));
             if (uncompressed <= 0) {
                 corrupt(where() + " gives uncompressed size " + std::to_string(uncompressed));
             }
@@ -649,16 +649,16 @@ public:
     {
         // Trees of more than one buffer are gone from OpenVDB; it would warn on stderr and
         // read on as if there were one.
-        const uint32_t buffers = u32(what);
+        const uint32_t buffers = load<uint32_t>(what);
         if (buffers != 1) corrupt(what + " has " + std::to_string(buffers) + " buffers; point grids have 1");
         // Leaves are made with the background as their value, and a PointDataLeafNode
         // asserts that it is 0 (its values are point offsets), aborting the process.
-        const uint32_t background = u32(what);
+        const uint32_t background = load<uint32_t>(what);
         if (background != 0) {
             corrupt(what + " has background " + std::to_string(background) + "; point grids need 0");
         }
-        const uint32_t tiles = u32(what);
-        const uint32_t children = u32(what);
+        const uint32_t tiles = load<uint32_t>(what);
+        const uint32_t children = load<uint32_t>(what);
         if (tiles > left() / 17) {
             corrupt(what + " claims " + std::to_string(tiles) + " root tiles in " +
                     std::to_string(left()) + " bytes");
@@ -674,10 +674,8 @@ public:
         // the leaf buffers would belong to other leaves than the ones walked here.
         std::array<int32_t, 3> previous{};
         for (uint32_t i = 0; i < children; ++i) {
-            need(12, what);
             std::array<int32_t, 3> origin;
-            std::memcpy(origin.data(), mData + mPos, 12);
-            mPos += 12;
+            for (int32_t& xyz : origin) xyz = load<int32_t>(what);
             if (i > 0 && !(previous < origin)) {
                 corrupt("root children of " + what + " are not in order: (" + coord(origin) +
                         ") after (" + coord(previous) + ")");
@@ -726,10 +724,7 @@ public:
             return;
         }
         // io::bloscFromStream / unzipFromStream: an int64 size, negative for raw bytes.
-        need(8, what);
-        int64_t chunk;
-        std::memcpy(&chunk, mData + mPos, 8);
-        mPos += 8;
+        const int64_t chunk = load<int64_t>(what);
         if (chunk <= 0) {
             if (uint64_t(0) - uint64_t(chunk) != bytes) {
                 corrupt("uncompressed chunk of " + std::to_string(uint64_t(0) - uint64_t(chunk)) +
@@ -758,34 +753,17 @@ public:
     /// The readers below name what they read for the error message with @a what: a string,
     /// or (in the per-leaf walk, run for every leaf) a callable returning one, called only
     /// when there is an error to report.
-    template<typename WhatT>
-    uint64_t u64(const WhatT& what)
+    ///
+    /// An integer of type @a T as the file stores it (OpenVDB writes the host's byte order,
+    /// little-endian on every platform it supports). Also used for the grid count.
+    template<typename T, typename WhatT>
+    T load(const WhatT& what)
     {
-        need(8, what);
-        uint64_t value;
-        std::memcpy(&value, mData + mPos, 8);
-        mPos += 8;
-        return value;
-    }
-
-    template<typename WhatT>
-    uint16_t u16(const WhatT& what)
-    {
-        need(2, what);
-        uint16_t value;
-        std::memcpy(&value, mData + mPos, 2);
-        mPos += 2;
-        return value;
-    }
-
-    /// Also used for the grid count.
-    template<typename WhatT>
-    uint32_t u32(const WhatT& what)
-    {
-        need(4, what);
-        uint32_t value;
-        std::memcpy(&value, mData + mPos, 4);
-        mPos += 4;
+        static_assert(std::is_integral_v<T>, "load<T>() reads integers");
+        need(sizeof(T), what);
+        T value;
+        std::memcpy(&value, mData + mPos, sizeof(T));
+        mPos += sizeof(T);
         return value;
     }
 
@@ -816,15 +794,9 @@ private:
         mPos += size_t(bytes);
     }
     template<typename WhatT>
-    uint8_t u8(const WhatT& what)
-    {
-        need(1, what);
-        return mData[mPos++];
-    }
-    template<typename WhatT>
     std::string string(const WhatT& what)
     {
-        const uint32_t length = u32(what);
+        const uint32_t length = load<uint32_t>(what);
         if (length > left()) {
             corrupt(describe(what) + " claims " + std::to_string(length) + " bytes, " +
                     std::to_string(left()) + " left");
@@ -840,12 +812,12 @@ private:
     void delayedLoadValue(uint32_t bytes, const std::string& item)
     {
         if (bytes == 0) return;
-        const uint32_t count = u32(item);
+        const uint32_t count = load<uint32_t>(item);
         // A leaf takes far more than one byte of the file.
         if (count > mSize) corrupt(item + " claims " + std::to_string(count) + " leaves");
         for (int array = 0; array < 2; ++array) {
             const uint64_t width = array == 0 ? 1 : 8;
-            const uint32_t compressed = u32(item);
+            const uint32_t compressed = load<uint32_t>(item);
             if (array == 1 && compressed == std::numeric_limits<uint32_t>::max()) break;
             if (compressed == 0) {
                 skip(uint64_t(count) * width, item);
@@ -911,7 +883,7 @@ public:
         fileMetadata.readMeta(is);
         expectAt(check.pos(), "the file metadata");
 
-        const uint32_t gridCount = check.u32("grid count");
+        const uint32_t gridCount = check.load<uint32_t>("grid count");
         // A grid takes at least its descriptor (three strings and three offsets).
         if (gridCount > check.left() / 36) {
             check.corrupt("grid count " + std::to_string(int32_t(gridCount)) + " does not fit in the file");
