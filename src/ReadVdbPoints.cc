@@ -31,6 +31,9 @@
 #include <openvdb/points/StreamCompression.h>
 #pragma GCC visibility pop
 
+#include <blosc.h>  // BLOSC_MAX_OVERHEAD
+#include <zlib.h>
+
 #include <algorithm>
 #include <array>
 #include <cctype>
@@ -163,7 +166,10 @@ convertGrid(const PointDataGrid& grid, const std::string& path)
 /// where every node's values come as a chunk whose size io::bloscFromStream/unzipFromStream
 /// allocate before reading, and then every leaf's buffers (pointLeafBuffers(): attribute
 /// descriptors, array metadata, page headers, pages, point offsets), where OpenVDB also
-/// asserts on sizes it did not check. The whole grid is walked before OpenVDB reads any of it.
+/// asserts on sizes it did not check. Every compressed chunk in there (Blosc, or zlib in a
+/// topology) is decompressed into a scratch buffer and must give the bytes it should:
+/// OpenVDB throws on corrupt data, and leaks when it does. The whole grid is walked before
+/// OpenVDB reads any of it.
 class VdbSizeCheck
 {
 public:
@@ -287,8 +293,8 @@ public:
     /// arrays out of pages without checking that they are as long as the array. So each size
     /// is checked here against the bytes left and against what the array must hold (its size,
     /// stride and storage type), every leaf and every page, before OpenVDB reads any of it.
-    /// One pass over the bytes, without decompressing anything: Blosc chunks are checked by
-    /// their 16-byte headers.
+    /// One pass over the bytes: Blosc chunks are checked by their 16-byte headers, then
+    /// decompressed (bloscChunk()), since OpenVDB leaks when it throws on corrupt data.
     void pointLeafBuffers(const std::string& grid)
     {
         const std::string what = "leaf buffers of " + grid;
@@ -592,8 +598,16 @@ public:
     /// compression::BLOSC_PAD_BYTES to that length with zeros before compressing them.)
     /// Blosc's codecs do not compress more than 1032:1 (deflate's limit; OpenVDB writes LZ4,
     /// at most about 255:1), which bounds what a small file can make OpenVDB allocate.
+    /// A tree's topology is read by io::bloscFromStream, which neither pads nor accepts
+    /// padding (@a padded false).
+    ///
+    /// The chunk is then decompressed into a scratch buffer, as OpenVDB will decompress it,
+    /// and must give exactly the bytes its header says: sizes cannot tell corrupt data, and
+    /// OpenVDB leaks when it throws on it (in the topology, RootNode::readTopology holds the
+    /// new child node in a raw pointer, 270 KB and its subtree; in the leaf buffers, the
+    /// pages and page handles of PagedInputStream). At most a page (1 MB) at a time.
     template<typename WhatT>
-    void bloscChunk(uint64_t bytes, uint64_t uncompressed, const WhatT& where)
+    void bloscChunk(uint64_t bytes, uint64_t uncompressed, const WhatT& where, bool padded = true)
     {
         need(bytes, where);
         if (bytes < 16) {
@@ -603,7 +617,7 @@ public:
         uint32_t header[3];
         std::memcpy(header, mData + mPos + 4, sizeof(header));
         const uint64_t pad = uint64_t(openvdb::compression::BLOSC_PAD_BYTES);
-        const bool padded = header[0] == pad && uncompressed <= pad;
+        padded = padded && header[0] == pad && uncompressed <= pad;
         // Blosc divides by the block size and allocates by it; it writes 1 for no bytes.
         if ((header[0] != uncompressed && !padded) || header[2] != bytes || header[1] == 0
             || header[1] > std::max<uint32_t>(header[0], 1)) {
@@ -614,6 +628,19 @@ public:
         if (uncompressed / 1032 > bytes) {
             corrupt("Blosc chunk in " + describe(where) + " claims " + std::to_string(uncompressed) +
                     " bytes from " + std::to_string(bytes) + ", more than 1032:1");
+        }
+        // A bare 16-byte header of no bytes (a node without active values) is what
+        // io::bloscFromStream accepts and compression::bloscDecompress would not.
+        if (header[0] > 0) {
+            // compression::bloscDecompress wants room for Blosc's overhead after the bytes.
+            mScratch.resize(std::max(mScratch.size(), size_t(header[0]) + BLOSC_MAX_OVERHEAD));
+            try {
+                openvdb::compression::bloscDecompress(mScratch.data(), size_t(uncompressed),
+                    size_t(header[0]) + BLOSC_MAX_OVERHEAD, reinterpret_cast<const char*>(mData + mPos));
+            } catch (const openvdb::Exception&) {
+                corrupt("corrupt Blosc chunk in " + describe(where) + ": it does not decompress to the " +
+                        std::to_string(header[0]) + " bytes its header gives");
+            }
         }
         mPos += size_t(bytes);
     }
@@ -739,8 +766,30 @@ public:
         }
         // Blosc takes precedence over zip (io::readData); Blosc reads as much as its own
         // header says, whatever the chunk size said.
-        if (compression & openvdb::io::COMPRESS_BLOSC) bloscChunk(uint64_t(chunk), bytes, what);
-        else mPos += size_t(chunk);
+        if (compression & openvdb::io::COMPRESS_BLOSC) {
+            bloscChunk(uint64_t(chunk), bytes, what, /*padded=*/false);
+        } else {
+            zipChunk(mData + mPos, size_t(chunk), size_t(bytes), what);
+            mPos += size_t(chunk);
+        }
+    }
+
+    /// io::unzipFromStream() of a chunk of node values (at most 32^3 values of 4 bytes): it
+    /// is inflated into a scratch buffer first and must give exactly @a bytes, for the
+    /// reason bloscChunk() gives (OpenVDB throws on it inside RootNode::readTopology).
+    void zipChunk(const unsigned char* chunk, size_t chunkBytes, size_t bytes, const std::string& what)
+    {
+        mScratch.resize(std::max(mScratch.size(), bytes));
+        uLongf inflated = uLongf(bytes);
+        const int status = uncompress(reinterpret_cast<Bytef*>(mScratch.data()), &inflated,
+                                      chunk, uLong(chunkBytes));
+        if (status != Z_OK) {
+            corrupt("corrupt zlib chunk in " + what + " (" + zError(status) + ")");
+        }
+        if (inflated != bytes) {
+            corrupt("zlib chunk in " + what + " inflates to " + std::to_string(inflated) +
+                    " bytes, expected " + std::to_string(bytes));
+        }
     }
 
     static size_t bitCount(const unsigned char* bytes, size_t size)
@@ -839,6 +888,7 @@ private:
     const std::string& mPath;
     bool mHasGridOffsets = false;
     uint64_t mLeafCount = 0;  ///< leaves in the topology walked last
+    std::vector<char> mScratch;  ///< decompressed chunks (bloscChunk(), zipChunk())
     /// sizeof(StorageType) per attribute array type seen (storageBytes())
     std::map<openvdb::NamePair, size_t> mStorageBytes;
 };
