@@ -5,13 +5,18 @@
 ///        attribute of a numeric or vector type, by name. Group and string attributes have
 ///        no ParticleAttribute counterpart and are skipped.
 ///
-/// The bytes are read from memory the way openvdb::io::Stream reads them, grid by grid, so
-/// the reader never opens the file twice and the fuzz target can feed it bytes; before
-/// OpenVDB reads a header, metadata, grid descriptor, transform or a PointDataGrid's tree
-/// and leaf buffers, every size in it is checked against the bytes present and against what
-/// it describes (VdbSizeCheck), and grids that are not needed are skipped unread when the
-/// file says where they end. Points are visited leaf by leaf in tree order, so the particle
-/// order is the same on every run.
+/// The bytes are read the way openvdb::io::Stream reads them, grid by grid, from a
+/// VdbSource: the open file (readVdbPointsFile(), never opened twice) or a memory block (the
+/// fuzz target's bytes, a pipe). Before OpenVDB reads a header, metadata, grid descriptor,
+/// transform or a PointDataGrid's tree and leaf buffers, every size in it is checked against
+/// the bytes present and against what it describes, and every compressed chunk of the grid
+/// is decompressed once (VdbSizeCheck, through a 64 KB window); OpenVDB then reads the same
+/// bytes through a 64 KB stream buffer (VdbStreamBuf). So the file is never held whole: peak
+/// memory is the PointDataGrid, then the particle arrays made from it. Grids that are not
+/// needed are skipped unread when the file says where they end. Points are visited leaf by
+/// leaf in tree order, so the particle order is the same on every run.
+
+#include "ReadVdbPoints.h"
 
 #include "FileFormats.h"
 #include "ParticleReaders.h"
@@ -37,12 +42,17 @@
 #include <algorithm>
 #include <array>
 #include <cctype>
+#include <cerrno>
 #include <cstring>
+#include <istream>
 #include <limits>
 #include <map>
 #include <memory>
-#include <sstream>
+#include <streambuf>
 #include <type_traits>
+#include <vector>
+
+#include <unistd.h>
 
 namespace nonbloppy {
 namespace io_internal {
@@ -153,6 +163,184 @@ convertGrid(const PointDataGrid& grid, const std::string& path)
 }
 
 // ------------------------------------------------------------------------------------------
+// Where the bytes come from
+
+/// The bytes of a .vdb file by position: a block in memory (the fuzz target's input, a pipe
+/// read whole) or an open regular file, read with pread() so that the walk and OpenVDB's
+/// stream can each keep their own position in it.
+class VdbSource
+{
+public:
+    VdbSource(const char* data, size_t size, const std::string& path)
+        : mMemory(data), mSize(size), mPath(path) {}
+    /// @a fd stays the caller's to close.
+    VdbSource(int fd, uint64_t size, const std::string& path) : mFd(fd), mSize(size), mPath(path) {}
+
+    uint64_t size() const { return mSize; }
+    /// The whole block, or nullptr for a file.
+    const char* memory() const { return mMemory; }
+
+    /// Copy the @a n bytes at @a pos (pos + n <= size()) to @a out.
+    /// @throw FileError "cannot read <path>: <reason>", or the truncated-stream error if the
+    ///        file shrank since its size was taken.
+    void read(uint64_t pos, char* out, size_t n) const
+    {
+        if (mMemory) {
+            std::memcpy(out, mMemory + pos, n);
+            return;
+        }
+        while (n > 0) {
+            const ssize_t got = ::pread(mFd, out, n, off_t(pos));
+            if (got < 0) {
+                if (errno == EINTR) continue;
+                failRead(mPath, errno);
+            }
+            if (got == 0) fail(mPath, "cannot read .vdb file: truncated stream");
+            out += got;
+            pos += uint64_t(got);
+            n -= size_t(got);
+        }
+    }
+
+private:
+    const char* mMemory = nullptr;
+    int mFd = -1;
+    uint64_t mSize = 0;
+    const std::string& mPath;
+};
+
+/// A window onto a VdbSource for the walk (VdbSizeCheck): the bytes asked for, and up to
+/// kWindowBytes after them, read at once. A request longer than that (a long string, a
+/// compressed chunk: at most a page of 1 MB in files OpenVDB writes) widens the window.
+class VdbWindow
+{
+public:
+    explicit VdbWindow(const VdbSource& source) : mSource(source) {}
+
+    /// The @a n bytes at @a pos (pos + n <= size()), valid until the next call.
+    const unsigned char* bytes(uint64_t pos, size_t n)
+    {
+        if (const char* memory = mSource.memory()) {
+            return reinterpret_cast<const unsigned char*>(memory + pos);
+        }
+        if (pos < mStart || pos + n > mStart + mLength) {
+            const size_t length = size_t(std::min<uint64_t>(std::max(n, kWindowBytes), mSource.size() - pos));
+            if (mBuffer.size() < length) mBuffer.resize(length);
+            mSource.read(pos, mBuffer.data(), length);
+            mStart = pos;
+            mLength = length;
+        }
+        return reinterpret_cast<const unsigned char*>(mBuffer.data()) + (pos - mStart);
+    }
+
+    uint64_t size() const { return mSource.size(); }
+
+private:
+    static constexpr size_t kWindowBytes = size_t(1) << 16;
+    const VdbSource& mSource;
+    std::vector<char> mBuffer;
+    uint64_t mStart = 0;
+    size_t mLength = 0;
+};
+
+/// The std::streambuf OpenVDB reads from: the memory block itself, or a file through a
+/// buffer of kBufferBytes (reads longer than that go straight into the caller's memory).
+/// Seekable, read-only.
+class VdbStreamBuf : public std::streambuf
+{
+public:
+    explicit VdbStreamBuf(const VdbSource& source) : mSource(source)
+    {
+        if (const char* memory = source.memory()) {
+            char* begin = const_cast<char*>(memory);  // a get area only: never written
+            setg(begin, begin, begin + source.size());
+        } else {
+            mBuffer.resize(kBufferBytes);
+            setg(mBuffer.data(), mBuffer.data(), mBuffer.data());
+        }
+    }
+
+protected:
+    int_type underflow() override
+    {
+        if (gptr() < egptr()) return traits_type::to_int_type(*gptr());
+        if (!fill()) return traits_type::eof();
+        return traits_type::to_int_type(*gptr());
+    }
+
+    std::streamsize xsgetn(char* out, std::streamsize count) override
+    {
+        std::streamsize done = 0;
+        while (done < count) {
+            if (gptr() == egptr()) {
+                const uint64_t pos = position();
+                const uint64_t rest = uint64_t(count - done);
+                if (!mSource.memory() && rest >= kBufferBytes) {
+                    const size_t n = size_t(std::min(rest, mSource.size() - pos));
+                    if (n == 0) break;
+                    mSource.read(pos, out + done, n);
+                    done += std::streamsize(n);
+                    mStart = pos + n;
+                    setg(mBuffer.data(), mBuffer.data(), mBuffer.data());
+                    continue;
+                }
+                if (!fill()) break;
+            }
+            const std::streamsize n = std::min<std::streamsize>(count - done, egptr() - gptr());
+            std::memcpy(out + done, gptr(), size_t(n));
+            setg(eback(), gptr() + n, egptr());
+            done += n;
+        }
+        return done;
+    }
+
+    pos_type seekoff(off_type offset, std::ios_base::seekdir dir, std::ios_base::openmode which) override
+    {
+        const off_type base = dir == std::ios_base::beg ? 0
+                            : dir == std::ios_base::cur ? off_type(position()) : off_type(mSource.size());
+        return seekpos(pos_type(base + offset), which);
+    }
+
+    pos_type seekpos(pos_type target, std::ios_base::openmode which) override
+    {
+        const off_type pos = off_type(target);
+        if (!(which & std::ios_base::in) || pos < 0 || uint64_t(pos) > mSource.size()) {
+            return pos_type(off_type(-1));
+        }
+        const uint64_t buffered = uint64_t(egptr() - eback());
+        if (uint64_t(pos) >= mStart && uint64_t(pos) <= mStart + buffered) {
+            setg(eback(), eback() + (uint64_t(pos) - mStart), egptr());
+        } else {
+            mStart = uint64_t(pos);
+            setg(mBuffer.data(), mBuffer.data(), mBuffer.data());
+        }
+        return target;
+    }
+
+private:
+    uint64_t position() const { return mStart + uint64_t(gptr() - eback()); }
+
+    /// The next bytes of the file into the buffer; false at the end (or for memory, whose
+    /// get area is all of it).
+    bool fill()
+    {
+        if (mSource.memory()) return false;
+        const uint64_t pos = position();
+        const size_t n = size_t(std::min<uint64_t>(kBufferBytes, mSource.size() - pos));
+        if (n == 0) return false;
+        mSource.read(pos, mBuffer.data(), n);
+        mStart = pos;
+        setg(mBuffer.data(), mBuffer.data(), mBuffer.data() + n);
+        return true;
+    }
+
+    static constexpr uint64_t kBufferBytes = uint64_t(1) << 16;
+    const VdbSource& mSource;
+    std::vector<char> mBuffer;
+    uint64_t mStart = 0;  ///< file position of eback()
+};
+
+// ------------------------------------------------------------------------------------------
 // Reading the stream with every size OpenVDB would trust checked first
 
 /// Checks the parts of a .vdb stream in which OpenVDB (io::Stream, MetaMap, GridDescriptor,
@@ -173,17 +361,17 @@ convertGrid(const PointDataGrid& grid, const std::string& path)
 class VdbSizeCheck
 {
 public:
-    VdbSizeCheck(const unsigned char* data, size_t size, const std::string& path)
-        : mData(data), mSize(size), mPath(path) {}
+    VdbSizeCheck(const VdbSource& source, const std::string& path)
+        : mBytes(source), mSize(source.size()), mPath(path) {}
 
-    void seek(size_t pos) { mPos = std::min(pos, mSize); }
+    void seek(size_t pos) { mPos = std::min<uint64_t>(pos, mSize); }
     size_t pos() const { return mPos; }
 
     /// The header io::Archive::readHeader() reads; returns the file format version.
     uint32_t header()
     {
         static const unsigned char kMagic[8] = {0x20, 0x42, 0x44, 0x56, 0, 0, 0, 0};
-        if (mSize < 8 || std::memcmp(mData, kMagic, 8) != 0) corrupt("not a VDB file");
+        if (mSize < 8 || std::memcmp(mBytes.bytes(0, 8), kMagic, 8) != 0) corrupt("not a VDB file");
         mPos = 8;
         const uint32_t version = load<uint32_t>("header");
         // PointDataGrids came with file format 223 or later; the per-grid compression
@@ -199,12 +387,12 @@ public:
                     std::to_string(openvdb::OPENVDB_FILE_VERSION) + ")");
         }
         skip(4 + 4, "header");  // library major, minor
-        need(1, "header");
-        mHasGridOffsets = mData[mPos++] != 0;
+        mHasGridOffsets = load<uint8_t>("header") != 0;
         // The UUID as text, 8-4-4-4-12 hex digits (boost::uuids' stream format).
         need(36, "header");
+        const unsigned char* uuid = here(36);
         for (size_t i = 0; i < 36; ++i) {
-            const char c = char(mData[mPos + i]);
+            const char c = char(uuid[i]);
             const bool dash = i == 8 || i == 13 || i == 18 || i == 23;
             if (dash ? c != '-' : !std::isxdigit(static_cast<unsigned char>(c))) corrupt("bad UUID in header");
         }
@@ -615,7 +803,7 @@ public:
                     " is shorter than its header");
         }
         uint32_t header[3];
-        std::memcpy(header, mData + mPos + 4, sizeof(header));
+        std::memcpy(header, here(16) + 4, sizeof(header));
         const uint64_t pad = uint64_t(openvdb::compression::BLOSC_PAD_BYTES);
         padded = padded && header[0] == pad && uncompressed <= pad;
         // Blosc divides by the block size and allocates by it; it writes 1 for no bytes.
@@ -636,7 +824,7 @@ public:
             mScratch.resize(std::max(mScratch.size(), size_t(header[0]) + BLOSC_MAX_OVERHEAD));
             try {
                 openvdb::compression::bloscDecompress(mScratch.data(), size_t(uncompressed),
-                    size_t(header[0]) + BLOSC_MAX_OVERHEAD, reinterpret_cast<const char*>(mData + mPos));
+                    size_t(header[0]) + BLOSC_MAX_OVERHEAD, reinterpret_cast<const char*>(here(size_t(bytes))));
             } catch (const openvdb::Exception&) {
                 corrupt("corrupt Blosc chunk in " + describe(where) + ": it does not decompress to the " +
                         std::to_string(header[0]) + " bytes its header gives");
@@ -724,8 +912,9 @@ public:
     {
         const size_t maskBytes = (size_t(1) << (3 * log2Dim)) / 8;
         need(2 * maskBytes, what);
-        const size_t childCount = bitCount(mData + mPos, maskBytes);
-        const size_t activeCount = bitCount(mData + mPos + maskBytes, maskBytes);
+        const unsigned char* masks = here(2 * maskBytes);
+        const size_t childCount = bitCount(masks, maskBytes);
+        const size_t activeCount = bitCount(masks + maskBytes, maskBytes);
         mPos += 2 * maskBytes;
         compressedValues(size_t(1) << (3 * log2Dim), activeCount, maskBytes, compression, what);
         for (size_t c = 0; c < childCount; ++c) {
@@ -740,8 +929,7 @@ public:
     void compressedValues(size_t count, size_t activeCount, size_t maskBytes,
                           uint32_t compression, const std::string& what)
     {
-        need(1, what);
-        const int8_t flag = static_cast<int8_t>(mData[mPos++]);
+        const int8_t flag = load<int8_t>(what);
         if (flag == 2 || flag == 4 || flag == 5) skip(flag == 5 ? 8 : 4, what);
         if (flag == 3 || flag == 4 || flag == 5) skip(maskBytes, what);
         if ((compression & openvdb::io::COMPRESS_ACTIVE_MASK) && flag != 6) count = activeCount;
@@ -769,7 +957,7 @@ public:
         if (compression & openvdb::io::COMPRESS_BLOSC) {
             bloscChunk(uint64_t(chunk), bytes, what, /*padded=*/false);
         } else {
-            zipChunk(mData + mPos, size_t(chunk), size_t(bytes), what);
+            zipChunk(here(size_t(chunk)), size_t(chunk), size_t(bytes), what);
             mPos += size_t(chunk);
         }
     }
@@ -811,7 +999,7 @@ public:
         static_assert(std::is_integral_v<T>, "load<T>() reads integers");
         need(sizeof(T), what);
         T value;
-        std::memcpy(&value, mData + mPos, sizeof(T));
+        std::memcpy(&value, here(sizeof(T)), sizeof(T));
         mPos += sizeof(T);
         return value;
     }
@@ -850,7 +1038,7 @@ private:
             corrupt(describe(what) + " claims " + std::to_string(length) + " bytes, " +
                     std::to_string(left()) + " left");
         }
-        std::string text(reinterpret_cast<const char*>(mData + mPos), length);
+        std::string text(reinterpret_cast<const char*>(here(length)), length);
         mPos += length;
         return text;
     }
@@ -876,14 +1064,18 @@ private:
             // uncompressed size (little-endian).
             if (compressed < 16 || compressed > left()) corrupt("bad compressed array in " + item);
             uint32_t uncompressed;
-            std::memcpy(&uncompressed, mData + mPos + 4, 4);
+            std::memcpy(&uncompressed, here(16) + 4, 4);
             if (uncompressed != uint64_t(count) * width) corrupt("bad compressed array in " + item);
             mPos += compressed;
         }
     }
 
-    const unsigned char* mData;
-    size_t mSize;
+    /// The @a n bytes at the read position (need() has checked them), valid until the next
+    /// read.
+    const unsigned char* here(size_t n) { return mBytes.bytes(mPos, n); }
+
+    VdbWindow mBytes;
+    uint64_t mSize;
     size_t mPos = 0;
     const std::string& mPath;
     bool mHasGridOffsets = false;
@@ -900,10 +1092,12 @@ class CheckedVdbStream : public openvdb::io::Archive
 {
 public:
     /// The grids read, the last of them the first PointDataGrid if there is one.
-    openvdb::GridPtrVec read(const char* data, size_t size, const std::string& path)
+    openvdb::GridPtrVec read(const VdbSource& source, const std::string& path)
     {
-        VdbSizeCheck check(reinterpret_cast<const unsigned char*>(data), size, path);
-        std::istringstream is(std::string(data, size), std::ios::in | std::ios::binary);
+        const uint64_t size = source.size();
+        VdbSizeCheck check(source, path);
+        VdbStreamBuf buffer(source);
+        std::istream is(&buffer);
         // OpenVDB does not check its reads: past the end it would go on with uninitialised
         // sizes. A short read throws instead.
         is.exceptions(std::ios::failbit | std::ios::badbit);
@@ -977,15 +1171,14 @@ public:
     }
 };
 
-} // namespace
-
+/// The first PointDataGrid of @a source, converted.
 ParticleSet
-readVdbPointsParticles(const char* data, size_t size, const std::string& path)
+readVdbPoints(const VdbSource& source, const std::string& path)
 {
     openvdb::initialize();
     openvdb::GridPtrVec grids;
     try {
-        grids = CheckedVdbStream().read(data, size, path);
+        grids = CheckedVdbStream().read(source, path);
         for (const openvdb::GridBase::Ptr& grid : grids) {
             if (const auto points = openvdb::gridConstPtrCast<PointDataGrid>(grid)) {
                 return convertGrid(*points, path);
@@ -1013,6 +1206,27 @@ readVdbPointsParticles(const char* data, size_t size, const std::string& path)
              }
              return names.empty() ? std::string("none") : names;
          }() + "); a density cache cannot be meshed as particles");
+}
+
+} // namespace
+
+ParticleSet
+readVdbPointsParticles(const char* data, size_t size, const std::string& path)
+{
+    return readVdbPoints(VdbSource(data, size, path), path);
+}
+
+ParticleSet
+readVdbPointsFile(const std::string& path)
+{
+    const OpenFile file = openFile(path);
+    if (!file.regular) {
+        // A pipe cannot be read twice (walk, then OpenVDB): read it whole.
+        const std::vector<char> data = readToEndAndClose(file.fd, path, 0);
+        return readVdbPointsParticles(data.data(), data.size(), path);
+    }
+    struct FdCloser { int fd; ~FdCloser() { ::close(fd); } } closer{file.fd};
+    return readVdbPoints(VdbSource(file.fd, file.size, path), path);
 }
 
 } // namespace io_internal

@@ -1,0 +1,29 @@
+// SPDX-License-Identifier: Apache-2.0
+/// @file ReadVdbPoints.h
+/// @brief Private: the OpenVDB points reader by path, streaming the file instead of loading it.
+///
+/// readVdbPointsParticles() (ParticleReaders.h) runs the same code over a memory block (the
+/// fuzz target's input); both give the same particles and, word for word, the same errors.
+
+#ifndef NONBLOPPY_READ_VDB_POINTS_H
+#define NONBLOPPY_READ_VDB_POINTS_H
+
+#include <nonbloppy/Particles.h>
+
+#include <string>
+
+namespace nonbloppy {
+namespace io_internal {
+
+/// The first openvdb::points::PointDataGrid of the `.vdb` file @a path. The file is walked
+/// and checked through a bounded window (pread), then libopenvdb parses the grid from the
+/// same open file through a bounded stream buffer, so peak memory is the PointDataGrid plus
+/// the particle arrays, not the file. A pipe or other non-regular file, which cannot be
+/// read twice, is read whole first.
+/// @throw FileError naming @a path.
+ParticleSet readVdbPointsFile(const std::string& path);
+
+} // namespace io_internal
+} // namespace nonbloppy
+
+#endif // NONBLOPPY_READ_VDB_POINTS_H
