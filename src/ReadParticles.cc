@@ -21,6 +21,7 @@
 
 #include "FileFormats.h"
 #include "ParticleReaders.h"
+#include "ReadVdbPoints.h"
 #include "ReadVtu.h"
 #include "StreamReader.h"
 
@@ -519,9 +520,8 @@ readParticles(const std::string& path)
     } else if (ext == ".vtu" || ext == ".vtp") {
         particles = readVtuFile(path);
     } else {
-        // .vdb goes through OpenVDB's own stream reader, on the whole file in memory.
-        const std::vector<char> file = loadFile(path);
-        particles = readVdbPointsParticles(file.data(), file.size(), path);
+        // .vdb: walked and checked through a window, then read by OpenVDB from the file.
+        particles = readVdbPointsFile(path);
     }
 
     // Later stages hash positions into voxels; one NaN would poison the whole grid.
