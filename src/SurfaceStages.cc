@@ -4,6 +4,8 @@
 
 #include "SurfaceStages.h"
 
+#include "Cancellation.h"
+
 #include <nonbloppy/ComputeNormals.h>
 #include <nonbloppy/CorrectSurface.h>
 #include <nonbloppy/Error.h>
@@ -19,9 +21,7 @@ namespace surface_stages_internal {
 
 void checkCancelled(openvdb::util::NullInterrupter* interrupter, const char* stage)
 {
-    if (interrupter && interrupter->wasInterrupted()) {
-        throw CancelledError(std::string("interrupted during ") + stage);
-    }
+    cancellation_internal::CancelPoll(interrupter, stage).throwIfStopped();
 }
 
 void runSurfaceStages(const ParticleIndex& index, bool keepDensity, SurfaceResult& result,
