@@ -407,6 +407,8 @@ bool extractByRegionImpl(const openvdb::FloatGrid& density, double threshold, Su
     std::unique_ptr<std::atomic<uint8_t>[]> used;
     std::vector<size_t> newBefore;
     std::vector<size_t> claimedBefore;
+    std::vector<uint32_t> regionLeaves;   // pieces of the current region that are copied
+    std::vector<FloatLeaf*> leafCopies;   // their copies, in that order
     constexpr uint32_t kNew = SeamTable::kNone;  // not in a seam table: a vertex of its own
     for (size_t r = 0; r < regions.size(); ++r) {
         poll.throwIfStopped();
@@ -421,11 +423,13 @@ bool extractByRegionImpl(const openvdb::FloatGrid& density, double threshold, Su
         const int bandBegin = bounds.min()[cross] + region.band.first * dim;
         const int bandEnd = bounds.min()[cross] + region.band.second * dim;
 
-        // The region's pieces plus kShellPlanes planes of the leaf layers around it.
+        // The region's pieces plus kShellPlanes planes of the leaf layers around it: tiles
+        // added here, leaves copied (and their shells cut) in parallel, then added in order.
         openvdb::FloatGrid::Ptr regionGrid = openvdb::FloatGrid::create(tree.background());
         regionGrid->setTransform(transform.copy());
         regionGrid->setGridClass(density.getGridClass());
         openvdb::FloatTree& regionTree = regionGrid->tree();
+        regionLeaves.clear();
         for (int layer = std::max(region.slab.first - 1, 0);
              layer <= std::min(region.slab.second, layerCount - 1); ++layer) {
             for (uint32_t n : piecesPerLayer[size_t(layer)]) {
@@ -434,23 +438,47 @@ bool extractByRegionImpl(const openvdb::FloatGrid& density, double threshold, Su
                 if (bandLayer < region.band.first - 1 || bandLayer > region.band.second) continue;
                 if (!piece.leaf || piece.role == LeafRole::Above) {
                     regionTree.addTile(1, piece.origin, piece.value, /*active=*/true);
-                    continue;
+                } else {
+                    regionLeaves.push_back(n);
                 }
-                auto* copy = new FloatLeaf(*piece.leaf);
-                const bool shell = layer < region.slab.first || layer >= region.slab.second
-                                   || bandLayer < region.band.first || bandLayer >= region.band.second;
-                if (shell) {
-                    for (openvdb::Index i = 0; i < FloatLeaf::SIZE; ++i) {
-                        const openvdb::Coord ijk = copy->offsetToGlobalCoord(i);
-                        if (ijk[axis] < slabBegin - kShellPlanes || ijk[axis] >= slabEnd + kShellPlanes
-                            || ijk[cross] < bandBegin - kShellPlanes || ijk[cross] >= bandEnd + kShellPlanes) {
-                            copy->setValueOff(i, tree.background());
-                        }
-                    }
-                }
-                regionTree.addLeaf(copy);
             }
         }
+        leafCopies.assign(regionLeaves.size(), nullptr);
+        // Voxels kept of a shell leaf: planes [low, high) along the two cut axes.
+        const openvdb::Coord keepLow = [&] {
+            openvdb::Coord c(std::numeric_limits<int>::min());
+            c[axis] = slabBegin - kShellPlanes;
+            c[cross] = bandBegin - kShellPlanes;
+            return c;
+        }();
+        const openvdb::Coord keepHigh = [&] {
+            openvdb::Coord c(std::numeric_limits<int>::max());
+            c[axis] = slabEnd + kShellPlanes;
+            c[cross] = bandEnd + kShellPlanes;
+            return c;
+        }();
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, regionLeaves.size(), 64),
+            [&](const tbb::blocked_range<size_t>& range) {
+                for (size_t k = range.begin(); k < range.end(); ++k) {
+                    const FloatLeaf& leaf = *pieces[regionLeaves[k]].leaf;
+                    auto* copy = new FloatLeaf(leaf);
+                    const openvdb::Coord origin = leaf.origin();
+                    bool inside = true;
+                    for (int a = 0; a < 3; ++a) {
+                        inside &= origin[a] >= keepLow[a] && origin[a] + dim <= keepHigh[a];
+                    }
+                    if (!inside) {
+                        for (openvdb::Index i = 0; i < FloatLeaf::SIZE; ++i) {
+                            const openvdb::Coord ijk = origin + FloatLeaf::offsetToLocalCoord(i);
+                            bool keep = true;
+                            for (int a = 0; a < 3; ++a) keep &= ijk[a] >= keepLow[a] && ijk[a] < keepHigh[a];
+                            if (!keep) copy->setValueOff(i, tree.background());
+                        }
+                    }
+                    leafCopies[k] = copy;
+                }
+            });
+        for (FloatLeaf* copy : leafCopies) regionTree.addLeaf(copy);
         openvdb::tools::VolumeToMesh mesher(threshold, 0.0);
         mesher(*regionGrid);
         regionGrid.reset();
