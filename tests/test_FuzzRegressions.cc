@@ -112,8 +112,9 @@ struct Expected
 
 const Expected kExpected[] = {
     // fuzz_vdb_points: a stream OpenVDB rejected halfway through a grid's tree, leaking a
-    // node (upstream; see tests/fuzz/lsan.supp): a Blosc chunk of an internal node whose own
-    // header says 0 bytes. The check of Blosc headers in the tree now rejects it first.
+    // node (upstream, once suppressed in tests/fuzz/lsan.supp): a Blosc chunk of an internal
+    // node whose own header says 0 bytes. The check of Blosc headers in the tree now rejects
+    // it first.
     {"vdb_points_corrupt_stream_openvdb_leak.vdb",
      "cannot read .vdb file: Blosc chunk in tree of grid 'points' says 0 bytes from 16 in blocks "
      "of 1; expected 8 bytes from 16"},
