@@ -184,6 +184,7 @@ ResolvedParameters resolveParameters(const SurfaceParameters& params,
     out.blend = params.blend;
     out.iterations = params.iterations;
     out.adaptivity = params.adaptivity;
+    out.regionLeaves = params.regionLeaves;
     out.spacingGiven = bool(params.spacing);
     out.effectiveRadiusGiven = bool(params.effectiveRadius);
     out.thresholdGiven = bool(params.threshold);

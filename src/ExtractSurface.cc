@@ -685,10 +685,11 @@ SurfaceMesh extractSurface(const openvdb::DoubleGrid& density, double threshold,
 namespace surface_stages_internal {
 
 void extractSurfaceInto(const openvdb::FloatGrid& density, double threshold, double adaptivity,
-                        SurfaceMesh& mesh, openvdb::util::NullInterrupter* interrupter)
+                        size_t leavesPerRegion, SurfaceMesh& mesh,
+                        openvdb::util::NullInterrupter* interrupter)
 {
-    if (adaptivity == 0.0) {
-        extractByRegion(density, threshold, mesh, interrupter, kLeavesPerRegion);
+    if (adaptivity == 0.0 && leavesPerRegion > 0) {
+        extractByRegion(density, threshold, mesh, interrupter, leavesPerRegion);
     } else {
         extractInto(density, threshold, adaptivity, mesh);
     }

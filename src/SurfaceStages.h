@@ -72,13 +72,6 @@ void runSurfaceStages(const ParticleIndex& index, bool keepDensity, SurfaceResul
                       std::vector<openvdb::Vec3s>& unrelaxed, UnrelaxedBuffer whenRepaired,
                       openvdb::util::NullInterrupter* interrupter);
 
-/// Kept leaves (those a crossing edge may touch) per region of extractByRegion(). A region
-/// is meshed in one uninterruptible volumeToMesh call, the longest wait for a cancel: on
-/// the 64× benchmark input, 1024 leaves take 75-120 ms (two busy cores), 2048 leaves
-/// 110-200 ms, 4096 leaves 200-370 ms. The price is the shells meshed twice: extraction
-/// CPU time 1.53× that of one whole-grid volumeToMesh at 1024 leaves, 1.39× at 2048, 1.25×
-/// at 4096 (scratch memory falls with the region size).
-constexpr size_t kLeavesPerRegion = 1024;
 /// Leaf layers (8 voxels each) per region at least, along each axis it is cut on: each
 /// region also meshes three voxel planes beyond each cut face, 19% more work per axis at
 /// four layers.
@@ -86,12 +79,13 @@ constexpr int kMinLayersPerRegion = 4;
 
 /// extractSurface() into @a mesh's existing vectors (which keep their capacity); normals and
 /// attributes are cleared. Same checks and orientation as extractSurface(); with adaptivity 0
-/// through extractByRegion() (the same polygons and vertices, in another order), polled for
-/// a cancel between regions. Defined in ExtractSurface.cc, the only translation unit that
+/// and @a leavesPerRegion > 0 through extractByRegion() (the same polygons and vertices, in
+/// another order), polled for a cancel between regions. Defined in ExtractSurface.cc, the only translation unit that
 /// includes tools/VolumeToMesh.h.
 /// @throw ParameterError as extractSurface(); CancelledError("interrupted during extract surface")
 void extractSurfaceInto(const openvdb::FloatGrid& density, double threshold, double adaptivity,
-                        SurfaceMesh& mesh, openvdb::util::NullInterrupter* interrupter);
+                        size_t leavesPerRegion, SurfaceMesh& mesh,
+                        openvdb::util::NullInterrupter* interrupter);
 
 /// The surface φ = @a threshold of a density grid (adaptivity 0), meshed region by region:
 /// slabs across the grid's longest axis, each cut again across the second longest when it
@@ -106,7 +100,7 @@ void extractSurfaceInto(const openvdb::FloatGrid& density, double threshold, dou
 /// count. A grid that makes one region, has tiles larger than a leaf or a transform that is
 /// not an axis-aligned scale is meshed whole, as extractSurface().
 /// Cost: O(voxels) as extractSurface(), plus copying the leaves a crossing touches and, per
-/// region, its shell (see kLeavesPerRegion); scratch memory is one region's plus the seam
+/// region, its shell (see SurfaceParameters::regionLeaves); scratch memory is one region's plus the seam
 /// vertices of two slabs. The interrupter (may be null) is asked while leaves are
 /// classified and before each region. Thread-safety: reentrant; the grid is only read.
 /// @throw ParameterError if @a threshold is not finite; CancelledError as above

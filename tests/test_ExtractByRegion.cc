@@ -8,6 +8,7 @@
 
 #include "../src/SurfaceStages.h"
 
+#include <nonbloppy/BuildSurface.h>
 #include <nonbloppy/Error.h>
 #include <nonbloppy/ExtractSurface.h>
 #include <nonbloppy/ParticleIndex.h>
@@ -157,6 +158,32 @@ TEST(ExtractByRegion, LeavesOutAndTilesLeavesNoCrossingTouchesWithoutChangingThe
     ASSERT_GT(tileDeepInterior(*tiled, kThreshold), 0u);
     extractByRegion(*tiled, kThreshold, regions, nullptr, 16, 1);
     EXPECT_TRUE(canonicalQuads(regions) == expected);
+}
+
+TEST(ExtractByRegion, RegionLeavesOfBuildSurfaceChangesOnlyTheOrder)
+{
+    // SurfaceParameters::regionLeaves: 0 meshes the grid whole, any other value by region;
+    // the plain method without relaxation leaves the extracted mesh as it is.
+    const ParticleSet frame =
+        readParticles(std::string(NONBLOPPY_TEST_DATA_DIR) + "/dam_break_frame_23_24389_particles.vtk");
+    SurfaceParameters params;
+    params.effectiveRadius = kRadius;
+    params.voxelSize = kVoxelSize;
+    params.threshold = kThreshold;
+    params.iterations = 0;
+    params.method = Method::Paper;
+    std::vector<Quad> expected;
+    for (const size_t regionLeaves : {size_t(0), size_t(1), size_t(64), kDefaultRegionLeaves}) {
+        params.regionLeaves = regionLeaves;
+        const SurfaceResult result = buildSurface(frame.positions, params);
+        EXPECT_EQ(result.parameters.regionLeaves, regionLeaves);
+        if (regionLeaves == 0) {
+            expected = canonicalQuads(result.mesh);
+            ASSERT_GT(expected.size(), 30000u);
+        } else {
+            EXPECT_TRUE(canonicalQuads(result.mesh) == expected) << regionLeaves << " leaves per region";
+        }
+    }
 }
 
 TEST(ExtractByRegion, SameOrderAtOneAndTwoThreads)

@@ -47,6 +47,11 @@ namespace {
 
 namespace fs = std::filesystem;
 
+/// Density leaves per extraction region for the tool: on the 64x benchmark input a signal
+/// is answered within about 0.5 s, and the extraction takes 1.5-1.7 s instead of the
+/// library default's 1.9-2.3 s (SurfaceParameters::regionLeaves).
+constexpr size_t kToolRegionLeaves = 16384;
+
 // ---------------------------------------------------------------------------------------
 // Cancellation and progress
 
@@ -433,10 +438,12 @@ FrameOutcome meshFrame(const MeshOptions& o, ProgressInterrupter& interrupter)
     params.iterations = o.iterations;
     params.adaptivity = o.adaptivity;
     params.method = o.method == "paper" ? nonbloppy::Method::Paper : nonbloppy::Method::Faithful;
-    // Without --vdb nothing needs the grid: the library then turns the fluid's deep interior
-    // into tiles before extraction (the same mesh, bit for bit) and frees the grid before
-    // relaxing, which lowers the peak memory of large frames.
+    // Without --vdb nothing needs the grid: the library frees it before relaxing, which
+    // lowers the peak memory of large frames.
     params.keepDensity = !o.vdbPath.empty();
+    // A Ctrl-C or a farm's SIGTERM needs no 50 ms answer: larger extraction regions mesh
+    // faster (see SurfaceParameters::regionLeaves).
+    params.regionLeaves = kToolRegionLeaves;
 
     // The particles are handed over, unless --attributes or --vdb-points still need them.
     const bool keepParticles = o.outputs.needParticles();
