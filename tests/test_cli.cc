@@ -207,6 +207,7 @@ TEST_F(CliTest, BadParameters)
     expectFailure(base + "-c 2", "--blend must lie in [0,1], got 2");
     expectFailure(base + "--iterations=-1", "--iterations must be >= 0, got -1");
     expectFailure(base + "--adaptivity 1.5", "--adaptivity must lie in [0,1], got 1.5");
+    expectFailure(base + "--region-leaves -1", "--region-leaves must be >= 0, got -1");
     expectFailure(base + "--threads 0", "--threads must be >= 1, got 0");
 }
 

@@ -9,7 +9,9 @@
 
 #include "CliTestUtil.h"
 
+#include <algorithm>
 #include <cstdio>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -271,6 +273,32 @@ TEST_F(CliSequenceTest, VerbosePrintsBytesPerParticle)
         EXPECT_NE(r.err.find("bytes/particle", at), std::string::npos) << r.err;
     }
     EXPECT_NE(r.err.find("getrusage ru_maxrss"), std::string::npos) << r.err;
+}
+
+TEST_F(CliSequenceTest, RegionLeavesChangeOnlyTheVertexOrder)
+{
+    // --region-leaves 0 extracts the grid whole, 1 in regions of one leaf: the same
+    // surface (plain method, no relaxation: the extracted mesh as it is), vertices in
+    // another order.
+    const std::string dam = kData + "/bunny_frame_14_7705_particles.vtk";
+    const std::string common = " --method paper -t 0 -q --quads";
+    ASSERT_EQ(run("mesh " + quote(dam) + " -o " + quote(out("whole.obj")) + common + " --region-leaves 0").exitCode, 0);
+    ASSERT_EQ(run("mesh " + quote(dam) + " -o " + quote(out("regions.obj")) + common + " --region-leaves 1").exitCode, 0);
+    const auto sortedLines = [](const std::string& text, char kind) {
+        std::vector<std::string> lines;
+        std::istringstream in(text);
+        for (std::string line; std::getline(in, line);) {
+            if (line.size() > 1 && line[0] == kind && line[1] == ' ') lines.push_back(line);
+        }
+        std::sort(lines.begin(), lines.end());
+        return lines;
+    };
+    const std::string whole = readText(out("whole.obj")), regions = readText(out("regions.obj"));
+    EXPECT_NE(whole, regions);  // another order
+    const std::vector<std::string> vertices = sortedLines(whole, 'v');
+    ASSERT_GT(vertices.size(), 1000u);
+    EXPECT_TRUE(vertices == sortedLines(regions, 'v'));
+    EXPECT_EQ(sortedLines(whole, 'f').size(), sortedLines(regions, 'f').size());
 }
 
 TEST_F(CliSequenceTest, MeshWithoutVdbIsTheSameMesh)

@@ -47,11 +47,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-/// Density leaves per extraction region for the tool: on the 64x benchmark input a signal
-/// is answered within about 0.5 s, and the extraction takes 1.5-1.7 s instead of the
-/// library default's 1.9-2.3 s (SurfaceParameters::regionLeaves).
-constexpr size_t kToolRegionLeaves = 16384;
-
 // ---------------------------------------------------------------------------------------
 // Cancellation and progress
 
@@ -186,6 +181,7 @@ struct MeshOptions
     double blend = nonbloppy::kDefaultBlend;
     int iterations = nonbloppy::kDefaultIterations;
     double adaptivity = nonbloppy::kDefaultAdaptivity;
+    long long regionLeaves = nonbloppy::kDefaultRegionLeaves;  ///< signed, so that -1 is refused
     std::string method = "faithful";  ///< --method: faithful (default) or paper
     CLI::Option* methodOpt = nullptr;
     int threads = 0;
@@ -265,6 +261,10 @@ void validateParameters(const MeshOptions& o)
                                         + std::to_string(o.iterations));
     }
     requireUnitInterval(o.adaptivity, "--adaptivity");
+    if (o.regionLeaves < 0) {
+        throw nonbloppy::ParameterError("--region-leaves must be >= 0, got "
+                                        + std::to_string(o.regionLeaves));
+    }
     if (o.threadsOpt->count() > 0 && o.threads < 1) {
         throw nonbloppy::ParameterError("--threads must be >= 1, got " + std::to_string(o.threads));
     }
@@ -441,9 +441,7 @@ FrameOutcome meshFrame(const MeshOptions& o, ProgressInterrupter& interrupter)
     // Without --vdb nothing needs the grid: the library frees it before relaxing, which
     // lowers the peak memory of large frames.
     params.keepDensity = !o.vdbPath.empty();
-    // A Ctrl-C or a farm's SIGTERM needs no 50 ms answer: larger extraction regions mesh
-    // faster (see SurfaceParameters::regionLeaves).
-    params.regionLeaves = kToolRegionLeaves;
+    params.regionLeaves = size_t(o.regionLeaves);
 
     // The particles are handed over, unless --attributes or --vdb-points still need them.
     const bool keepParticles = o.outputs.needParticles();
@@ -682,6 +680,10 @@ Command setupMeshCommand(CLI::App& parent)
 
     o.adaptivityOpt = cmd->add_option("--adaptivity", o.adaptivity,
         "Polygon merging in flat regions, in [0,1] (default: 0)")->group(kGroupAdvanced);
+    cmd->add_option("--region-leaves", o.regionLeaves,
+        "Density leaves per extraction region: smaller takes less memory and answers Ctrl-C "
+        "sooner, larger is faster; 0: the whole grid at once; the same surface either way, its vertices in another order "
+        "(default: " + std::to_string(nonbloppy::kDefaultRegionLeaves) + ")")->group(kGroupAdvanced);
     o.threadsOpt = cmd->add_option("--threads", o.threads,
         "Worker threads (default: all cores); results do not depend on it")
         ->group(kGroupAdvanced);
