@@ -2,10 +2,12 @@
 /// @file ParticleReaders.h
 /// @brief Private: the particle readers added after VTK/PLY/XYZ, one source file each,
 ///        working on a buffer holding the whole file (so the fuzz targets in tests/fuzz/
-///        can feed them bytes directly). readParticles() dispatches to them for .vdb
-///        only; BGEO, CSV/TXT and JSON files go through the streaming path readers of
-///        StreamReader.h, which run the same code over a bounded buffer, and .vtu/.vtp
-///        through readVtuFile() (ReadVtu.h), which streams the file through expat.
+///        can feed them bytes directly); readParticles() reads files otherwise:
+///        BGEO, CSV/TXT and JSON files go through the streaming path readers of
+///        StreamReader.h, which run the same code over a bounded buffer, .vtu/.vtp
+///        through readVtuFile() (ReadVtu.h), which streams the file through expat, and
+///        .vdb through readVdbPointsFile() (ReadVdbPoints.h), which reads the open file
+///        through bounded windows (a .vdb pipe is read whole, then walked).
 ///
 /// Each one names @a path in its errors only; it never opens it. Every count read from a
 /// header is checked against the bytes present before anything is allocated.
