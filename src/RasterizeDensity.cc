@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "Cancellation.h"
+#include "InstructionSet.h"
 #include "ParticleIndexImpl.h"
 
 #include <nonbloppy/Error.h>
@@ -14,6 +15,9 @@
 #include <atomic>
 #if defined(__SSE2__)
 #include <emmintrin.h>
+#endif
+#if NONBLOPPY_HAS_AVX2_COPY
+#include <immintrin.h>
 #endif
 #include <cmath>
 #include <sstream>
@@ -116,6 +120,23 @@ inline void addRowWeights(float* row, int zFirst, int zLast, float dxy2, float p
 #endif
 }
 
+#if NONBLOPPY_HAS_AVX2_COPY
+/// addRowWeights() for the AVX2 copy of the loop (InstructionSet.h): the whole 8-voxel row
+/// in one register. Voxels beyond the support get w = +0, which leaves their sums as they
+/// are, so the bits are those of the baseline, which skips them.
+NONBLOPPY_TARGET_AVX2 inline void addRowWeightsAvx2(float* row, float dxy2, float pz, float h, float radius,
+                                                    float minDistance2)
+{
+    const __m256 lz = _mm256_set_ps(7.0f, 6.0f, 5.0f, 4.0f, 3.0f, 2.0f, 1.0f, 0.0f);
+    const __m256 dz = _mm256_sub_ps(_mm256_mul_ps(lz, _mm256_set1_ps(h)), _mm256_set1_ps(pz));
+    const __m256 d2 = _mm256_add_ps(_mm256_set1_ps(dxy2), _mm256_mul_ps(dz, dz));
+    const __m256 distance = _mm256_sqrt_ps(_mm256_max_ps(d2, _mm256_set1_ps(minDistance2)));
+    __m256 w = _mm256_sub_ps(_mm256_div_ps(_mm256_set1_ps(radius), distance), _mm256_set1_ps(1.0f));
+    w = _mm256_max_ps(w, _mm256_setzero_ps());
+    _mm256_storeu_ps(row, _mm256_add_ps(_mm256_loadu_ps(row), w));
+}
+#endif
+
 /// Fills one density leaf from the particles whose support overlaps it (a gather over
 /// leaves, a scatter over each particle's clipped sphere inside the leaf): no two tasks
 /// write the same memory, and each voxel sums its particles in the index's fixed order.
@@ -128,8 +149,28 @@ struct RasterizeLeafOp
     double effectiveRadius;
     CancelPoll& poll;
     std::atomic<size_t>& done;
+    bool avx2;  ///< run the AVX2 copy of the loop (InstructionSet.h)
 
     void operator()(const tbb::blocked_range<size_t>& range) const
+    {
+#if NONBLOPPY_HAS_AVX2_COPY
+        if (avx2) { fillLeavesAvx2(range); return; }
+#endif
+        fillLeaves<false>(range);
+    }
+
+#if NONBLOPPY_HAS_AVX2_COPY
+    /// fillLeaves() compiled for AVX2 (it is inlined here).
+    NONBLOPPY_TARGET_AVX2 void fillLeavesAvx2(const tbb::blocked_range<size_t>& range) const
+    {
+        fillLeaves<true>(range);
+    }
+#endif
+
+    /// The leaves of @a range. Always inlined, so that each caller compiles it for its own
+    /// instruction set.
+    template<bool Avx2>
+    __attribute__((always_inline)) inline void fillLeaves(const tbb::blocked_range<size_t>& range) const
     {
         const auto& positions = particles.sortedPositions();
         auto accessor = particles.impl().grid->getConstAccessor();
@@ -174,6 +215,13 @@ struct RasterizeLeafOp
                                 // z-range reaches: branch-free SIMD, voxels outside get 0.
                                 // (Clipping each row to its chord was tried: mispredicted
                                 // trip counts made it slower.)
+#if NONBLOPPY_HAS_AVX2_COPY
+                                if constexpr (Avx2) {
+                                    addRowWeightsAvx2(values + (i << 6) + (j << 3), dxy2, pz, h, radius,
+                                                      minDistance2);
+                                    continue;
+                                }
+#endif
                                 addRowWeights(values + (i << 6) + (j << 3), lo[2], hi[2], dxy2, pz, h, radius,
                                               minDistance2);
                             }
@@ -199,6 +247,15 @@ struct RasterizeLeafOp
 
 openvdb::FloatGrid::Ptr rasterizeDensity(const ParticleIndex& particles, const DensitySettings& settings,
                                          openvdb::util::NullInterrupter* interrupter)
+{
+    return instruction_set_internal::rasterizeDensity(particles, settings, interrupter,
+                                                      instruction_set_internal::InstructionSet::Auto);
+}
+
+openvdb::FloatGrid::Ptr instruction_set_internal::rasterizeDensity(const ParticleIndex& particles,
+                                                                   const DensitySettings& settings,
+                                                                   openvdb::util::NullInterrupter* interrupter,
+                                                                   InstructionSet set)
 {
     openvdb::initialize();
     if (!(settings.effectiveRadius > 0.0) || !std::isfinite(settings.effectiveRadius)) {
@@ -227,7 +284,8 @@ openvdb::FloatGrid::Ptr rasterizeDensity(const ParticleIndex& particles, const D
     std::atomic<size_t> done{0};
     if (!poll.stopped()) {
         tbb::parallel_for(tbb::blocked_range<size_t>(0, origins.size(), 16),
-            RasterizeLeafOp{particles, origins, results, voxelSize, settings.effectiveRadius, poll, done});
+            RasterizeLeafOp{particles, origins, results, voxelSize, settings.effectiveRadius, poll, done,
+                            instruction_set_internal::useAvx2(set)});
     }
 
     openvdb::FloatGrid::Ptr grid = openvdb::FloatGrid::create(0.0f);

@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "Cancellation.h"
+#include "InstructionSet.h"
 #include "ParticleIndexImpl.h"
 
 #include <nonbloppy/Error.h>
@@ -21,12 +22,13 @@ namespace {
 
 using cancellation_internal::CancelPoll;
 
+/// Candidates processed side by side (two SSE registers, or one AVX register).
 constexpr size_t kLanes = 8;
 /// Vertex groups of a task between two polls: each group gathers its candidate particles
 /// and sums over them for every vertex, so a task of many groups runs for milliseconds.
 constexpr size_t kGroupsPerPoll = 16;
 /// Edge of a vertex group in particle-index cells.
-constexpr double kGroupCells = 2.0;  ///< candidates processed side by side (two SSE or one AVX register)
+constexpr double kGroupCells = 2.0;
 
 /// Candidate particles of one group of vertices, as separate x, y, z arrays padded to a
 /// multiple of kLanes with particles far outside every support (weight 0).
@@ -102,8 +104,23 @@ struct RelaxStepOp
     float blend;
     float maxStep;  ///< cap on one step's length, world units; 0: no cap (the paper)
     CancelPoll& poll;
+    bool avx2;      ///< run the AVX2 copy of the loop (InstructionSet.h)
 
     void operator()(const tbb::blocked_range<size_t>& range) const
+    {
+        if (avx2) relaxRangeAvx2(range);
+        else relaxRange(range);
+    }
+
+    /// relaxRange() compiled for AVX2 (it is inlined here).
+    NONBLOPPY_TARGET_AVX2 void relaxRangeAvx2(const tbb::blocked_range<size_t>& range) const
+    {
+        relaxRange(range);
+    }
+
+    /// The step for the vertex groups of @a range. Always inlined, so that each caller
+    /// compiles it for its own instruction set.
+    __attribute__((always_inline)) inline void relaxRange(const tbb::blocked_range<size_t>& range) const
     {
         const auto& positions = particles.sortedPositions();
         auto accessor = particles.impl().grid->getConstAccessor();
@@ -234,6 +251,15 @@ void groupVerticesByCell(const std::vector<openvdb::Vec3s>& points, double group
 void relaxVertices(SurfaceMesh& mesh, const ParticleIndex& particles, const RelaxSettings& settings,
                    openvdb::util::NullInterrupter* interrupter)
 {
+    instruction_set_internal::relaxVertices(mesh, particles, settings, interrupter,
+                                            instruction_set_internal::InstructionSet::Auto);
+}
+
+void instruction_set_internal::relaxVertices(SurfaceMesh& mesh, const ParticleIndex& particles,
+                                             const RelaxSettings& settings,
+                                             openvdb::util::NullInterrupter* interrupter,
+                                             InstructionSet set)
+{
     std::ostringstream msg;
     if (!(settings.effectiveRadius > 0.0) || !std::isfinite(settings.effectiveRadius)) {
         msg << "--radius must be > 0, got " << settings.effectiveRadius;
@@ -255,6 +281,7 @@ void relaxVertices(SurfaceMesh& mesh, const ParticleIndex& particles, const Rela
 
     if (interrupter) interrupter->start("relax vertices");
     CancelPoll poll(interrupter, "relax vertices");
+    const bool avx2 = instruction_set_internal::useAvx2(set);
     try {
         std::vector<openvdb::Vec3s> next(mesh.points.size());
         std::vector<uint32_t> order;
@@ -263,7 +290,7 @@ void relaxVertices(SurfaceMesh& mesh, const ParticleIndex& particles, const Rela
             groupVerticesByCell(mesh.points, kGroupCells * particles.cellSize(), order, groupStart, poll);
             tbb::parallel_for(tbb::blocked_range<size_t>(0, groupStart.size() - 1, 64),
                 RelaxStepOp{particles, order, groupStart, mesh.points, next, float(settings.effectiveRadius),
-                            float(settings.blend), float(settings.maxStep), poll});
+                            float(settings.blend), float(settings.maxStep), poll, avx2});
             poll.throwIfStopped();
             mesh.points.swap(next);
             if (poll.stopped(100 * (iteration + 1) / settings.iterations)) poll.throwIfStopped();

@@ -1,0 +1,69 @@
+// SPDX-License-Identifier: Apache-2.0
+/// @file InstructionSet.h
+/// @brief Private: the vector instructions a hot loop is compiled for, chosen at run time.
+///        Only src/ and the tests include it.
+///
+/// The library is built for the x86-64 baseline (SSE2), as Debian builds it. The inner
+/// loops of the rasterization and the relaxation also have a copy compiled for AVX2 (eight
+/// lanes in one register instead of two), taken when the CPU has AVX2. Both copies give the
+/// same bits, which keeps meshes identical across machines: each lane does the same IEEE
+/// additions, multiplications, divisions and square roots in the same order, and neither
+/// copy fuses a multiply-add (AVX2 alone does not enable FMA). tests/test_RelaxVertices.cc
+/// and tests/test_RasterizeDensity.cc compare the two on a real frame.
+
+#ifndef NONBLOPPY_INSTRUCTION_SET_H
+#define NONBLOPPY_INSTRUCTION_SET_H
+
+#include <nonbloppy/Mesh.h>
+#include <nonbloppy/ParticleIndex.h>
+#include <nonbloppy/RasterizeDensity.h>
+#include <nonbloppy/RelaxVertices.h>
+
+#include <openvdb/util/NullInterrupter.h>
+
+/// Marks a function to be compiled for AVX2 as well as the baseline (x86-64 with GCC or
+/// clang); elsewhere the AVX2 copy is the baseline one.
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+#define NONBLOPPY_HAS_AVX2_COPY 1
+#define NONBLOPPY_TARGET_AVX2 __attribute__((target("avx2")))
+#else
+#define NONBLOPPY_HAS_AVX2_COPY 0
+#define NONBLOPPY_TARGET_AVX2
+#endif
+
+namespace nonbloppy {
+namespace instruction_set_internal {
+
+/// Which copy of a hot loop runs.
+enum class InstructionSet
+{
+    Auto,      ///< AVX2 when the CPU has it, else the baseline
+    Baseline,  ///< the x86-64 baseline (SSE2) copy, whatever the CPU
+};
+
+/// Whether the AVX2 copy runs for @a set. Cost: a CPUID lookup cached by the compiler's
+/// runtime (__builtin_cpu_supports).
+inline bool useAvx2(InstructionSet set)
+{
+#if NONBLOPPY_HAS_AVX2_COPY
+    return set == InstructionSet::Auto && __builtin_cpu_supports("avx2");
+#else
+    (void)set;
+    return false;
+#endif
+}
+
+/// rasterizeDensity() running the copy of its inner loop that @a set picks (the public
+/// function passes Auto). Same checks, throws and thread-safety.
+openvdb::FloatGrid::Ptr rasterizeDensity(const ParticleIndex& particles, const DensitySettings& settings,
+                                         openvdb::util::NullInterrupter* interrupter, InstructionSet set);
+
+/// relaxVertices() running the copy of its inner loop that @a set picks (the public
+/// function passes Auto). Same checks, throws and thread-safety.
+void relaxVertices(SurfaceMesh& mesh, const ParticleIndex& particles, const RelaxSettings& settings,
+                   openvdb::util::NullInterrupter* interrupter, InstructionSet set);
+
+} // namespace instruction_set_internal
+} // namespace nonbloppy
+
+#endif // NONBLOPPY_INSTRUCTION_SET_H
