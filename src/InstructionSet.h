@@ -8,8 +8,8 @@
 /// lanes in one register instead of two), taken when the CPU has AVX2. Both copies give the
 /// same bits, which keeps meshes identical across machines: each lane does the same IEEE
 /// additions, multiplications, divisions and square roots in the same order, and neither
-/// copy fuses a multiply-add (AVX2 alone does not enable FMA). tests/test_RelaxVertices.cc
-/// and tests/test_RasterizeDensity.cc compare the two on a real frame.
+/// copy fuses a multiply-add (AVX2 alone does not enable FMA). tests/test_InstructionSet.cc
+/// compares the two on a real frame.
 
 #ifndef NONBLOPPY_INSTRUCTION_SET_H
 #define NONBLOPPY_INSTRUCTION_SET_H

@@ -1,20 +1,15 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "TestUtil.h"
 
-#include "../src/InstructionSet.h"
-
 #include <nonbloppy/Error.h>
 #include <nonbloppy/Kernel.h>
 #include <nonbloppy/ParticleIndex.h>
 #include <nonbloppy/RasterizeDensity.h>
-#include <nonbloppy/ReadParticles.h>
 
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
 
-#include <cstring>
 #include <random>
-#include <string>
 
 using namespace nonbloppy;
 
@@ -154,32 +149,4 @@ TEST(ParticleIndex, RejectsNonFinitePositions)
     } catch (const ParameterError& e) {
         EXPECT_STREQ(e.what(), "non-finite position of particle 7");
     }
-}
-
-TEST(RasterizeDensity, AvxAndBaselineCopiesGiveTheSameBits)
-{
-    // The same grids on every machine: the AVX2 copy of the inner loop (taken on this CPU
-    // when it has AVX2) must give the baseline copy's bits, leaf by leaf, on a real frame.
-    using namespace instruction_set_internal;
-    const ParticleSet frame =
-        readParticles(std::string(NONBLOPPY_TEST_DATA_DIR) + "/dam_break_frame_23_24389_particles.vtk");
-    const ParticleIndex index = ParticleIndex::build(frame.positions, 0.05);
-    DensitySettings settings;
-    settings.effectiveRadius = 0.1;
-    settings.voxelSize = 0.025;
-    const openvdb::FloatGrid::Ptr automatic = rasterizeDensity(index, settings, nullptr, InstructionSet::Auto);
-    const openvdb::FloatGrid::Ptr baseline = rasterizeDensity(index, settings, nullptr, InstructionSet::Baseline);
-    ASSERT_EQ(automatic->tree().leafCount(), baseline->tree().leafCount());
-    ASSERT_GT(automatic->activeVoxelCount(), 250000u);
-    size_t differing = 0;
-    auto other = baseline->tree().cbeginLeaf();
-    for (auto leaf = automatic->tree().cbeginLeaf(); leaf; ++leaf, ++other) {
-        ASSERT_TRUE(other);
-        ASSERT_EQ(leaf->origin(), other->origin());
-        differing += leaf->getValueMask() != other->getValueMask()
-                     || std::memcmp(leaf->buffer().data(), other->buffer().data(),
-                                    sizeof(float) * leaf->SIZE) != 0;
-    }
-    EXPECT_EQ(differing, 0u);
-    if (!useAvx2(InstructionSet::Auto)) GTEST_SKIP() << "no AVX2 here: both runs took the baseline copy";
 }

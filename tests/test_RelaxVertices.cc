@@ -1,20 +1,15 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "TestUtil.h"
 
-#include "../src/InstructionSet.h"
-
 #include <nonbloppy/Error.h>
 #include <nonbloppy/ExtractSurface.h>
 #include <nonbloppy/ParticleIndex.h>
 #include <nonbloppy/RasterizeDensity.h>
-#include <nonbloppy/ReadParticles.h>
 #include <nonbloppy/RelaxVertices.h>
 
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <cstring>
-#include <string>
 
 using namespace nonbloppy;
 
@@ -112,35 +107,4 @@ TEST(RelaxVertices, RejectsBadSettings)
     RelaxSettings noRadius = relaxSettings(0.3, 2);
     noRadius.effectiveRadius = 0.0;
     expectMessage(noRadius, "--radius must be > 0, got 0");
-}
-
-TEST(RelaxVertices, AvxAndBaselineCopiesGiveTheSameBits)
-{
-    // The same meshes on every machine: the AVX2 copy of the inner loop (taken on this CPU
-    // when it has AVX2) must give the baseline copy's bits, on a real frame with a capped
-    // step (both branches of the step).
-    using namespace instruction_set_internal;
-    const ParticleSet frame =
-        readParticles(std::string(NONBLOPPY_TEST_DATA_DIR) + "/dam_break_frame_23_24389_particles.vtk");
-    const ParticleIndex index = ParticleIndex::build(frame.positions, 0.05);
-    DensitySettings density;
-    density.effectiveRadius = 0.1;
-    density.voxelSize = 0.025;
-    const SurfaceMesh extracted = extractSurface(*rasterizeDensity(index, density), 6.666);
-    ASSERT_GT(extracted.points.size(), 30000u);
-    RelaxSettings settings;
-    settings.effectiveRadius = 0.1;
-    settings.blend = 0.7;
-    settings.iterations = 3;
-    settings.maxStep = 0.01;
-    SurfaceMesh automatic = extracted, baseline = extracted;
-    relaxVertices(automatic, index, settings, nullptr, InstructionSet::Auto);
-    relaxVertices(baseline, index, settings, nullptr, InstructionSet::Baseline);
-    ASSERT_EQ(automatic.points.size(), baseline.points.size());
-    EXPECT_EQ(std::memcmp(automatic.points.data(), baseline.points.data(),
-                          automatic.points.size() * sizeof(openvdb::Vec3s)), 0);
-    size_t moved = 0;
-    for (size_t i = 0; i < extracted.points.size(); ++i) moved += automatic.points[i] != extracted.points[i];
-    EXPECT_GT(moved, extracted.points.size() / 2);
-    if (!useAvx2(InstructionSet::Auto)) GTEST_SKIP() << "no AVX2 here: both runs took the baseline copy";
 }
