@@ -183,12 +183,7 @@ public:
     /// The index remembered for @a key, or kNone.
     uint32_t find(const PositionKey& key) const
     {
-        if (mSlots.empty()) return kNone;
-        for (size_t slot = hashOf(key) & (mSlots.size() - 1);; slot = (slot + 1) & (mSlots.size() - 1)) {
-            const Slot& s = mSlots[slot];
-            if (s.index == kNone) return kNone;
-            if (s.key == key) return s.index;
-        }
+        return mSlots.empty() ? kNone : mSlots[slotOf(mSlots, key)].index;
     }
     void clear()
     {
@@ -213,13 +208,21 @@ private:
         for (uint32_t b : key.bits) h = (h ^ b) * 0x100000001B3ull;
         return size_t(h ^ (h >> 29));
     }
+    /// The slot holding @a key, or the empty slot where it would go (@a slots is never full).
+    static size_t slotOf(const std::vector<Slot>& slots, const PositionKey& key)
+    {
+        size_t slot = hashOf(key) & (slots.size() - 1);
+        while (slots[slot].index != kNone && !(slots[slot].key == key)) slot = (slot + 1) & (slots.size() - 1);
+        return slot;
+    }
+    /// Put @a key with @a index into @a slots unless it is there; whether it was put.
     static bool place(std::vector<Slot>& slots, const PositionKey& key, uint32_t index)
     {
-        for (size_t slot = hashOf(key) & (slots.size() - 1);; slot = (slot + 1) & (slots.size() - 1)) {
-            Slot& s = slots[slot];
-            if (s.index == kNone) { s.key = key; s.index = index; return true; }
-            if (s.key == key) return false;
-        }
+        Slot& s = slots[slotOf(slots, key)];
+        if (s.index != kNone) return false;
+        s.key = key;
+        s.index = index;
+        return true;
     }
     void grow()
     {
@@ -444,35 +447,22 @@ bool extractByRegionImpl(const openvdb::FloatGrid& density, double threshold, Su
             }
         }
         leafCopies.assign(regionLeaves.size(), nullptr);
-        // Voxels kept of a shell leaf: planes [low, high) along the two cut axes.
-        const openvdb::Coord keepLow = [&] {
-            openvdb::Coord c(std::numeric_limits<int>::min());
-            c[axis] = slabBegin - kShellPlanes;
-            c[cross] = bandBegin - kShellPlanes;
-            return c;
-        }();
-        const openvdb::Coord keepHigh = [&] {
-            openvdb::Coord c(std::numeric_limits<int>::max());
-            c[axis] = slabEnd + kShellPlanes;
-            c[cross] = bandEnd + kShellPlanes;
-            return c;
-        }();
+        // The voxels a region keeps: kShellPlanes planes beyond each cut face, unbounded
+        // along the third axis.
+        openvdb::CoordBBox keep(openvdb::Coord(std::numeric_limits<int>::min()),
+                                openvdb::Coord(std::numeric_limits<int>::max()));
+        keep.min()[axis] = slabBegin - kShellPlanes;
+        keep.max()[axis] = slabEnd + kShellPlanes - 1;
+        keep.min()[cross] = bandBegin - kShellPlanes;
+        keep.max()[cross] = bandEnd + kShellPlanes - 1;
         tbb::parallel_for(tbb::blocked_range<size_t>(0, regionLeaves.size(), 64),
             [&](const tbb::blocked_range<size_t>& range) {
                 for (size_t k = range.begin(); k < range.end(); ++k) {
                     const FloatLeaf& leaf = *pieces[regionLeaves[k]].leaf;
                     auto* copy = new FloatLeaf(leaf);
-                    const openvdb::Coord origin = leaf.origin();
-                    bool inside = true;
-                    for (int a = 0; a < 3; ++a) {
-                        inside &= origin[a] >= keepLow[a] && origin[a] + dim <= keepHigh[a];
-                    }
-                    if (!inside) {
+                    if (!keep.isInside(leaf.getNodeBoundingBox())) {  // a shell leaf: cut it
                         for (openvdb::Index i = 0; i < FloatLeaf::SIZE; ++i) {
-                            const openvdb::Coord ijk = origin + FloatLeaf::offsetToLocalCoord(i);
-                            bool keep = true;
-                            for (int a = 0; a < 3; ++a) keep &= ijk[a] >= keepLow[a] && ijk[a] < keepHigh[a];
-                            if (!keep) copy->setValueOff(i, tree.background());
+                            if (!keep.isInside(leaf.offsetToGlobalCoord(i))) copy->setValueOff(i, tree.background());
                         }
                     }
                     leafCopies[k] = copy;
