@@ -141,10 +141,71 @@ size_t markFolded(const SurfaceMesh& mesh, const std::vector<openvdb::Vec3s>& be
     return folded;
 }
 
+/// Convexity of every vertex: (v − mean of its edge neighbours) · n, world units, > 0 where
+/// the surface bulges outwards. Each polygon adds its two edge neighbours to each corner, so
+/// on a closed manifold mesh every neighbour is counted once from each side of their edge:
+/// the mean is that of the distinct neighbours, with no adjacency lists to build.
+std::vector<double> vertexConvexity(const SurfaceMesh& mesh, CancelPoll& poll)
+{
+    std::vector<openvdb::Vec3d> neighbourSum(mesh.points.size(), openvdb::Vec3d(0.0));
+    std::vector<uint32_t> neighbourCount(mesh.points.size(), 0);
+    auto addEdge = [&](unsigned a, unsigned b) {
+        neighbourSum[a] += openvdb::Vec3d(mesh.points[b]);
+        neighbourSum[b] += openvdb::Vec3d(mesh.points[a]);
+        ++neighbourCount[a];
+        ++neighbourCount[b];
+    };
+    for (size_t n = 0; n < mesh.triangles.size(); ++n) {
+        if (poll.stoppedAt(n)) poll.throwIfStopped();
+        const openvdb::Vec3I& t = mesh.triangles[n];
+        addEdge(t[0], t[1]);
+        addEdge(t[1], t[2]);
+        addEdge(t[2], t[0]);
+    }
+    for (size_t n = 0; n < mesh.quads.size(); ++n) {
+        if (poll.stoppedAt(n)) poll.throwIfStopped();
+        const openvdb::Vec4I& q = mesh.quads[n];
+        addEdge(q[0], q[1]);
+        addEdge(q[1], q[2]);
+        addEdge(q[2], q[3]);
+        addEdge(q[3], q[0]);
+    }
+    std::vector<double> convexity(mesh.points.size(), 0.0);
+    for (size_t i = 0; i < convexity.size(); ++i) {
+        if (neighbourCount[i] == 0) continue;
+        const openvdb::Vec3d mean = neighbourSum[i] / double(neighbourCount[i]);
+        convexity[i] = (openvdb::Vec3d(mesh.points[i]) - mean).dot(openvdb::Vec3d(mesh.normals[i]));
+    }
+    return convexity;
+}
+
+/// A third of the area of every triangle around each vertex (quads split along 0–2): the
+/// volume the surface sweeps when vertex i moves by δ along its normal is about Σ δ·area_i.
+std::vector<double> vertexAreas(const SurfaceMesh& mesh, CancelPoll& poll)
+{
+    std::vector<double> area(mesh.points.size(), 0.0);
+    forEachTriangle(mesh, poll, [&](unsigned i, unsigned j, unsigned k) {
+        const double third = triangleNormal(mesh.points[i], mesh.points[j], mesh.points[k]).length() / 6.0;
+        area[i] += third;
+        area[j] += third;
+        area[k] += third;
+    });
+    return area;
+}
+
+void requireNormals(const SurfaceMesh& mesh)
+{
+    if (mesh.normals.size() != mesh.points.size()) {
+        throw ParameterError("offsetting a surface needs its normals (computeNormals())");
+    }
+}
+
 } // namespace
 
-double calibrateRelaxedThreshold(double effectiveRadiusOverSpacing, double blend, int iterations)
+double calibrateRelaxedThreshold(double effectiveRadiusOverSpacing, double blend, int iterations,
+                                 bool* reachesSurface)
 {
+    if (reachesSurface) *reachesSurface = true;
     const double ratio = effectiveRadiusOverSpacing;
     if (!(blend >= 0.0 && blend <= 1.0)) {
         std::ostringstream msg;
@@ -169,7 +230,10 @@ double calibrateRelaxedThreshold(double effectiveRadiusOverSpacing, double blend
     while (relaxedHeight(ratio, blend, iterations, high) < 0.5) {
         low = high;
         high += kScanStep;
-        if (high >= limit) return planeDensity(ratio, limit);
+        if (high >= limit) {
+            if (reachesSurface) *reachesSurface = false;
+            return planeDensity(ratio, limit);
+        }
     }
     for (int step = 0; step < 24; ++step) {
         const double middle = 0.5 * (low + high);
@@ -208,9 +272,7 @@ size_t repairFolds(SurfaceMesh& mesh, const std::vector<openvdb::Vec3s>& before,
 
 void offsetSurface(SurfaceMesh& mesh, double distance)
 {
-    if (mesh.normals.size() != mesh.points.size()) {
-        throw ParameterError("offsetting a surface needs its normals (computeNormals())");
-    }
+    requireNormals(mesh);
     const float d = float(distance);
     tbb::parallel_for(tbb::blocked_range<size_t>(0, mesh.points.size()),
         [&](const tbb::blocked_range<size_t>& range) {
@@ -241,6 +303,72 @@ double preserveVolume(SurfaceMesh& mesh, double targetVolume, double maxDistance
         total += distance;
     }
     return total;
+}
+
+double preserveVolume(SurfaceMesh& mesh, const VolumeSettings& settings,
+                      openvdb::util::NullInterrupter* interrupter)
+{
+    if (!(settings.convexityFloor >= 0.0) || !std::isfinite(settings.convexityFloor)) {
+        std::ostringstream msg;
+        msg << "convexity floor must be >= 0, got " << settings.convexityFloor;
+        throw ParameterError(msg.str());
+    }
+    if (!(settings.maxDistance > 0.0)) {
+        std::ostringstream msg;
+        msg << "largest volume offset must be > 0, got " << settings.maxDistance;
+        throw ParameterError(msg.str());
+    }
+    if (settings.offset == VolumeOffset::Uniform) {
+        return preserveVolume(mesh, settings.targetVolume, settings.maxDistance, interrupter);
+    }
+    const double target = settings.targetVolume;
+    if (!(target > 0.0) || !std::isfinite(target)) {
+        std::ostringstream msg;
+        msg << "target volume must be > 0, got " << target;
+        throw ParameterError(msg.str());
+    }
+    requireNormals(mesh);
+    CancelPoll poll(interrupter, "correct surface");
+
+    // Where to put the volume is decided once, on the relaxed surface: later passes only
+    // rescale it, so the offset cannot feed back into its own convexity.
+    std::vector<double> share = vertexConvexity(mesh, poll);
+    bool anyConvex = false;
+    for (double& c : share) {
+        c = std::max(0.0, c - settings.convexityFloor);
+        anyConvex = anyConvex || c > 0.0;
+    }
+    if (!anyConvex) return preserveVolume(mesh, target, settings.maxDistance, interrupter);
+
+    // Three passes: each solves the volume to first order (Σ α·share_i·area_i), the next
+    // absorbs the curvature term and what the clamp to ±maxDistance left over.
+    constexpr int kPasses = 3;
+    std::vector<double> moved(mesh.points.size(), 0.0);
+    for (int pass = 0; pass < kPasses; ++pass) {
+        poll.throwIfStopped();
+        const MeshMeasures measures = measureMesh(mesh);  // serial, not interruptible
+        const std::vector<double> area = vertexAreas(mesh, poll);
+        double sweptPerUnit = 0.0;
+        for (size_t i = 0; i < share.size(); ++i) sweptPerUnit += share[i] * area[i];
+        if (!(sweptPerUnit > 0.0)) break;
+        const double alpha = (target - measures.volume) / sweptPerUnit;
+        if (alpha == 0.0) break;
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, mesh.points.size()),
+            [&](const tbb::blocked_range<size_t>& range) {
+                for (size_t i = range.begin(); i < range.end(); ++i) {
+                    const double total = std::clamp(moved[i] + alpha * share[i],
+                                                    -settings.maxDistance, settings.maxDistance);
+                    mesh.points[i] += float(total - moved[i]) * mesh.normals[i];
+                    moved[i] = total;
+                }
+            });
+        cancellation_internal::computeNormals(mesh, poll);
+    }
+    double farthest = 0.0;
+    for (double d : moved) {
+        if (std::abs(d) > std::abs(farthest)) farthest = d;
+    }
+    return farthest;
 }
 
 } // namespace nonbloppy

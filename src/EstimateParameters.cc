@@ -200,9 +200,11 @@ ResolvedParameters resolveParameters(const SurfaceParameters& params,
     out.voxelSize = params.voxelSize ? *params.voxelSize : kDefaultVoxelOverSpacing * out.spacing;
     out.method = params.method;
     const bool faithful = params.method == Method::Faithful;
+    bool calibratedForRelaxedSurface = false;
     if (params.threshold) out.threshold = *params.threshold;
     else if (faithful) out.threshold = calibrateRelaxedThreshold(out.effectiveRadius / out.spacing,
-                                                                 out.blend, out.iterations);
+                                                                 out.blend, out.iterations,
+                                                                 &calibratedForRelaxedSurface);
     else out.threshold = calibrateThreshold(out.effectiveRadius / out.spacing);
     if (faithful) {
         if (params.maxStep && (!(*params.maxStep >= 0.0) || !std::isfinite(*params.maxStep))) {
@@ -210,6 +212,8 @@ ResolvedParameters resolveParameters(const SurfaceParameters& params,
         }
         out.maxStep = params.maxStep ? *params.maxStep : kDefaultMaxStepOverSpacing * out.spacing;
         out.preserveVolume = params.preserveVolume ? *params.preserveVolume : out.spacingGiven;
+        out.volumeOffset = params.volumeOffset ? *params.volumeOffset
+                           : calibratedForRelaxedSurface ? VolumeOffset::Convex : VolumeOffset::Uniform;
         out.repairFolds = params.repairFolds;
         // The volume target N·s³ needs s even when r_e, r_0 and h were all given.
         if (out.preserveVolume && !(out.spacing > 0.0)) {

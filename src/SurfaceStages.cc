@@ -81,8 +81,13 @@ void runSurfaceStages(const ParticleIndex& index, bool keepDensity, SurfaceResul
         // Each particle stands for s³ of fluid; preserveVolume() recomputes the normals.
         StageScope scope(result.timings, interrupter, "correct surface");
         const double s = p.spacing;
-        preserveVolume(result.mesh, double(result.particleCount) * s * s * s,
-                       kMaxVolumeOffsetOverSpacing * s, interrupter);
+        VolumeSettings volume;
+        volume.targetVolume = double(result.particleCount) * s * s * s;
+        volume.offset = p.volumeOffset;
+        volume.convexityFloor = kConvexityFloorOverSpacing * s;
+        volume.maxDistance = (p.volumeOffset == VolumeOffset::Convex ? kMaxConvexOffsetOverSpacing
+                                                                     : kMaxVolumeOffsetOverSpacing) * s;
+        preserveVolume(result.mesh, volume, interrupter);
         checkCancelled(interrupter, "correct surface");
     }
 }

@@ -163,6 +163,11 @@ TEST(Cancellation, StageFunctionsThrowTheirStagesMessage)
     mesh = result.mesh;
     EXPECT_EQ(cancelMessage([&] { preserveVolume(mesh, 1.0, 0.01, &stop); }),
               "interrupted during correct surface");
+    mesh = result.mesh;
+    VolumeSettings convex;
+    convex.targetVolume = 1.0;
+    EXPECT_EQ(cancelMessage([&] { preserveVolume(mesh, convex, &stop); }),
+              "interrupted during correct surface");
 }
 
 TEST(Cancellation, AnInterrupterThatNeverFiresChangesNoByte)

@@ -8,7 +8,7 @@
 /// ends 0.32 s inside the true surface, and the fluid loses that much all around
 /// (docs/fidelity.md, row "paper"). buildSurface() with Method::Faithful extracts at
 /// calibrateRelaxedThreshold() instead, so that relaxation ends on the true surface, then
-/// calls repairFolds(); Method::Paper calls none of this.
+/// calls repairFolds() and, given the spacing, preserveVolume(); Method::Paper calls none of this.
 
 #ifndef NONBLOPPY_CORRECT_SURFACE_H
 #define NONBLOPPY_CORRECT_SURFACE_H
@@ -34,9 +34,14 @@ namespace nonbloppy {
 /// bodies 4 s apart) get the threshold of that limit and end inside the true surface.
 /// The result depends only on r_e/s, c and t. Cost: about 10⁶ kernel evaluations (~10 ms).
 /// Thread-safety: reentrant.
+/// @param effectiveRadiusOverSpacing  r_e / s, > 0.5
+/// @param blend           c in [0,1]
+/// @param iterations      t ≥ 0
+/// @param reachesSurface  optional; set to whether the relaxed face ends at s/2 (false when
+///                        the start height had to be limited and the face ends inside)
 /// @throw ParameterError if @a effectiveRadiusOverSpacing ≤ 0.5, c outside [0,1] or t < 0.
 NONBLOPPY_API double calibrateRelaxedThreshold(double effectiveRadiusOverSpacing, double blend,
-                                               int iterations);
+                                               int iterations, bool* reachesSurface = nullptr);
 
 /// Number of triangles (quads split along the 0–2 diagonal) of @a mesh whose normal points
 /// against the normal the same triangle had with the vertex positions @a before (same
@@ -73,6 +78,33 @@ NONBLOPPY_API size_t repairFolds(SurfaceMesh& mesh, const std::vector<openvdb::V
 /// @throw ParameterError if mesh.normals and mesh.points differ in size.
 NONBLOPPY_API void offsetSurface(SurfaceMesh& mesh, double distance);
 
+/// How preserveVolume() spreads its offset over the surface.
+enum class VolumeOffset
+{
+    /// Every vertex moves the same distance along its normal. Simple, but relaxation takes
+    /// its volume mostly from edges, corners and thin features, so a uniform offset pushes
+    /// the flat faces out to pay for them (docs/fidelity.md, row "uniform volume offset").
+    Uniform,
+    /// Each vertex moves in proportion to how convex the surface is there: its convexity
+    /// (the distance from the mean of its edge neighbours to the vertex, along the normal)
+    /// above a floor that ignores the bumps of flat faces. The volume goes back where
+    /// relaxation took it: rounded edges and corners grow back towards sharp ones, thin
+    /// sheets and jets regain their thickness, flat faces stay where they are.
+    Convex,
+};
+
+/// What preserveVolume() aims for and how it may move the surface.
+struct VolumeSettings
+{
+    double targetVolume = 0.0;                ///< volume to enclose, world units³, > 0
+    VolumeOffset offset = VolumeOffset::Convex;  ///< how the offset is spread
+    /// Convex only: convexity below this (world units, ≥ 0) counts as flat and does not move.
+    double convexityFloor = 0.0;
+    /// Largest distance any vertex moves in total, world units (> 0): a wrong target cannot
+    /// move the surface far.
+    double maxDistance = std::numeric_limits<double>::infinity();
+};
+
 /// Offset the surface along its normals (offsetSurface()) so that its enclosed volume becomes
 /// @a targetVolume (world units³), to first order: distance = (target − volume) / area,
 /// applied twice to absorb the curvature term. Needs normals; recomputes them afterwards.
@@ -92,6 +124,25 @@ NONBLOPPY_API void offsetSurface(SurfaceMesh& mesh, double distance);
 /// Thread-safety: reentrant; the mesh is written.
 NONBLOPPY_API double preserveVolume(SurfaceMesh& mesh, double targetVolume,
                                     double maxDistance = std::numeric_limits<double>::infinity(),
+                                    openvdb::util::NullInterrupter* interrupter = nullptr);
+
+/// Offset the surface along its normals so that it encloses settings.targetVolume, spreading
+/// the offset as settings.offset says. Uniform is preserveVolume() above. Convex computes
+/// every vertex's convexity once, moves vertex i by α·max(0, convexity_i − convexityFloor)
+/// with α solved from the volume and the vertices' areas (three passes, absorbing the
+/// curvature term), each vertex's total clamped to ±maxDistance; if no vertex is convex
+/// enough it falls back to Uniform. Faithful buildSurface() uses Convex with a floor of
+/// kConvexityFloorOverSpacing·s: on the fidelity shapes it brings the mean distance to the
+/// true surface 1.3–1.5x closer than Uniform (docs/fidelity.md).
+/// @return the signed distance of the vertex that moved farthest (world units, < 0 inwards)
+/// @throw ParameterError if the target is not > 0, the floor is < 0, maxDistance is not > 0
+///        or normals are missing; CancelledError("interrupted during correct surface") when
+///        @a interrupter says stop (asked every 4096 polygons of each serial pass and inside
+///        computeNormals(); a stop leaves the mesh partly offset).
+/// Cost: Convex: one serial pass over the polygons for the convexity, then per pass
+/// measureMesh() and vertex areas (serial, O(P)), the offset and computeNormals(); scratch
+/// 16 bytes per vertex. Deterministic. Thread-safety: reentrant; the mesh is written.
+NONBLOPPY_API double preserveVolume(SurfaceMesh& mesh, const VolumeSettings& settings,
                                     openvdb::util::NullInterrupter* interrupter = nullptr);
 
 } // namespace nonbloppy
