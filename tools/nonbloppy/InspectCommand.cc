@@ -200,7 +200,7 @@ int inspectParticles(const std::string& path, const nonbloppy::ParticleSet& part
                                      + " -> "
                                      + formatVec3(bbox->second.x(), bbox->second.y(), bbox->second.z()));
     }
-    printRow("spacing", spacing ? formatNumber(*spacing) + " (median nearest-neighbour distance)"
+    printRow("spacing", spacing ? formatNumber(*spacing) + " (estimated: volume per particle inside the fluid)"
                                 : "- (" + spacingNote + ")");
     if (particles.attributes.empty()) {
         printRow("attributes", "none");

@@ -661,7 +661,7 @@ Command setupMeshCommand(CLI::App& parent)
         ->group(kGroupInputOutput);
 
     o.spacingOpt = cmd->add_option("--spacing", o.spacing,
-        "Particle spacing s (default: median nearest-neighbour distance)")
+        "Particle spacing s (default: estimated, the volume per particle inside the fluid)")
         ->group(kGroupNumerical);
     o.radiusOpt = cmd->add_option("--radius", o.radius,
         "Effective (kernel) radius r_e (default: 2 s)")->group(kGroupNumerical);
