@@ -53,6 +53,8 @@ TEST_F(CliTest, MeshWritesObjAndVdbAndSummary)
     EXPECT_NE(r.out.find("particles"), std::string::npos) << r.out;
     EXPECT_NE(r.out.find("2366"), std::string::npos) << r.out;
     EXPECT_NE(r.out.find("(derived)"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("volume offset        off            (needs --spacing)"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("region leaves        1024           (default)"), std::string::npos) << r.out;
     EXPECT_NE(r.out.find("rasterize density"), std::string::npos) << r.out;
     EXPECT_EQ(listDir(dir() + "/out"), (std::vector<std::string>{"cube.obj", "cube.vdb"}));
     EXPECT_GT(fs::file_size(out("cube.obj")), 1000u);

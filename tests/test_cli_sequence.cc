@@ -229,7 +229,8 @@ TEST_F(CliSequenceTest, LogHasOneObjectPerFrameAndASummary)
           std::string("\"faces\": "), std::string("\"seconds\": {\"read particles\": "),
           std::string("\"rasterize density\": "), std::string("\"write vdb\": "),
           std::string("\"peak_rss_bytes\": "), std::string("\"parameters\": {\"spacing\": "),
-          std::string("\"effective_radius\": 0.1, "), std::string("\"iterations\": 2, ")}) {
+          std::string("\"effective_radius\": 0.1, "), std::string("\"iterations\": 2, "),
+          std::string("\"region_leaves\": 1024}")}) {
         EXPECT_NE(frame2.find(field), std::string::npos) << field << "\n" << frame2;
     }
     EXPECT_EQ(frame2.back(), '}');

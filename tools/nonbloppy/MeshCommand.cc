@@ -197,7 +197,8 @@ struct MeshOptions
     // Set after declaration, to tell "given" from "default".
     CLI::Option *spacingOpt = nullptr, *radiusOpt = nullptr, *thresholdOpt = nullptr,
                 *voxelSizeOpt = nullptr, *blendOpt = nullptr, *iterationsOpt = nullptr,
-                *adaptivityOpt = nullptr, *threadsOpt = nullptr, *vdbOpt = nullptr;
+                *adaptivityOpt = nullptr, *threadsOpt = nullptr, *vdbOpt = nullptr,
+                *regionLeavesOpt = nullptr;
 };
 
 std::optional<double> ifGiven(const CLI::Option* option, double value)
@@ -351,6 +352,12 @@ void printSummary(const MeshOptions& o, const nonbloppy::SurfaceResult& result,
         origin(o.iterationsOpt->count() > 0, "(default)"));
     row("adaptivity", formatNumber(p.adaptivity), origin(o.adaptivityOpt->count() > 0, "(default)"));
     row("method", o.method, origin(o.methodOpt->count() > 0, "(default)"));
+    if (p.method == nonbloppy::Method::Faithful) {
+        row("volume offset",
+            !p.preserveVolume ? "off" : p.volumeOffset == nonbloppy::VolumeOffset::Convex ? "convex" : "uniform",
+            p.preserveVolume ? "(N*s^3, --spacing given)" : "(needs --spacing)");
+    }
+    row("region leaves", std::to_string(p.regionLeaves), origin(o.regionLeavesOpt->count() > 0, "(default)"));
     row("threads", std::to_string(threads), origin(o.threadsOpt->count() > 0, "(default)"));
 
     out << "result\n";
@@ -584,7 +591,7 @@ int runSequence(const MeshOptions& o)
         report.parameters = {{"spacing", p.spacing}, {"effective_radius", p.effectiveRadius},
                              {"threshold", p.threshold}, {"voxel_size", p.voxelSize},
                              {"blend", p.blend}, {"iterations", double(p.iterations)},
-                             {"adaptivity", p.adaptivity}};
+                             {"adaptivity", p.adaptivity}, {"region_leaves", double(p.regionLeaves)}};
         if (sampler) {
             sampler->stop();
             std::lock_guard<std::mutex> lock(verboseMutex);
@@ -680,7 +687,7 @@ Command setupMeshCommand(CLI::App& parent)
 
     o.adaptivityOpt = cmd->add_option("--adaptivity", o.adaptivity,
         "Polygon merging in flat regions, in [0,1] (default: 0)")->group(kGroupAdvanced);
-    cmd->add_option("--region-leaves", o.regionLeaves,
+    o.regionLeavesOpt = cmd->add_option("--region-leaves", o.regionLeaves,
         "Density leaves per extraction region: smaller takes less memory and answers Ctrl-C "
         "sooner, larger is faster; 0: the whole grid at once; the same surface either way, its vertices in another order "
         "(default: " + std::to_string(nonbloppy::kDefaultRegionLeaves) + ")")->group(kGroupAdvanced);
