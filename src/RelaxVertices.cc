@@ -8,6 +8,7 @@
 #include <nonbloppy/RelaxVertices.h>
 
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
 #include <tbb/parallel_sort.h>
 
 #include <atomic>
@@ -204,26 +205,41 @@ struct RelaxStepOp
 /// Sort vertex numbers by the group cell (edge @a groupSize) their position falls in and
 /// return the start of each run of equal cells (plus the end). Cells are packed into 64-bit
 /// keys relative to the smallest cell, so the sort compares integers, not coordinates through
-/// an index; ties keep vertex order, so grouping is deterministic. Asks @a poll as it goes
-/// and throws its CancelledError on a stop (the sort is stopped through runStoppable()).
+/// an index; ties keep vertex order, so grouping is deterministic. Every pass is parallel:
+/// run once per iteration on millions of vertices, serial passes left the second thread
+/// idle. @a keyed is scratch, kept by the caller across iterations (its tens of megabytes
+/// would otherwise be faulted in anew each time). Asks @a poll as it goes and throws its
+/// CancelledError on a stop (the sort is stopped through runStoppable()).
 void groupVerticesByCell(const std::vector<openvdb::Vec3s>& points, double groupSize,
-                         std::vector<uint32_t>& order, std::vector<size_t>& groupStart,
-                         CancelPoll& poll)
+                         std::vector<std::pair<uint64_t, uint32_t>>& keyed, std::vector<uint32_t>& order,
+                         std::vector<size_t>& groupStart, CancelPoll& poll)
 {
     using particle_index_internal::cellOf;
-    openvdb::Coord lowest(std::numeric_limits<int>::max()), highest(std::numeric_limits<int>::min());
-    for (size_t i = 0; i < points.size(); ++i) {
-        if (poll.stoppedAt(i)) poll.throwIfStopped();
-        const openvdb::Coord c = cellOf(points[i], groupSize);
-        lowest.minComponent(c);
-        highest.maxComponent(c);
-    }
+    using Bounds = std::pair<openvdb::Coord, openvdb::Coord>;
+    const Bounds bounds = tbb::parallel_reduce(tbb::blocked_range<size_t>(0, points.size()),
+        Bounds(openvdb::Coord(std::numeric_limits<int>::max()), openvdb::Coord(std::numeric_limits<int>::min())),
+        [&](const tbb::blocked_range<size_t>& r, Bounds b) {
+            for (size_t i = r.begin(); i < r.end(); ++i) {
+                if (poll.stoppedAt(i - r.begin())) return b;
+                const openvdb::Coord c = cellOf(points[i], groupSize);
+                b.first.minComponent(c);
+                b.second.maxComponent(c);
+            }
+            return b;
+        },
+        [](Bounds a, const Bounds& b) {
+            a.first.minComponent(b.first);
+            a.second.maxComponent(b.second);
+            return a;
+        });
+    poll.throwIfStopped();
+    const openvdb::Coord lowest = bounds.first, highest = bounds.second;
     constexpr int64_t kSpan = int64_t(1) << 21;
     const openvdb::Coord extent = highest - lowest;
     if (extent[0] >= kSpan || extent[1] >= kSpan || extent[2] >= kSpan) {
         throw ParameterError("mesh vertices span more than 2^21 relaxation cells per axis; use a larger --radius");
     }
-    std::vector<std::pair<uint64_t, uint32_t>> keyed(points.size());
+    keyed.resize(points.size());
     tbb::parallel_for(tbb::blocked_range<size_t>(0, points.size()), [&](const tbb::blocked_range<size_t>& r) {
         for (size_t i = r.begin(); i < r.end(); ++i) {
             if (poll.stoppedAt(i - r.begin())) return;
@@ -236,14 +252,36 @@ void groupVerticesByCell(const std::vector<openvdb::Vec3s>& points, double group
     // Keys are unique (they hold the vertex number), so any sort gives the same order.
     cancellation_internal::runStoppable(poll, [&] { tbb::parallel_sort(keyed.begin(), keyed.end()); });
     poll.throwIfStopped();
+    // The order, and the groups' starts: a count of starts per block, its prefix sum, then
+    // each block writes its own.
     order.resize(points.size());
-    groupStart.clear();
-    for (size_t n = 0; n < keyed.size(); ++n) {
-        if (poll.stoppedAt(n)) poll.throwIfStopped();
-        order[n] = keyed[n].second;
-        if (n == 0 || keyed[n].first != keyed[n - 1].first) groupStart.push_back(n);
-    }
-    groupStart.push_back(order.size());
+    constexpr size_t kBlock = 16384;
+    const size_t blocks = (keyed.size() + kBlock - 1) / kBlock;
+    std::vector<size_t> startsBefore(blocks + 1, 0);
+    const auto startsGroup = [&](size_t n) { return n == 0 || keyed[n].first != keyed[n - 1].first; };
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, blocks), [&](const tbb::blocked_range<size_t>& r) {
+        for (size_t b = r.begin(); b < r.end(); ++b) {
+            if (poll.stopped()) return;
+            size_t count = 0;
+            for (size_t n = b * kBlock, end = std::min(n + kBlock, keyed.size()); n < end; ++n) {
+                order[n] = keyed[n].second;
+                count += startsGroup(n);
+            }
+            startsBefore[b + 1] = count;
+        }
+    });
+    poll.throwIfStopped();
+    for (size_t b = 0; b < blocks; ++b) startsBefore[b + 1] += startsBefore[b];
+    groupStart.resize(startsBefore[blocks] + 1);
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, blocks), [&](const tbb::blocked_range<size_t>& r) {
+        for (size_t b = r.begin(); b < r.end(); ++b) {
+            size_t out = startsBefore[b];
+            for (size_t n = b * kBlock, end = std::min(n + kBlock, keyed.size()); n < end; ++n) {
+                if (startsGroup(n)) groupStart[out++] = n;
+            }
+        }
+    });
+    groupStart.back() = order.size();
 }
 
 } // namespace
@@ -284,10 +322,11 @@ void instruction_set_internal::relaxVertices(SurfaceMesh& mesh, const ParticleIn
     const bool avx2 = instruction_set_internal::useAvx2(set);
     try {
         std::vector<openvdb::Vec3s> next(mesh.points.size());
+        std::vector<std::pair<uint64_t, uint32_t>> keyed;
         std::vector<uint32_t> order;
         std::vector<size_t> groupStart;
         for (int iteration = 0; iteration < settings.iterations; ++iteration) {
-            groupVerticesByCell(mesh.points, kGroupCells * particles.cellSize(), order, groupStart, poll);
+            groupVerticesByCell(mesh.points, kGroupCells * particles.cellSize(), keyed, order, groupStart, poll);
             tbb::parallel_for(tbb::blocked_range<size_t>(0, groupStart.size() - 1, 64),
                 RelaxStepOp{particles, order, groupStart, mesh.points, next, float(settings.effectiveRadius),
                             float(settings.blend), float(settings.maxStep), poll, avx2});
