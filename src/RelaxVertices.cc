@@ -202,17 +202,112 @@ struct RelaxStepOp
     }
 };
 
+/// Buffers of groupVerticesByCell(), kept across iterations.
+struct GroupScratch
+{
+    std::vector<uint64_t> packed, spare;               ///< cell rank and vertex, for the radix sort
+    std::vector<std::pair<uint64_t, uint32_t>> keyed;  ///< cell key and vertex, for the comparison sort
+};
+
+/// Stable LSD radix sort of @a values by their bits [@a low, @a low + @a bits), 11 bits a
+/// pass, through @a spare. The values are cut into a fixed number of chunks (not one per
+/// thread): each pass counts the digits of every chunk in parallel, takes the starts in
+/// digit order then chunk order, and lets every chunk place its values in order, so the
+/// result is the same for any thread count. On a stop of @a poll the order is unspecified.
+void radixSortHigh(std::vector<uint64_t>& values, std::vector<uint64_t>& spare, int low, int bits, CancelPoll& poll)
+{
+    constexpr int kDigitBits = 11;
+    constexpr size_t kDigits = size_t(1) << kDigitBits;
+    constexpr size_t kChunks = 16;
+    const size_t count = values.size();
+    const size_t chunkSize = (count + kChunks - 1) / kChunks;
+    spare.resize(count);
+    std::vector<size_t> next(kChunks * kDigits);
+    for (int shift = low; shift < low + bits; shift += kDigitBits) {
+        const auto digitOf = [&](uint64_t v) { return size_t(v >> shift) & (kDigits - 1); };
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, kChunks, 1), [&](const tbb::blocked_range<size_t>& r) {
+            for (size_t chunk = r.begin(); chunk < r.end(); ++chunk) {
+                size_t* counts = next.data() + chunk * kDigits;
+                std::fill(counts, counts + kDigits, size_t(0));
+                const size_t begin = chunk * chunkSize, end = std::min(begin + chunkSize, count);
+                for (size_t i = begin; i < end; ++i) {
+                    if (poll.stoppedAt(i - begin)) return;
+                    ++counts[digitOf(values[i])];
+                }
+            }
+        });
+        if (poll.stopped()) return;
+        size_t start = 0;
+        for (size_t digit = 0; digit < kDigits; ++digit) {
+            for (size_t chunk = 0; chunk < kChunks; ++chunk) {
+                size_t& slot = next[chunk * kDigits + digit];
+                const size_t inChunk = slot;
+                slot = start;
+                start += inChunk;
+            }
+        }
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, kChunks, 1), [&](const tbb::blocked_range<size_t>& r) {
+            for (size_t chunk = r.begin(); chunk < r.end(); ++chunk) {
+                size_t* slots = next.data() + chunk * kDigits;
+                const size_t begin = chunk * chunkSize, end = std::min(begin + chunkSize, count);
+                for (size_t i = begin; i < end; ++i) spare[slots[digitOf(values[i])]++] = values[i];
+            }
+        });
+        values.swap(spare);
+    }
+}
+
+/// @a order[n] = vertexAt(n), and the start of every run of equal keyAt(n) (plus the end) in
+/// @a groupStart, for n < @a count sorted by key: a count of starts per block, its prefix
+/// sum, then each block writes its own.
+template<typename KeyAt, typename VertexAt>
+void writeGroups(size_t count, const KeyAt& keyAt, const VertexAt& vertexAt, std::vector<uint32_t>& order,
+                 std::vector<size_t>& groupStart, CancelPoll& poll)
+{
+    order.resize(count);
+    constexpr size_t kBlock = 16384;
+    const size_t blocks = (count + kBlock - 1) / kBlock;
+    std::vector<size_t> startsBefore(blocks + 1, 0);
+    const auto startsGroup = [&](size_t n) { return n == 0 || keyAt(n) != keyAt(n - 1); };
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, blocks), [&](const tbb::blocked_range<size_t>& r) {
+        for (size_t b = r.begin(); b < r.end(); ++b) {
+            if (poll.stopped()) return;
+            size_t starts = 0;
+            for (size_t n = b * kBlock, end = std::min(n + kBlock, count); n < end; ++n) {
+                order[n] = vertexAt(n);
+                starts += startsGroup(n);
+            }
+            startsBefore[b + 1] = starts;
+        }
+    });
+    poll.throwIfStopped();
+    for (size_t b = 0; b < blocks; ++b) startsBefore[b + 1] += startsBefore[b];
+    groupStart.resize(startsBefore[blocks] + 1);
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, blocks), [&](const tbb::blocked_range<size_t>& r) {
+        for (size_t b = r.begin(); b < r.end(); ++b) {
+            size_t out = startsBefore[b];
+            for (size_t n = b * kBlock, end = std::min(n + kBlock, count); n < end; ++n) {
+                if (startsGroup(n)) groupStart[out++] = n;
+            }
+        }
+    });
+    groupStart.back() = count;
+}
+
 /// Sort vertex numbers by the group cell (edge @a groupSize) their position falls in and
 /// return the start of each run of equal cells (plus the end). Cells are packed into 64-bit
 /// keys relative to the smallest cell, so the sort compares integers, not coordinates through
 /// an index; ties keep vertex order, so grouping is deterministic. Every pass is parallel:
 /// run once per iteration on millions of vertices, serial passes left the second thread
-/// idle. @a keyed is scratch, kept by the caller across iterations (its tens of megabytes
-/// would otherwise be faulted in anew each time). Asks @a poll as it goes and throws its
-/// CancelledError on a stop (the sort is stopped through runStoppable()).
-void groupVerticesByCell(const std::vector<openvdb::Vec3s>& points, double groupSize,
-                         std::vector<std::pair<uint64_t, uint32_t>>& keyed, std::vector<uint32_t>& order,
-                         std::vector<size_t>& groupStart, CancelPoll& poll)
+/// idle. When the cells of the vertices' box number fewer than 2^32 (always, but for
+/// scattered vertices), the key is the cell's rank in that box and the vertex number packed
+/// into 64 bits, sorted by a stable radix sort on the rank's bits (two passes where a surface
+/// crosses a million cells; the comparison sort cost a tenth of the step). @a scratch is
+/// kept by the caller across iterations (its tens of megabytes would otherwise be faulted in
+/// anew each time). Asks @a poll as it goes and throws its CancelledError on a stop (the
+/// sort is stopped through runStoppable()).
+void groupVerticesByCell(const std::vector<openvdb::Vec3s>& points, double groupSize, GroupScratch& scratch,
+                         std::vector<uint32_t>& order, std::vector<size_t>& groupStart, CancelPoll& poll)
 {
     using particle_index_internal::cellOf;
     using Bounds = std::pair<openvdb::Coord, openvdb::Coord>;
@@ -239,6 +334,30 @@ void groupVerticesByCell(const std::vector<openvdb::Vec3s>& points, double group
     if (extent[0] >= kSpan || extent[1] >= kSpan || extent[2] >= kSpan) {
         throw ParameterError("mesh vertices span more than 2^21 relaxation cells per axis; use a larger --radius");
     }
+    const openvdb::Coord dims = extent + openvdb::Coord(1);
+    const uint64_t cellCount = uint64_t(dims[0]) * uint64_t(dims[1]) * uint64_t(dims[2]);
+    if (cellCount <= (uint64_t(1) << 32)) {
+        std::vector<uint64_t>& packed = scratch.packed;
+        packed.resize(points.size());
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, points.size()), [&](const tbb::blocked_range<size_t>& r) {
+            for (size_t i = r.begin(); i < r.end(); ++i) {
+                if (poll.stoppedAt(i - r.begin())) return;
+                const openvdb::Coord c = cellOf(points[i], groupSize) - lowest;
+                const uint64_t rank = (uint64_t(c[0]) * uint64_t(dims[1]) + uint64_t(c[1])) * uint64_t(dims[2])
+                                      + uint64_t(c[2]);
+                packed[i] = (rank << 32) | uint64_t(i);
+            }
+        });
+        poll.throwIfStopped();
+        int bits = 0;
+        while (bits < 32 && (uint64_t(1) << bits) < cellCount) ++bits;
+        radixSortHigh(packed, scratch.spare, 32, bits, poll);
+        poll.throwIfStopped();
+        writeGroups(packed.size(), [&](size_t n) { return packed[n] >> 32; },
+                    [&](size_t n) { return uint32_t(packed[n]); }, order, groupStart, poll);
+        return;
+    }
+    std::vector<std::pair<uint64_t, uint32_t>>& keyed = scratch.keyed;
     keyed.resize(points.size());
     tbb::parallel_for(tbb::blocked_range<size_t>(0, points.size()), [&](const tbb::blocked_range<size_t>& r) {
         for (size_t i = r.begin(); i < r.end(); ++i) {
@@ -252,36 +371,8 @@ void groupVerticesByCell(const std::vector<openvdb::Vec3s>& points, double group
     // Keys are unique (they hold the vertex number), so any sort gives the same order.
     cancellation_internal::runStoppable(poll, [&] { tbb::parallel_sort(keyed.begin(), keyed.end()); });
     poll.throwIfStopped();
-    // The order, and the groups' starts: a count of starts per block, its prefix sum, then
-    // each block writes its own.
-    order.resize(points.size());
-    constexpr size_t kBlock = 16384;
-    const size_t blocks = (keyed.size() + kBlock - 1) / kBlock;
-    std::vector<size_t> startsBefore(blocks + 1, 0);
-    const auto startsGroup = [&](size_t n) { return n == 0 || keyed[n].first != keyed[n - 1].first; };
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, blocks), [&](const tbb::blocked_range<size_t>& r) {
-        for (size_t b = r.begin(); b < r.end(); ++b) {
-            if (poll.stopped()) return;
-            size_t count = 0;
-            for (size_t n = b * kBlock, end = std::min(n + kBlock, keyed.size()); n < end; ++n) {
-                order[n] = keyed[n].second;
-                count += startsGroup(n);
-            }
-            startsBefore[b + 1] = count;
-        }
-    });
-    poll.throwIfStopped();
-    for (size_t b = 0; b < blocks; ++b) startsBefore[b + 1] += startsBefore[b];
-    groupStart.resize(startsBefore[blocks] + 1);
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, blocks), [&](const tbb::blocked_range<size_t>& r) {
-        for (size_t b = r.begin(); b < r.end(); ++b) {
-            size_t out = startsBefore[b];
-            for (size_t n = b * kBlock, end = std::min(n + kBlock, keyed.size()); n < end; ++n) {
-                if (startsGroup(n)) groupStart[out++] = n;
-            }
-        }
-    });
-    groupStart.back() = order.size();
+    writeGroups(keyed.size(), [&](size_t n) { return keyed[n].first; }, [&](size_t n) { return keyed[n].second; },
+                order, groupStart, poll);
 }
 
 } // namespace
@@ -322,11 +413,11 @@ void instruction_set_internal::relaxVertices(SurfaceMesh& mesh, const ParticleIn
     const bool avx2 = instruction_set_internal::useAvx2(set);
     try {
         std::vector<openvdb::Vec3s> next(mesh.points.size());
-        std::vector<std::pair<uint64_t, uint32_t>> keyed;
+        GroupScratch scratch;
         std::vector<uint32_t> order;
         std::vector<size_t> groupStart;
         for (int iteration = 0; iteration < settings.iterations; ++iteration) {
-            groupVerticesByCell(mesh.points, kGroupCells * particles.cellSize(), keyed, order, groupStart, poll);
+            groupVerticesByCell(mesh.points, kGroupCells * particles.cellSize(), scratch, order, groupStart, poll);
             tbb::parallel_for(tbb::blocked_range<size_t>(0, groupStart.size() - 1, 64),
                 RelaxStepOp{particles, order, groupStart, mesh.points, next, float(settings.effectiveRadius),
                             float(settings.blend), float(settings.maxStep), poll, avx2});
