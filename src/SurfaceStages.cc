@@ -51,8 +51,13 @@ void runSurfaceStages(const ParticleIndex& index, bool keepDensity, SurfaceResul
         StageScope scope(result.timings, interrupter, "extract surface");
         // Region by region (adaptivity 0): volumeToMesh cannot be stopped safely from
         // outside (see Cancellation.h), so the regions bound the wait for a cancel.
-        extractSurfaceInto(*result.density, p.threshold, p.adaptivity, p.regionLeaves, result.mesh, interrupter);
-        if (!keepDensity) result.density.reset();
+        if (keepDensity) {
+            extractSurfaceInto(*result.density, p.threshold, p.adaptivity, p.regionLeaves, result.mesh, interrupter);
+        } else {
+            extractSurfaceReleasing(*result.density, p.threshold, p.adaptivity, p.regionLeaves, result.mesh,
+                                    interrupter);
+            result.density.reset();
+        }
         checkCancelled(interrupter, "extract surface");
     }
     {

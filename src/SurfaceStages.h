@@ -87,6 +87,14 @@ void extractSurfaceInto(const openvdb::FloatGrid& density, double threshold, dou
                         size_t leavesPerRegion, SurfaceMesh& mesh,
                         openvdb::util::NullInterrupter* interrupter);
 
+/// extractSurfaceInto(), for a grid that is destroyed afterwards: region by region, the leaves
+/// of the leaf layers no later region reads become inactive tiles, so the grid's memory goes
+/// as the mesh's grows (the grid is left partial, fit only to be destroyed). The mesh is the
+/// same, bit for bit (tested). Defined in ExtractSurface.cc.
+void extractSurfaceReleasing(openvdb::FloatGrid& density, double threshold, double adaptivity,
+                             size_t leavesPerRegion, SurfaceMesh& mesh,
+                             openvdb::util::NullInterrupter* interrupter);
+
 /// The surface φ = @a threshold of a density grid (adaptivity 0), meshed region by region:
 /// slabs across the grid's longest axis, each cut again across the second longest when it
 /// holds more than @a leavesPerRegion kept leaves, every cut at least @a minLayersPerRegion
@@ -103,10 +111,12 @@ void extractSurfaceInto(const openvdb::FloatGrid& density, double threshold, dou
 /// region, its shell (see SurfaceParameters::regionLeaves); scratch memory is one region's plus the seam
 /// vertices of two slabs. The interrupter (may be null) is asked while leaves are
 /// classified and before each region. Thread-safety: reentrant; the grid is only read.
+/// @param release  optional: @a density's own tree, whose leaves are freed as the slabs pass
+///                 (see extractSurfaceReleasing()); null leaves the grid untouched
 /// @throw ParameterError if @a threshold is not finite; CancelledError as above
 void extractByRegion(const openvdb::FloatGrid& density, double threshold, SurfaceMesh& mesh,
                      openvdb::util::NullInterrupter* interrupter, size_t leavesPerRegion,
-                     int minLayersPerRegion = kMinLayersPerRegion);
+                     int minLayersPerRegion = kMinLayersPerRegion, openvdb::FloatTree* release = nullptr);
 
 } // namespace surface_stages_internal
 } // namespace nonbloppy

@@ -219,3 +219,33 @@ TEST(ExtractByRegion, RejectsANonFiniteThreshold)
         extractByRegion(damBreakDensity(), std::nan(""), mesh, nullptr, 100);
     }), "--threshold must be finite, got nan");
 }
+
+TEST(ExtractByRegion, ReleasingTheGridGivesTheSameMeshBitForBit)
+{
+    // A grid meshed for the last time gives its leaves back slab by slab (the CLI without
+    // --vdb): the same vertices and polygons in the same order, and far fewer leaves left.
+    for (const size_t leavesPerRegion : {size_t(1), size_t(8), size_t(64)}) {
+        SurfaceMesh kept;
+        extractByRegion(damBreakDensity(), kThreshold, kept, nullptr, leavesPerRegion, 1);
+        openvdb::FloatGrid::Ptr copy = damBreakDensity().deepCopy();
+        const openvdb::Index64 leavesBefore = copy->tree().leafCount();
+        SurfaceMesh released;
+        extractByRegion(*copy, kThreshold, released, nullptr, leavesPerRegion, 1, &copy->tree());
+        EXPECT_EQ(released.points, kept.points) << leavesPerRegion;
+        EXPECT_EQ(released.quads, kept.quads) << leavesPerRegion;
+        EXPECT_EQ(released.normals, kept.normals) << leavesPerRegion;
+        EXPECT_LT(copy->tree().leafCount(), leavesBefore / 2) << leavesPerRegion;
+    }
+    // The whole stage chain: the same mesh with and without the grid kept.
+    SurfaceParameters params;
+    params.spacing = 0.05;
+    const ParticleSet frame =
+        readParticles(std::string(NONBLOPPY_TEST_DATA_DIR) + "/dam_break_frame_23_24389_particles.vtk");
+    const SurfaceResult withGrid = buildSurface(frame.positions, params);
+    params.keepDensity = false;
+    const SurfaceResult without = buildSurface(frame.positions, params);
+    ASSERT_TRUE(withGrid.density);
+    EXPECT_FALSE(without.density);
+    EXPECT_EQ(without.mesh.points, withGrid.mesh.points);
+    EXPECT_EQ(without.mesh.quads, withGrid.mesh.quads);
+}
