@@ -193,6 +193,15 @@ std::vector<double> vertexAreas(const SurfaceMesh& mesh, CancelPoll& poll)
     return area;
 }
 
+void requireTargetVolume(double targetVolume)
+{
+    if (!(targetVolume > 0.0) || !std::isfinite(targetVolume)) {
+        std::ostringstream msg;
+        msg << "target volume must be > 0, got " << targetVolume;
+        throw ParameterError(msg.str());
+    }
+}
+
 void requireNormals(const SurfaceMesh& mesh)
 {
     if (mesh.normals.size() != mesh.points.size()) {
@@ -283,11 +292,7 @@ void offsetSurface(SurfaceMesh& mesh, double distance)
 double preserveVolume(SurfaceMesh& mesh, double targetVolume, double maxDistance,
                       openvdb::util::NullInterrupter* interrupter)
 {
-    if (!(targetVolume > 0.0) || !std::isfinite(targetVolume)) {
-        std::ostringstream msg;
-        msg << "target volume must be > 0, got " << targetVolume;
-        throw ParameterError(msg.str());
-    }
+    requireTargetVolume(targetVolume);
     CancelPoll poll(interrupter, "correct surface");
     double total = 0.0;
     for (int pass = 0; pass < 2; ++pass) {
@@ -322,11 +327,7 @@ double preserveVolume(SurfaceMesh& mesh, const VolumeSettings& settings,
         return preserveVolume(mesh, settings.targetVolume, settings.maxDistance, interrupter);
     }
     const double target = settings.targetVolume;
-    if (!(target > 0.0) || !std::isfinite(target)) {
-        std::ostringstream msg;
-        msg << "target volume must be > 0, got " << target;
-        throw ParameterError(msg.str());
-    }
+    requireTargetVolume(target);
     requireNormals(mesh);
     CancelPoll poll(interrupter, "correct surface");
 
