@@ -72,10 +72,15 @@ void runSurfaceStages(const ParticleIndex& index, bool keepDensity, SurfaceResul
                       std::vector<openvdb::Vec3s>& unrelaxed, UnrelaxedBuffer whenRepaired,
                       openvdb::util::NullInterrupter* interrupter);
 
-/// Leaf layers (8 voxels each) per region at least, along each axis it is cut on: each
-/// region also meshes three voxel planes beyond each cut face, 19% more work per axis at
-/// four layers.
-constexpr int kMinLayersPerRegion = 4;
+/// Leaf layers (8 voxels each) per region at least, along each axis it is cut on. Each region
+/// also meshes three voxel planes beyond each cut face, but volumeToMesh scans whole leaves,
+/// so a cut face costs a whole leaf layer: at four layers a region cut on two axes scans
+/// (4+2)²/4² = 2.25 times its own leaves. Measured on the 64x benchmark input (1024 leaves
+/// per region, two threads): leaves scanned / extraction wall / longest region, 4 layers
+/// 70,185 / 1.49-1.63 s / 48 ms, 8 layers 64,762 / 1.19-1.21 s / 38-40 ms, 12 layers
+/// 61,164 / 0.99-1.12 s / 34-41 ms, 16 layers 55,713 / 0.91-0.97 s / 45-49 ms (45,688 leaves
+/// touch the surface). Twelve keeps regions short (the cancel latency) and most of the gain.
+constexpr int kMinLayersPerRegion = 12;
 
 /// extractSurface() into @a mesh's existing vectors (which keep their capacity); normals and
 /// attributes are cleared. Same checks and orientation as extractSurface(); with adaptivity 0

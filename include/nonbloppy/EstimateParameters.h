@@ -130,9 +130,10 @@ struct SurfaceParameters
     /// surface has the same polygons and vertices whatever the value (only their order changes);
     /// the value trades cancel latency against speed, since OpenVDB's volumeToMesh cannot
     /// be stopped inside a region. On the 64x benchmark input (1.56M particles, two
-    /// cores), extraction wall time / longest wait for a cancel: 1024 leaves 1.9-2.3 s /
-    /// 43-59 ms, 4096 leaves 1.6-1.7 s / 132-158 ms, 16384 leaves 1.5-1.7 s / 400-470 ms,
-    /// whole grid 1.3-1.6 s / 1.3-1.6 s. Scratch memory grows with the region.
+    /// cores, no --vdb), extraction wall time / process peak: 1024 leaves 1.03-1.14 s /
+    /// 272-282 MB (longest region 34-41 ms), 4096 leaves 0.98-1.21 s / 291 MB, 16384
+    /// leaves 0.98-1.10 s / 380 MB, whole grid 0.68-0.80 s / 435-444 MB (one call that
+    /// cannot be stopped). Scratch memory grows with the region.
     size_t regionLeaves = kDefaultRegionLeaves;
 };
 
