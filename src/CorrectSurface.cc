@@ -297,7 +297,7 @@ double preserveVolume(SurfaceMesh& mesh, double targetVolume, double maxDistance
     double total = 0.0;
     for (int pass = 0; pass < 2; ++pass) {
         poll.throwIfStopped();
-        const MeshMeasures measures = measureMesh(mesh);  // serial, not interruptible
+        const AreaAndVolume measures = measureAreaAndVolume(mesh);  // serial, O(P)
         poll.throwIfStopped();
         if (!(measures.area > 0.0)) break;
         const double distance = std::clamp((targetVolume - measures.volume) / measures.area,
@@ -347,7 +347,7 @@ double preserveVolume(SurfaceMesh& mesh, const VolumeSettings& settings,
     std::vector<double> moved(mesh.points.size(), 0.0);
     for (int pass = 0; pass < kPasses; ++pass) {
         poll.throwIfStopped();
-        const MeshMeasures measures = measureMesh(mesh);  // serial, not interruptible
+        const AreaAndVolume measures = measureAreaAndVolume(mesh);  // serial, O(P)
         const std::vector<double> area = vertexAreas(mesh, poll);
         double sweptPerUnit = 0.0;
         for (size_t i = 0; i < share.size(); ++i) sweptPerUnit += share[i] * area[i];

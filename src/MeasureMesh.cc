@@ -36,8 +36,9 @@ addEdge(std::vector<EdgeUse>& edges, uint32_t from, uint32_t to)
 }
 
 /// Adds the area and the signed volume of the tetrahedron (origin, p0, p1, p2).
+template<typename MeasuresT>
 void
-addTriangle(const SurfaceMesh& mesh, uint32_t i0, uint32_t i1, uint32_t i2, MeshMeasures& m)
+addTriangle(const SurfaceMesh& mesh, uint32_t i0, uint32_t i1, uint32_t i2, MeasuresT& m)
 {
     const openvdb::Vec3d p0(mesh.points[i0]), p1(mesh.points[i1]), p2(mesh.points[i2]);
     m.area += 0.5 * (p1 - p0).cross(p2 - p0).length();
@@ -45,7 +46,39 @@ addTriangle(const SurfaceMesh& mesh, uint32_t i0, uint32_t i1, uint32_t i2, Mesh
     m.volume += p0.dot(p1.cross(p2)) / 6.0;
 }
 
+[[noreturn]] void
+throwBadIndex(const SurfaceMesh& mesh, size_t polygon, uint32_t index)
+{
+    throw ParameterError("polygon " + std::to_string(polygon) + " references vertex " +
+        std::to_string(index) + " but the mesh has " + std::to_string(mesh.points.size()) +
+        " vertices");
+}
+
 } // namespace
+
+AreaAndVolume
+measureAreaAndVolume(const SurfaceMesh& mesh)
+{
+    AreaAndVolume m;
+    const size_t vertexCount = mesh.points.size();
+    size_t polygon = 0;
+    for (const openvdb::Vec3I& t : mesh.triangles) {
+        for (int i = 0; i < 3; ++i) {
+            if (t[i] >= vertexCount) throwBadIndex(mesh, polygon, t[i]);
+        }
+        addTriangle(mesh, t[0], t[1], t[2], m);
+        ++polygon;
+    }
+    for (const openvdb::Vec4I& q : mesh.quads) {
+        for (int i = 0; i < 4; ++i) {
+            if (q[i] >= vertexCount) throwBadIndex(mesh, polygon, q[i]);
+        }
+        addTriangle(mesh, q[0], q[1], q[2], m);
+        addTriangle(mesh, q[0], q[2], q[3], m);
+        ++polygon;
+    }
+    return m;
+}
 
 MeshMeasures
 measureMesh(const SurfaceMesh& mesh)
@@ -56,11 +89,7 @@ measureMesh(const SurfaceMesh& mesh)
 
     std::vector<bool> used(mesh.points.size(), false);
     auto use = [&](size_t polygon, uint32_t index) {
-        if (index >= mesh.points.size()) {
-            throw ParameterError("polygon " + std::to_string(polygon) + " references vertex " +
-                std::to_string(index) + " but the mesh has " +
-                std::to_string(mesh.points.size()) + " vertices");
-        }
+        if (index >= mesh.points.size()) throwBadIndex(mesh, polygon, index);
         used[index] = true;
     };
 

@@ -14,6 +14,8 @@ namespace {
 using nonbloppy::MeshMeasures;
 using nonbloppy::SurfaceMesh;
 using nonbloppy::measureMesh;
+using nonbloppy::AreaAndVolume;
+using nonbloppy::measureAreaAndVolume;
 
 /// The cube [0,1]³ (scaled by @a size and moved by @a offset) as six quads,
 /// counter-clockwise seen from outside.
@@ -183,6 +185,39 @@ TEST(MeasureMesh, OutOfRangeIndexIsAParameterError)
         FAIL() << "expected ParameterError";
     } catch (const nonbloppy::ParameterError& e) {
         EXPECT_STREQ(e.what(), "polygon 0 references vertex 99 but the mesh has 8 vertices");
+    }
+}
+
+TEST(MeasureAreaAndVolume, SameBitsAsMeasureMeshForTrianglesAndQuads)
+{
+    // A moved cube of quads plus a tetrahedron of triangles in one mesh: both sums in the
+    // same order as measureMesh(), so the same doubles, not just close ones.
+    SurfaceMesh mesh = cube(1.5f, openvdb::Vec3s(0.3f, -2.1f, 7.7f));
+    const uint32_t base = uint32_t(mesh.points.size());
+    for (const openvdb::Vec3s& p : {openvdb::Vec3s(3, 0, 0), openvdb::Vec3s(4, 0.1f, 0),
+                                    openvdb::Vec3s(3, 1.3f, 0), openvdb::Vec3s(3.2f, 0, 0.9f)}) {
+        mesh.points.push_back(p);
+    }
+    for (const openvdb::Vec3I& t : {openvdb::Vec3I(0, 2, 1), openvdb::Vec3I(0, 1, 3),
+                                    openvdb::Vec3I(0, 3, 2), openvdb::Vec3I(1, 2, 3)}) {
+        mesh.triangles.push_back(t + openvdb::Vec3I(base));
+    }
+    const MeshMeasures full = measureMesh(mesh);
+    const AreaAndVolume fast = measureAreaAndVolume(mesh);
+    EXPECT_EQ(fast.area, full.area);
+    EXPECT_EQ(fast.volume, full.volume);
+    EXPECT_NEAR(fast.volume, 1.5 * 1.5 * 1.5 + 1.0 * 1.3 * 0.9 / 6.0, 1e-5);
+}
+
+TEST(MeasureAreaAndVolume, OutOfRangeIndexIsAParameterError)
+{
+    SurfaceMesh mesh = cube();
+    mesh.quads.emplace_back(0, 1, 2, 8);
+    try {
+        measureAreaAndVolume(mesh);
+        FAIL() << "expected ParameterError";
+    } catch (const nonbloppy::ParameterError& e) {
+        EXPECT_STREQ(e.what(), "polygon 6 references vertex 8 but the mesh has 8 vertices");
     }
 }
 

@@ -43,12 +43,12 @@ struct SurfaceResult
 /// @param interrupter  optional; every stage is announced with start(name) … end() under
 ///                     the names of the timings, and every loop of nonbloppy's own asks
 ///                     wasInterrupted() about every 0.1 ms of work (see each stage's
-///                     header). "extract surface" meshes slabs of about 4096 leaves
+///                     header). "extract surface" meshes regions of about regionLeaves leaves
 ///                     and asks between them (volumeToMesh itself takes no
 ///                     interrupter). Not interruptible: OpenVDB's point partitioner
 ///                     (part of "index particles" and of "estimate parameters"), the
-///                     threshold calibration (~10 ms) and measureMesh() in the volume
-///                     correction. A stop throws CancelledError("interrupted during
+///                     threshold calibration (~10 ms) and measureAreaAndVolume() in
+///                     the volume correction. A stop throws CancelledError("interrupted during
 ///                     <stage>") and discards every partial result.
 /// Cost: dominated by "rasterize density", O(N·(r_e/h)³), and "relax vertices",
 /// O(t·V·particles within r_e); memory about the density grid plus 16 bytes per particle.

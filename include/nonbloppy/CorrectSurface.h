@@ -117,10 +117,10 @@ struct VolumeSettings
 /// @param targetVolume volume to enclose, world units³, > 0
 /// @param maxDistance  largest distance moved in total, world units (the correction is
 ///                     clamped to ±maxDistance, so a wrong target cannot move the surface far)
-/// @param interrupter  optional; asked before and after each measureMesh() (which is serial
-///                     and not interruptible, O(P)) and inside computeNormals() as there;
+/// @param interrupter  optional; asked before and after each measureAreaAndVolume() (which
+///                     is serial and not interruptible, O(P)) and inside computeNormals() as there;
 ///                     no start()/end(). A stop leaves the mesh partly offset.
-/// Cost: two passes of measureMesh() + offsetSurface() + computeNormals(), O(P + V).
+/// Cost: two passes of measureAreaAndVolume() + offsetSurface() + computeNormals(), O(P + V).
 /// Thread-safety: reentrant; the mesh is written.
 NONBLOPPY_API double preserveVolume(SurfaceMesh& mesh, double targetVolume,
                                     double maxDistance = std::numeric_limits<double>::infinity(),
@@ -140,7 +140,7 @@ NONBLOPPY_API double preserveVolume(SurfaceMesh& mesh, double targetVolume,
 ///        @a interrupter says stop (asked every 4096 polygons of each serial pass and inside
 ///        computeNormals(); a stop leaves the mesh partly offset).
 /// Cost: Convex: one serial pass over the polygons for the convexity, then per pass
-/// measureMesh() and vertex areas (serial, O(P)), the offset and computeNormals(); scratch
+/// measureAreaAndVolume() and vertex areas (serial, O(P)), the offset and computeNormals(); scratch
 /// 16 bytes per vertex. Deterministic. Thread-safety: reentrant; the mesh is written.
 NONBLOPPY_API double preserveVolume(SurfaceMesh& mesh, const VolumeSettings& settings,
                                     openvdb::util::NullInterrupter* interrupter = nullptr);

@@ -38,6 +38,20 @@ struct MeshMeasures
 /// @throw ParameterError if a polygon references a vertex index out of range.
 NONBLOPPY_API MeshMeasures measureMesh(const SurfaceMesh& mesh);
 
+/// Area and signed enclosed volume of a mesh.
+struct AreaAndVolume
+{
+    double area = 0.0;    ///< world units²
+    double volume = 0.0;  ///< world units³, positive when polygons face outwards
+};
+
+/// The area and volume of measureMesh(), summed in the same order (the same bits), without
+/// its edge topology: what a volume correction asks on every pass.
+/// Cost: O(P), serial, no scratch memory (measureMesh() sorts all edges: on a 2.4M-vertex
+/// mesh about 0.4 s against 0.02 s). Thread-safety: reentrant; the mesh is only read.
+/// @throw ParameterError if a polygon references a vertex index out of range (as measureMesh()).
+NONBLOPPY_API AreaAndVolume measureAreaAndVolume(const SurfaceMesh& mesh);
+
 } // namespace nonbloppy
 
 #endif // NONBLOPPY_MEASURE_MESH_H
