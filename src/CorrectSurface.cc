@@ -115,6 +115,24 @@ void forEachTriangle(const SurfaceMesh& mesh, CancelPoll& poll, OpT&& op)
     }
 }
 
+/// Call @a op(a, b) for every edge of every polygon, in polygon order (triangles, then
+/// quads), each polygon's edges in its winding; asks @a poll as forEachTriangle().
+template<typename OpT>
+void forEachPolygonEdge(const SurfaceMesh& mesh, CancelPoll& poll, OpT&& op)
+{
+    const auto edgesOf = [&](const auto& polygon, int corners) {
+        for (int i = 0; i < corners; ++i) op(polygon[i], polygon[(i + 1) % corners]);
+    };
+    for (size_t n = 0; n < mesh.triangles.size(); ++n) {
+        if (poll.stoppedAt(n)) poll.throwIfStopped();
+        edgesOf(mesh.triangles[n], 3);
+    }
+    for (size_t n = 0; n < mesh.quads.size(); ++n) {
+        if (poll.stoppedAt(n)) poll.throwIfStopped();
+        edgesOf(mesh.quads[n], 4);
+    }
+}
+
 void requireSameSize(const SurfaceMesh& mesh, const std::vector<openvdb::Vec3s>& before)
 {
     if (before.size() != mesh.points.size()) {
@@ -155,21 +173,7 @@ std::vector<double> vertexConvexity(const SurfaceMesh& mesh, CancelPoll& poll)
         ++neighbourCount[a];
         ++neighbourCount[b];
     };
-    for (size_t n = 0; n < mesh.triangles.size(); ++n) {
-        if (poll.stoppedAt(n)) poll.throwIfStopped();
-        const openvdb::Vec3I& t = mesh.triangles[n];
-        addEdge(t[0], t[1]);
-        addEdge(t[1], t[2]);
-        addEdge(t[2], t[0]);
-    }
-    for (size_t n = 0; n < mesh.quads.size(); ++n) {
-        if (poll.stoppedAt(n)) poll.throwIfStopped();
-        const openvdb::Vec4I& q = mesh.quads[n];
-        addEdge(q[0], q[1]);
-        addEdge(q[1], q[2]);
-        addEdge(q[2], q[3]);
-        addEdge(q[3], q[0]);
-    }
+    forEachPolygonEdge(mesh, poll, addEdge);
     std::vector<double> convexity(mesh.points.size(), 0.0);
     for (size_t i = 0; i < convexity.size(); ++i) {
         if (neighbourCount[i] == 0) continue;
