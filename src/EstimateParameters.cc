@@ -27,35 +27,51 @@ std::string formatNumber(double value)
     return out.str();
 }
 
+/// Run @a perSample(i, x, forNeighbours) in parallel for every sampled slot i (sorted order,
+/// position x), where forNeighbours(visit) calls visit(k, offset) for every particle k in the
+/// box of half-width @a radius around x, offset = x_k − x (x itself included, k == samples[i]).
+/// A wide box visits thousands of particles per sample: @a poll is asked every 16 samples,
+/// and a stop leaves later samples unvisited.
+template<typename PerSampleOp>
+void forEachSampleNeighbourhood(const ParticleIndex& index, const std::vector<size_t>& samples,
+                                double radius, CancelPoll& poll, PerSampleOp&& perSample)
+{
+    using namespace particle_index_internal;
+    const auto& positions = index.sortedPositions();
+    const auto& grid = *index.impl().grid;
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, samples.size()),
+        [&](const tbb::blocked_range<size_t>& range) {
+            auto accessor = grid.getConstAccessor();
+            for (size_t i = range.begin(); i < range.end(); ++i) {
+                if ((i - range.begin()) % 16 == 0 && poll.stopped()) return;
+                const openvdb::Vec3d x = positions[samples[i]];
+                const auto forNeighbours = [&](auto&& visit) {
+                    forEachRunInBox(accessor, index.cellSize(), x - openvdb::Vec3d(radius),
+                        x + openvdb::Vec3d(radius), [&](uint32_t first, uint32_t end) {
+                            for (uint32_t k = first; k < end; ++k) visit(k, openvdb::Vec3d(positions[k]) - x);
+                        });
+                };
+                perSample(i, x, forNeighbours);
+            }
+        });
+}
+
 /// Nearest-neighbour distance of each sampled slot, searched within @a searchRadius;
 /// +inf where no other particle lies that close. Unspecified after a stop of @a poll.
 std::vector<double> nearestWithin(const ParticleIndex& index, const std::vector<size_t>& samples,
                                   double searchRadius, CancelPoll& poll)
 {
-    using namespace particle_index_internal;
-    const auto& positions = index.sortedPositions();
-    const auto& grid = *index.impl().grid;
     std::vector<double> nearest(samples.size());
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, samples.size()),
-        [&](const tbb::blocked_range<size_t>& range) {
-            auto accessor = grid.getConstAccessor();
-            for (size_t i = range.begin(); i < range.end(); ++i) {
-                // A wide search visits thousands of particles per sample: ask every 16.
-                if ((i - range.begin()) % 16 == 0 && poll.stopped()) return;
-                const size_t self = samples[i];
-                const openvdb::Vec3d x = positions[self];
-                double best = searchRadius * searchRadius;
-                bool found = false;
-                forEachRunInBox(accessor, index.cellSize(), x - openvdb::Vec3d(searchRadius),
-                    x + openvdb::Vec3d(searchRadius), [&](uint32_t first, uint32_t end) {
-                        for (uint32_t k = first; k < end; ++k) {
-                            if (k == self) continue;
-                            const double d2 = (openvdb::Vec3d(positions[k]) - x).lengthSqr();
-                            if (d2 <= best) { best = d2; found = true; }
-                        }
-                    });
-                nearest[i] = found ? std::sqrt(best) : std::numeric_limits<double>::infinity();
-            }
+    forEachSampleNeighbourhood(index, samples, searchRadius, poll,
+        [&](size_t i, const openvdb::Vec3d&, const auto& forNeighbours) {
+            double best = searchRadius * searchRadius;
+            bool found = false;
+            forNeighbours([&](uint32_t k, const openvdb::Vec3d& offset) {
+                if (k == samples[i]) return;
+                const double d2 = offset.lengthSqr();
+                if (d2 <= best) { best = d2; found = true; }
+            });
+            nearest[i] = found ? std::sqrt(best) : std::numeric_limits<double>::infinity();
         });
     return nearest;
 }
@@ -80,35 +96,23 @@ constexpr int kInteriorNeighbours = 12;
 std::vector<double> interiorSpacings(const ParticleIndex& index, const std::vector<size_t>& samples,
                                      double radius, CancelPoll& poll)
 {
-    using namespace particle_index_internal;
-    const auto& positions = index.sortedPositions();
-    const auto& grid = *index.impl().grid;
     std::vector<double> spacing(samples.size(), 0.0);  // 0: not inside
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, samples.size()),
-        [&](const tbb::blocked_range<size_t>& range) {
-            auto accessor = grid.getConstAccessor();
-            for (size_t i = range.begin(); i < range.end(); ++i) {
-                if ((i - range.begin()) % 16 == 0 && poll.stopped()) return;
-                const openvdb::Vec3d x = positions[samples[i]];
-                double count = 0.0;
-                int neighbours = -1;  // itself is counted below
-                openvdb::Vec3d offsetSum(0.0);
-                forEachRunInBox(accessor, index.cellSize(), x - openvdb::Vec3d(radius),
-                    x + openvdb::Vec3d(radius), [&](uint32_t first, uint32_t end) {
-                        for (uint32_t k = first; k < end; ++k) {
-                            const openvdb::Vec3d offset = openvdb::Vec3d(positions[k]) - x;
-                            const double q2 = offset.lengthSqr() / (radius * radius);
-                            if (!(q2 < 1.0)) continue;
-                            const double w = (1.0 - q2) * (1.0 - q2) * (1.0 - q2);
-                            count += w;
-                            offsetSum += w * offset;
-                            ++neighbours;
-                        }
-                    });
-                if (neighbours >= kInteriorNeighbours &&
-                    (offsetSum / count).length() < kInteriorCentroidFraction * radius) {
-                    spacing[i] = radius * std::cbrt(kSmoothCountIntegral / count);
-                }
+    forEachSampleNeighbourhood(index, samples, radius, poll,
+        [&](size_t i, const openvdb::Vec3d&, const auto& forNeighbours) {
+            double count = 0.0;
+            int neighbours = -1;  // itself is counted below
+            openvdb::Vec3d offsetSum(0.0);
+            forNeighbours([&](uint32_t, const openvdb::Vec3d& offset) {
+                const double q2 = offset.lengthSqr() / (radius * radius);
+                if (!(q2 < 1.0)) return;
+                const double w = (1.0 - q2) * (1.0 - q2) * (1.0 - q2);
+                count += w;
+                offsetSum += w * offset;
+                ++neighbours;
+            });
+            if (neighbours >= kInteriorNeighbours &&
+                (offsetSum / count).length() < kInteriorCentroidFraction * radius) {
+                spacing[i] = radius * std::cbrt(kSmoothCountIntegral / count);
             }
         });
     return spacing;
