@@ -28,8 +28,11 @@ constexpr size_t kLanes = 8;
 /// Vertex groups of a task between two polls: each group gathers its candidate particles
 /// and sums over them for every vertex, so a task of many groups runs for milliseconds.
 constexpr size_t kGroupsPerPoll = 16;
-/// Edge of a vertex group in particle-index cells.
-constexpr double kGroupCells = 2.0;
+/// Edge of a vertex group in particle-index cells. Larger groups share one gather among more
+/// vertices but give each a longer candidate list. 64x benchmark input, relax stage (t = 2),
+/// 3 runs each alternating: 2 cells 1.30-1.49 s at one thread / 0.67-0.78 s at two, 3 cells
+/// 1.03-1.21 / 0.53-0.69 s, 4 cells 1.03-1.13 / 0.60-0.66 s.
+constexpr double kGroupCells = 3.0;
 
 /// Candidate particles of one group of vertices, as separate x, y, z arrays padded to a
 /// multiple of kLanes with particles far outside every support (weight 0).
