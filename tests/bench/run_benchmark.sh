@@ -47,6 +47,12 @@ run_timed() {
   awk '{printf "%s %.2f %s\n", $1, $2 + $3, $4}' "$log.time" >> "$log"
 }
 
+# compute_time OUT: the stage times nonbloppy printed to OUT, without reading and writing.
+compute_time() {
+  sed -n '/^timings/,$p' "$1" | grep -vE 'read particles|write |total|timings' \
+    | awk '{for (i = 1; i <= NF; ++i) if ($i == "s") s += $(i - 1)} END {print s}'
+}
+
 # median COLUMN FILE
 median() { cut -d' ' -f"$1" "$2" | sort -g | awk '{v[NR] = $1} END {print v[int((NR + 1) / 2)]}'; }
 
@@ -69,9 +75,10 @@ for size in "${sizes[@]}"; do
   input="$out/dam_break_x${size}.ply"
   [ -s "$input" ] || "$tile" "$frame" "$input" --copies "${copies_of[$size]}" > /dev/null
   particles=$(( 24389 * size ))
-  rm -f "$out/nb_$size" "$out/vt_$size"
+  rm -f "$out/nb_$size" "$out/vt_$size" "$out/nb_$size.compute"
   for ((r = 0; r < runs; ++r)); do
     run_timed "$out/nb_$size" "$nonbloppy" mesh "$input" -o "$out/nb_x$size.ply" "${nb_args[@]}"
+    compute_time "$out/nb_$size.out" >> "$out/nb_$size.compute"
     run_timed "$out/vt_$size" vdb_tool -read "$input" -points2ls voxel=0.025 radius=2 width=3 \
       -ls2mesh adapt=0 -write "$out/vt_x$size.ply"
   done
@@ -135,8 +142,7 @@ say "Each relaxation iteration costs $(per_iteration "${t_fixed[4]}" "${t_fixed[
 
 # The paper's figure: 14,272 particles, t = 2, about 15 s on a 2008 desktop. Compute time of the
 # 1x frame (24,389 particles; stages without reading and writing) scaled to 14,272 particles.
-compute=$(sed -n '/^timings/,$p' "$out/nb_1.out" | grep -vE 'read particles|write |total|timings' \
-  | awk '{for (i = 1; i <= NF; ++i) if ($i == "s") s += $(i - 1)} END {print s}')
+compute=$(median 1 "$out/nb_1.compute")
 say ""
-say "Paper comparison: the 24,389-particle frame computes in ${compute} s (stages other than reading and writing, 2 threads), that is $(awk -v c="$compute" 'BEGIN {printf "%.3f", c * 14272 / 24389}') s for 14,272 particles (paper: about 15 s, t = 2)."
+say "Paper comparison: the 24,389-particle frame computes in ${compute} s (stages other than reading and writing, 2 threads, median of $runs runs; each: $(tr '\n' ' ' < "$out/nb_1.compute")s), that is $(awk -v c="$compute" 'BEGIN {printf "%.3f", c * 14272 / 24389}') s for 14,272 particles (paper: about 15 s, t = 2)."
 echo "report: $report" >&2
