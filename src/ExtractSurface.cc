@@ -705,24 +705,12 @@ SurfaceMesh extractSurface(const openvdb::DoubleGrid& density, double threshold,
 
 namespace surface_stages_internal {
 
-void extractSurfaceReleasing(openvdb::FloatGrid& density, double threshold, double adaptivity,
-                             size_t leavesPerRegion, SurfaceMesh& mesh,
-                             openvdb::util::NullInterrupter* interrupter)
-{
-    if (adaptivity == 0.0 && leavesPerRegion > 0) {
-        extractByRegion(density, threshold, mesh, interrupter, leavesPerRegion, kMinLayersPerRegion,
-                        &density.tree());
-    } else {
-        extractInto(density, threshold, adaptivity, mesh);
-    }
-}
-
 void extractSurfaceInto(const openvdb::FloatGrid& density, double threshold, double adaptivity,
                         size_t leavesPerRegion, SurfaceMesh& mesh,
-                        openvdb::util::NullInterrupter* interrupter)
+                        openvdb::util::NullInterrupter* interrupter, openvdb::FloatTree* release)
 {
     if (adaptivity == 0.0 && leavesPerRegion > 0) {
-        extractByRegion(density, threshold, mesh, interrupter, leavesPerRegion);
+        extractByRegion(density, threshold, mesh, interrupter, leavesPerRegion, kMinLayersPerRegion, release);
     } else {
         extractInto(density, threshold, adaptivity, mesh);
     }

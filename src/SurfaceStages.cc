@@ -51,13 +51,10 @@ void runSurfaceStages(const ParticleIndex& index, bool keepDensity, SurfaceResul
         StageScope scope(result.timings, interrupter, "extract surface");
         // Region by region (adaptivity 0): volumeToMesh cannot be stopped safely from
         // outside (see Cancellation.h), so the regions bound the wait for a cancel.
-        if (keepDensity) {
-            extractSurfaceInto(*result.density, p.threshold, p.adaptivity, p.regionLeaves, result.mesh, interrupter);
-        } else {
-            extractSurfaceReleasing(*result.density, p.threshold, p.adaptivity, p.regionLeaves, result.mesh,
-                                    interrupter);
-            result.density.reset();
-        }
+        // A grid nobody keeps gives its memory back as the regions pass.
+        extractSurfaceInto(*result.density, p.threshold, p.adaptivity, p.regionLeaves, result.mesh, interrupter,
+                           keepDensity ? nullptr : &result.density->tree());
+        if (!keepDensity) result.density.reset();
         checkCancelled(interrupter, "extract surface");
     }
     {

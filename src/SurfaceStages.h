@@ -87,18 +87,15 @@ constexpr int kMinLayersPerRegion = 12;
 /// and @a leavesPerRegion > 0 through extractByRegion() (the same polygons and vertices, in
 /// another order), polled for a cancel between regions. Defined in ExtractSurface.cc, the only translation unit that
 /// includes tools/VolumeToMesh.h.
+/// @param release  optional, for a grid that is destroyed afterwards: @a density's own tree.
+///                 Region by region, the leaves of the leaf layers no later region reads
+///                 become inactive tiles, so the grid's memory goes as the mesh's grows (the
+///                 grid is left partial, fit only to be destroyed); the mesh is the same, bit
+///                 for bit (tested). Null leaves the grid untouched.
 /// @throw ParameterError as extractSurface(); CancelledError("interrupted during extract surface")
 void extractSurfaceInto(const openvdb::FloatGrid& density, double threshold, double adaptivity,
                         size_t leavesPerRegion, SurfaceMesh& mesh,
-                        openvdb::util::NullInterrupter* interrupter);
-
-/// extractSurfaceInto(), for a grid that is destroyed afterwards: region by region, the leaves
-/// of the leaf layers no later region reads become inactive tiles, so the grid's memory goes
-/// as the mesh's grows (the grid is left partial, fit only to be destroyed). The mesh is the
-/// same, bit for bit (tested). Defined in ExtractSurface.cc.
-void extractSurfaceReleasing(openvdb::FloatGrid& density, double threshold, double adaptivity,
-                             size_t leavesPerRegion, SurfaceMesh& mesh,
-                             openvdb::util::NullInterrupter* interrupter);
+                        openvdb::util::NullInterrupter* interrupter, openvdb::FloatTree* release = nullptr);
 
 /// The surface φ = @a threshold of a density grid (adaptivity 0), meshed region by region:
 /// slabs across the grid's longest axis, each cut again across the second longest when it
@@ -117,7 +114,7 @@ void extractSurfaceReleasing(openvdb::FloatGrid& density, double threshold, doub
 /// vertices of two slabs. The interrupter (may be null) is asked while leaves are
 /// classified and before each region. Thread-safety: reentrant; the grid is only read.
 /// @param release  optional: @a density's own tree, whose leaves are freed as the slabs pass
-///                 (see extractSurfaceReleasing()); null leaves the grid untouched
+///                 (see extractSurfaceInto()); null leaves the grid untouched
 /// @throw ParameterError if @a threshold is not finite; CancelledError as above
 void extractByRegion(const openvdb::FloatGrid& density, double threshold, SurfaceMesh& mesh,
                      openvdb::util::NullInterrupter* interrupter, size_t leavesPerRegion,
