@@ -36,9 +36,8 @@ addEdge(std::vector<EdgeUse>& edges, uint32_t from, uint32_t to)
 }
 
 /// Adds the area and the signed volume of the tetrahedron (origin, p0, p1, p2).
-template<typename MeasuresT>
 void
-addTriangle(const SurfaceMesh& mesh, uint32_t i0, uint32_t i1, uint32_t i2, MeasuresT& m)
+addTriangle(const SurfaceMesh& mesh, uint32_t i0, uint32_t i1, uint32_t i2, AreaAndVolume& m)
 {
     const openvdb::Vec3d p0(mesh.points[i0]), p1(mesh.points[i1]), p2(mesh.points[i2]);
     m.area += 0.5 * (p1 - p0).cross(p2 - p0).length();
@@ -86,28 +85,21 @@ measureMesh(const SurfaceMesh& mesh)
     MeshMeasures m;
     m.vertices = mesh.points.size();
     m.polygons = mesh.polygonCount();
+    // Checks every index first (the same error for the same mesh), so the loop below may trust them.
+    const AreaAndVolume sums = measureAreaAndVolume(mesh);
+    m.area = sums.area;
+    m.volume = sums.volume;
 
     std::vector<bool> used(mesh.points.size(), false);
-    auto use = [&](size_t polygon, uint32_t index) {
-        if (index >= mesh.points.size()) throwBadIndex(mesh, polygon, index);
-        used[index] = true;
-    };
-
     std::vector<EdgeUse> edges;
     edges.reserve(3 * mesh.triangles.size() + 4 * mesh.quads.size());
-    size_t polygon = 0;
     for (const openvdb::Vec3I& t : mesh.triangles) {
-        for (int i = 0; i < 3; ++i) use(polygon, t[i]);
+        for (int i = 0; i < 3; ++i) used[t[i]] = true;
         for (int i = 0; i < 3; ++i) addEdge(edges, t[i], t[(i + 1) % 3]);
-        addTriangle(mesh, t[0], t[1], t[2], m);
-        ++polygon;
     }
     for (const openvdb::Vec4I& q : mesh.quads) {
-        for (int i = 0; i < 4; ++i) use(polygon, q[i]);
+        for (int i = 0; i < 4; ++i) used[q[i]] = true;
         for (int i = 0; i < 4; ++i) addEdge(edges, q[i], q[(i + 1) % 4]);
-        addTriangle(mesh, q[0], q[1], q[2], m);
-        addTriangle(mesh, q[0], q[2], q[3], m);
-        ++polygon;
     }
     m.unusedVertices = size_t(std::count(used.begin(), used.end(), false));
 

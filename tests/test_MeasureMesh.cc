@@ -188,10 +188,10 @@ TEST(MeasureMesh, OutOfRangeIndexIsAParameterError)
     }
 }
 
-TEST(MeasureAreaAndVolume, SameBitsAsMeasureMeshForTrianglesAndQuads)
+TEST(MeasureAreaAndVolume, SumsTrianglesAndQuadsAsMeasureMeshReportsThem)
 {
-    // A moved cube of quads plus a tetrahedron of triangles in one mesh: both sums in the
-    // same order as measureMesh(), so the same doubles, not just close ones.
+    // A moved cube of quads plus a tetrahedron of triangles in one mesh: the analytic area and
+    // volume, and the very doubles measureMesh() reports.
     SurfaceMesh mesh = cube(1.5f, openvdb::Vec3s(0.3f, -2.1f, 7.7f));
     const uint32_t base = uint32_t(mesh.points.size());
     for (const openvdb::Vec3s& p : {openvdb::Vec3s(3, 0, 0), openvdb::Vec3s(4, 0.1f, 0),
@@ -207,6 +207,7 @@ TEST(MeasureAreaAndVolume, SameBitsAsMeasureMeshForTrianglesAndQuads)
     EXPECT_EQ(fast.area, full.area);
     EXPECT_EQ(fast.volume, full.volume);
     EXPECT_NEAR(fast.volume, 1.5 * 1.5 * 1.5 + 1.0 * 1.3 * 0.9 / 6.0, 1e-5);
+    EXPECT_NEAR(fast.area, 16.081966, 1e-5);  // 6 · 1.5² plus the tetrahedron's four faces
 }
 
 TEST(MeasureAreaAndVolume, OutOfRangeIndexIsAParameterError)

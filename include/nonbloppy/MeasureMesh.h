@@ -45,8 +45,8 @@ struct AreaAndVolume
     double volume = 0.0;  ///< world units³, positive when polygons face outwards
 };
 
-/// The area and volume of measureMesh(), summed in the same order (the same bits), without
-/// its edge topology: what a volume correction asks on every pass.
+/// The area and volume that measureMesh() reports (it calls this), without its edge
+/// topology: what a volume correction asks on every pass.
 /// Cost: O(P), serial, no scratch memory (measureMesh() sorts all edges: on a 2.4M-vertex
 /// mesh about 0.4 s against 0.02 s). Thread-safety: reentrant; the mesh is only read.
 /// @throw ParameterError if a polygon references a vertex index out of range (as measureMesh()).
