@@ -27,7 +27,7 @@ std::string formatNumber(double value)
     return out.str();
 }
 
-/// Run @a perSample(i, x, forNeighbours) in parallel for every sampled slot i (sorted order,
+/// Run @a perSample(i, forNeighbours) in parallel for every sampled slot i (sorted order,
 /// position x), where forNeighbours(visit) calls visit(k, offset) for every particle k in the
 /// box of half-width @a radius around x, offset = x_k − x (x itself included, k == samples[i]).
 /// A wide box visits thousands of particles per sample: @a poll is asked every 16 samples,
@@ -51,7 +51,7 @@ void forEachSampleNeighbourhood(const ParticleIndex& index, const std::vector<si
                             for (uint32_t k = first; k < end; ++k) visit(k, openvdb::Vec3d(positions[k]) - x);
                         });
                 };
-                perSample(i, x, forNeighbours);
+                perSample(i, forNeighbours);
             }
         });
 }
@@ -63,7 +63,7 @@ std::vector<double> nearestWithin(const ParticleIndex& index, const std::vector<
 {
     std::vector<double> nearest(samples.size());
     forEachSampleNeighbourhood(index, samples, searchRadius, poll,
-        [&](size_t i, const openvdb::Vec3d&, const auto& forNeighbours) {
+        [&](size_t i, const auto& forNeighbours) {
             double best = searchRadius * searchRadius;
             bool found = false;
             forNeighbours([&](uint32_t k, const openvdb::Vec3d& offset) {
@@ -98,7 +98,7 @@ std::vector<double> interiorSpacings(const ParticleIndex& index, const std::vect
 {
     std::vector<double> spacing(samples.size(), 0.0);  // 0: not inside
     forEachSampleNeighbourhood(index, samples, radius, poll,
-        [&](size_t i, const openvdb::Vec3d&, const auto& forNeighbours) {
+        [&](size_t i, const auto& forNeighbours) {
             double count = 0.0;
             int neighbours = -1;  // itself is counted below
             openvdb::Vec3d offsetSum(0.0);
