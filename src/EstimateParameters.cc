@@ -28,13 +28,13 @@ std::string formatNumber(double value)
 }
 
 /// Run @a perSample(i, forNeighbours) in parallel for every sampled slot i (sorted order,
-/// position x), where forNeighbours(visit) calls visit(k, offset) for every particle k in the
-/// box of half-width @a radius around x, offset = x_k − x (x itself included, k == samples[i]).
-/// A wide box visits thousands of particles per sample: @a poll is asked every 16 samples,
-/// and a stop leaves later samples unvisited.
+/// position x), where forNeighbours(radius, visit) calls visit(k, offset) for every particle
+/// k in the box of half-width radius around x, offset = x_k − x (x itself included,
+/// k == samples[i]). A wide box visits thousands of particles per sample: @a poll is asked
+/// every 16 samples, and a stop leaves later samples unvisited.
 template<typename PerSampleOp>
 void forEachSampleNeighbourhood(const ParticleIndex& index, const std::vector<size_t>& samples,
-                                double radius, CancelPoll& poll, PerSampleOp&& perSample)
+                                CancelPoll& poll, PerSampleOp&& perSample)
 {
     using namespace particle_index_internal;
     const auto& positions = index.sortedPositions();
@@ -45,7 +45,7 @@ void forEachSampleNeighbourhood(const ParticleIndex& index, const std::vector<si
             for (size_t i = range.begin(); i < range.end(); ++i) {
                 if ((i - range.begin()) % 16 == 0 && poll.stopped()) return;
                 const openvdb::Vec3d x = positions[samples[i]];
-                const auto forNeighbours = [&](auto&& visit) {
+                const auto forNeighbours = [&](double radius, auto&& visit) {
                     forEachRunInBox(accessor, index.cellSize(), x - openvdb::Vec3d(radius),
                         x + openvdb::Vec3d(radius), [&](uint32_t first, uint32_t end) {
                             for (uint32_t k = first; k < end; ++k) visit(k, openvdb::Vec3d(positions[k]) - x);
@@ -62,17 +62,22 @@ std::vector<double> nearestWithin(const ParticleIndex& index, const std::vector<
                                   double searchRadius, CancelPoll& poll)
 {
     std::vector<double> nearest(samples.size());
-    forEachSampleNeighbourhood(index, samples, searchRadius, poll,
-        [&](size_t i, const auto& forNeighbours) {
-            double best = searchRadius * searchRadius;
+    forEachSampleNeighbourhood(index, samples, poll, [&](size_t i, const auto& forNeighbours) {
+        // Most neighbours lie well within the search radius: look in a box half as wide
+        // first (a quarter of the particles to visit), and in the whole one only when that
+        // finds none. Either way the nearest one within the radius is found.
+        for (const double radius : {0.5 * searchRadius, searchRadius}) {
+            double best = radius * radius;
             bool found = false;
-            forNeighbours([&](uint32_t k, const openvdb::Vec3d& offset) {
+            forNeighbours(radius, [&](uint32_t k, const openvdb::Vec3d& offset) {
                 if (k == samples[i]) return;
                 const double d2 = offset.lengthSqr();
                 if (d2 <= best) { best = d2; found = true; }
             });
             nearest[i] = found ? std::sqrt(best) : std::numeric_limits<double>::infinity();
-        });
+            if (found) break;
+        }
+    });
     return nearest;
 }
 
@@ -97,13 +102,18 @@ std::vector<double> interiorSpacings(const ParticleIndex& index, const std::vect
                                      double radius, CancelPoll& poll)
 {
     std::vector<double> spacing(samples.size(), 0.0);  // 0: not inside
-    forEachSampleNeighbourhood(index, samples, radius, poll,
+    forEachSampleNeighbourhood(index, samples, poll,
         [&](size_t i, const auto& forNeighbours) {
             double count = 0.0;
             int neighbours = -1;  // itself is counted below
             openvdb::Vec3d offsetSum(0.0);
-            forNeighbours([&](uint32_t, const openvdb::Vec3d& offset) {
-                const double q2 = offset.lengthSqr() / (radius * radius);
+            const double radiusSqr = radius * radius;
+            forNeighbours(radius, [&](uint32_t, const openvdb::Vec3d& offset) {
+                // Most of the box lies outside the ball: reject those before dividing
+                // (d² ≥ r² implies d²/r² ≥ 1, so this rejects nothing the test below keeps).
+                const double distanceSqr = offset.lengthSqr();
+                if (!(distanceSqr < radiusSqr)) return;
+                const double q2 = distanceSqr / radiusSqr;
                 if (!(q2 < 1.0)) return;
                 const double w = (1.0 - q2) * (1.0 - q2) * (1.0 - q2);
                 count += w;
