@@ -422,7 +422,7 @@ bool extractByRegionImpl(const openvdb::FloatGrid& density, double threshold, Su
     std::vector<size_t> claimedBefore;
     constexpr uint32_t kNew = SeamTable::kNone;  // not in a seam table: a vertex of its own
 
-    // Mesh region @a r alone: its pieces plus kShellPlanes planes of the leaf layers around
+    // Mesh @a region alone: its pieces plus kShellPlanes planes of the leaf layers around
     // it, tiles added serially, leaves copied (and their shells cut) in parallel, then added
     // in order. Reads the pieces only: regions of one batch run it concurrently.
     const auto meshRegion = [&](const Region& region) {

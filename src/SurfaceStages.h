@@ -105,14 +105,16 @@ void extractSurfaceInto(const openvdb::FloatGrid& density, double threshold, dou
 /// vertices at a seam are welded by exact position (a cell's vertices depend only on its
 /// corner values and the signs of the cells next to it). Leaves that no crossing edge
 /// touches are left out, or become tiles, so the regions scan fewer voxels than the whole
-/// grid holds. The result holds exactly the vertices and polygons of extractSurface()
+/// grid holds. Regions are meshed one per thread at a time (a batch), then welded in region
+/// order. The result holds exactly the vertices and polygons of extractSurface()
 /// (tested), oriented the same way, ordered region by region; deterministic at any thread
 /// count. A grid that makes one region, has tiles larger than a leaf or a transform that is
 /// not an axis-aligned scale is meshed whole, as extractSurface().
 /// Cost: O(voxels) as extractSurface(), plus copying the leaves a crossing touches and, per
-/// region, its shell (see SurfaceParameters::regionLeaves); scratch memory is one region's plus the seam
-/// vertices of two slabs. The interrupter (may be null) is asked while leaves are
-/// classified and before each region. Thread-safety: reentrant; the grid is only read.
+/// region, its shell (see SurfaceParameters::regionLeaves); scratch memory is one region's
+/// per thread plus the seam vertices of two slabs. The interrupter (may be null) is asked
+/// while leaves are classified and before each region of a batch. Thread-safety: reentrant;
+/// the grid is only read.
 /// @param release  optional: @a density's own tree, whose leaves are freed as the slabs pass
 ///                 (see extractSurfaceInto()); null leaves the grid untouched
 /// @throw ParameterError if @a threshold is not finite; CancelledError as above
