@@ -198,14 +198,19 @@ TEST(ExtractByRegion, RegionLeavesOfBuildSurfaceChangesOnlyTheOrder)
     }
 }
 
-TEST(ExtractByRegion, SameOrderAtOneAndTwoThreads)
+TEST(ExtractByRegion, SameOrderAtOneTwoAndThreeThreads)
 {
-    SurfaceMesh one, two;
+    // Regions are meshed a batch of one per thread at a time: batches of 1, 2 and 3 (which
+    // leaves a short last batch) must weld into the same mesh.
+    SurfaceMesh one, two, three;
     tbb::task_arena(1).execute([&] { extractByRegion(damBreakDensity(), kThreshold, one, nullptr, 64, 1); });
     tbb::task_arena(2).execute([&] { extractByRegion(damBreakDensity(), kThreshold, two, nullptr, 64, 1); });
+    tbb::task_arena(3).execute([&] { extractByRegion(damBreakDensity(), kThreshold, three, nullptr, 64, 1); });
     ASSERT_EQ(one.points.size(), two.points.size());
     EXPECT_TRUE(one.points == two.points);
     EXPECT_TRUE(one.quads == two.quads);
+    EXPECT_TRUE(one.points == three.points);
+    EXPECT_TRUE(one.quads == three.quads);
 }
 
 TEST(ExtractByRegion, AsksTheInterrupterBetweenRegionsAndStops)
