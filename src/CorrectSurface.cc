@@ -60,8 +60,9 @@ double latticeDensity(double ratio, const openvdb::Vec3d& x)
     return sum;
 }
 
-/// One relaxation step of vertex @a x against the unit lattice filling z ≤ 0.
-openvdb::Vec3d relaxOnLattice(double ratio, double blend, const openvdb::Vec3d& x)
+/// One relaxation step of vertex @a x against the unit lattice filling z ≤ 0, no longer than
+/// @a maxStep (lattice spacings; 0: uncapped), as relaxVertices() takes it.
+openvdb::Vec3d relaxOnLattice(double ratio, double blend, double maxStep, const openvdb::Vec3d& x)
 {
     double sw = 0.0;
     openvdb::Vec3d mean(0.0);
@@ -70,18 +71,21 @@ openvdb::Vec3d relaxOnLattice(double ratio, double blend, const openvdb::Vec3d& 
         mean += w * r;
     });
     if (!(sw > 0.0)) return x;
-    return x + blend * (mean / sw - x);
+    openvdb::Vec3d step = blend * (mean / sw - x);
+    const double length2 = step.lengthSqr();
+    if (maxStep > 0.0 && length2 > maxStep * maxStep) step *= maxStep / std::sqrt(length2);
+    return x + step;
 }
 
 /// Mean height, over the lattice cell, of vertices that start at height @a z0 after
-/// @a iterations relaxation steps.
-double relaxedHeight(double ratio, double blend, int iterations, double z0)
+/// @a iterations relaxation steps of at most @a maxStep.
+double relaxedHeight(double ratio, double blend, double maxStep, int iterations, double z0)
 {
     double sum = 0.0;
     for (int a = 0; a < kSamples; ++a)
         for (int b = 0; b < kSamples; ++b) {
             openvdb::Vec3d x((a + 0.5) / kSamples, (b + 0.5) / kSamples, z0);
-            for (int t = 0; t < iterations; ++t) x = relaxOnLattice(ratio, blend, x);
+            for (int t = 0; t < iterations; ++t) x = relaxOnLattice(ratio, blend, maxStep, x);
             sum += x[2];
         }
     return sum / (kSamples * kSamples);
@@ -223,7 +227,7 @@ void requireNormals(const SurfaceMesh& mesh)
 } // namespace
 
 double calibrateRelaxedThreshold(double effectiveRadiusOverSpacing, double blend, int iterations,
-                                 bool* reachesSurface)
+                                 bool* reachesSurface, double maxStepOverSpacing)
 {
     if (reachesSurface) *reachesSurface = true;
     const double ratio = effectiveRadiusOverSpacing;
@@ -235,6 +239,12 @@ double calibrateRelaxedThreshold(double effectiveRadiusOverSpacing, double blend
     if (iterations < 0) {
         throw ParameterError("--iterations must be >= 0, got " + std::to_string(iterations));
     }
+    if (!(maxStepOverSpacing >= 0.0) || !std::isfinite(maxStepOverSpacing)) {
+        std::ostringstream msg;
+        msg << "--max-step must be >= 0, got " << maxStepOverSpacing << " spacings";
+        throw ParameterError(msg.str());
+    }
+    const double maxStep = maxStepOverSpacing;
     const double blobThreshold = calibrateThreshold(ratio);  // checks the ratio
     if (iterations == 0 || blend == 0.0) return blobThreshold;
 
@@ -247,7 +257,7 @@ double calibrateRelaxedThreshold(double effectiveRadiusOverSpacing, double blend
     constexpr double kScanStep = 0.05, kMaxStart = 1.5;
     const double limit = std::min(kMaxStart, 0.75 * ratio);
     double low = 0.5, high = 0.5;
-    while (relaxedHeight(ratio, blend, iterations, high) < 0.5) {
+    while (relaxedHeight(ratio, blend, maxStep, iterations, high) < 0.5) {
         low = high;
         high += kScanStep;
         if (high >= limit) {
@@ -257,7 +267,7 @@ double calibrateRelaxedThreshold(double effectiveRadiusOverSpacing, double blend
     }
     for (int step = 0; step < 24; ++step) {
         const double middle = 0.5 * (low + high);
-        (relaxedHeight(ratio, blend, iterations, middle) < 0.5 ? low : high) = middle;
+        (relaxedHeight(ratio, blend, maxStep, iterations, middle) < 0.5 ? low : high) = middle;
     }
     return planeDensity(ratio, 0.5 * (low + high));
 }

@@ -288,17 +288,20 @@ ResolvedParameters resolveParameters(const SurfaceParameters& params,
     out.voxelSize = params.voxelSize ? *params.voxelSize : kDefaultVoxelOverSpacing * out.spacing;
     out.method = params.method;
     const bool faithful = params.method == Method::Faithful;
-    bool calibratedForRelaxedSurface = false;
-    if (params.threshold) out.threshold = *params.threshold;
-    else if (faithful) out.threshold = calibrateRelaxedThreshold(out.effectiveRadius / out.spacing,
-                                                                 out.blend, out.iterations,
-                                                                 &calibratedForRelaxedSurface);
-    else out.threshold = calibrateThreshold(out.effectiveRadius / out.spacing);
     if (faithful) {
         if (params.maxStep && (!(*params.maxStep >= 0.0) || !std::isfinite(*params.maxStep))) {
             throw ParameterError("--max-step must be >= 0, got " + formatNumber(*params.maxStep));
         }
         out.maxStep = params.maxStep ? *params.maxStep : kDefaultMaxStepOverSpacing * out.spacing;
+    }
+    bool calibratedForRelaxedSurface = false;
+    if (params.threshold) out.threshold = *params.threshold;
+    else if (faithful) out.threshold = calibrateRelaxedThreshold(out.effectiveRadius / out.spacing,
+                                                                 out.blend, out.iterations,
+                                                                 &calibratedForRelaxedSurface,
+                                                                 out.maxStep / out.spacing);
+    else out.threshold = calibrateThreshold(out.effectiveRadius / out.spacing);
+    if (faithful) {
         out.preserveVolume = params.preserveVolume ? *params.preserveVolume : out.spacingGiven;
         out.volumeOffset = params.volumeOffset ? *params.volumeOffset
                            : calibratedForRelaxedSurface ? VolumeOffset::Convex : VolumeOffset::Uniform;

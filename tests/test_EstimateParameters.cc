@@ -102,9 +102,11 @@ TEST(EstimateParameters, ResolveReportsWhatWasGivenAndChecksRanges)
     EXPECT_DOUBLE_EQ(resolved.effectiveRadius, 0.2);
     EXPECT_DOUBLE_EQ(resolved.voxelSize, 0.5 * resolved.spacing);
     EXPECT_NEAR(resolved.spacing, 0.05, 0.005 * 0.05);
-    // The default (Method::Faithful) calibrates r_0 for the relaxed surface, the paper's for the blob.
+    // The default (Method::Faithful) calibrates r_0 for the relaxed surface, with the steps
+    // capped at s/2 as the relaxation caps them; the paper's for the blob.
     EXPECT_DOUBLE_EQ(resolved.threshold,
-                     calibrateRelaxedThreshold(0.2 / resolved.spacing, kDefaultBlend, kDefaultIterations));
+                     calibrateRelaxedThreshold(0.2 / resolved.spacing, kDefaultBlend, kDefaultIterations, nullptr,
+                                               kDefaultMaxStepOverSpacing));
     SurfaceParameters paper = params;
     paper.method = Method::Paper;
     EXPECT_DOUBLE_EQ(resolveParameters(paper, ball).threshold, calibrateThreshold(0.2 / resolved.spacing));
