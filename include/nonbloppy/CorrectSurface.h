@@ -32,7 +32,8 @@ namespace nonbloppy {
 /// The start height is limited to min(1.5 s, 0.75 r_e): relaxations so strong that they
 /// would need to start farther out (c = 0.5, t = 2 would start 1.9 s out and merge fluid
 /// bodies 4 s apart) get the threshold of that limit and end inside the true surface.
-/// The result depends only on r_e/s, c and t. Cost: about 10⁶ kernel evaluations (~10 ms).
+/// The result depends only on r_e/s, c, t and the cap. Cost: about 10⁵ kernel evaluations
+/// (2 ms at r_e = 2.1 s).
 /// Thread-safety: reentrant.
 /// @param effectiveRadiusOverSpacing  r_e / s, > 0.5
 /// @param blend           c in [0,1]
