@@ -301,6 +301,7 @@ ResolvedParameters resolveParameters(const SurfaceParameters& params,
                                                                  &calibratedForRelaxedSurface,
                                                                  out.maxStep / out.spacing);
     else out.threshold = calibrateThreshold(out.effectiveRadius / out.spacing);
+    out.thresholdReachesSurface = params.threshold || !faithful || calibratedForRelaxedSurface;
     if (faithful) {
         out.preserveVolume = params.preserveVolume ? *params.preserveVolume : out.spacingGiven;
         out.volumeOffset = params.volumeOffset ? *params.volumeOffset

@@ -343,9 +343,11 @@ TEST(Fidelity, ConvexVolumeOffsetOnlyWhereTheCalibrationReachesTheSurface)
     SurfaceParameters params;
     params.spacing = 1.0;
     EXPECT_EQ(resolveParameters(params, jet.particles).volumeOffset, VolumeOffset::Convex);
+    EXPECT_TRUE(resolveParameters(params, jet.particles).thresholdReachesSurface);
     params.blend = 0.5;
     params.iterations = 4;
     EXPECT_EQ(resolveParameters(params, jet.particles).volumeOffset, VolumeOffset::Uniform);
+    EXPECT_FALSE(resolveParameters(params, jet.particles).thresholdReachesSurface);
     params = SurfaceParameters();
     params.spacing = 1.0;
     params.threshold = 2.6;  // the user's r_0: the whole surface may lie inside

@@ -69,6 +69,21 @@ TEST_F(CliTest, QuietPrintsNothing)
     EXPECT_TRUE(r.err.empty()) << r.err;
 }
 
+TEST_F(CliTest, WarnsWhenRelaxationIsTooStrongForTheCalibration)
+{
+    // c = 0.5, t = 4 would need the surface to start farther out than the calibration
+    // allows (CorrectSurface.h): the faces end inside, and the user is told once.
+    const RunResult strong = meshCube("strong", "-q --blend 0.5 --iterations 4");
+    ASSERT_EQ(strong.exitCode, 0) << strong.err;
+    EXPECT_EQ(strong.err, "nonbloppy: warning: --blend 0.5 --iterations 4 relax too strongly for --threshold "
+                          "to be calibrated: flat faces end inside the particles; lower --blend or "
+                          "--iterations, or give --spacing to correct the volume\n");
+    // A threshold of the user's own is not calibrated: nothing to warn about.
+    const RunResult given = meshCube("given", "-q --blend 0.5 --iterations 4 --threshold 3");
+    ASSERT_EQ(given.exitCode, 0) << given.err;
+    EXPECT_TRUE(given.err.empty()) << given.err;
+}
+
 TEST_F(CliTest, VerbosePrintsStagesOnStderr)
 {
     const RunResult r = meshCube("cube", "-v");

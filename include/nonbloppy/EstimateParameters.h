@@ -161,6 +161,10 @@ struct ResolvedParameters
     VolumeOffset volumeOffset = VolumeOffset::Convex;  ///< how it spreads its offset
     bool repairFolds = false;               ///< fold repair runs
     size_t regionLeaves = kDefaultRegionLeaves;  ///< leaves per extraction region; 0: whole grid
+    /// False when r_0 was calibrated for the relaxed surface but no start height within
+    /// reach lets relaxation end a flat face at s/2 (calibrateRelaxedThreshold()'s
+    /// reachesSurface: c and t so strong that the faces end inside the particles).
+    bool thresholdReachesSurface = true;
 };
 
 /// Check @a params and fill in what is missing. @a positions is only read when the spacing

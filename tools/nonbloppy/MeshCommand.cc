@@ -493,6 +493,17 @@ FrameOutcome meshFrame(const MeshOptions& o, ProgressInterrupter& interrupter)
     return outcome;
 }
 
+/// Once per run: relaxation too strong for the calibrated r_0 shrinks every flat face.
+void warnIfFacesEndInside(const MeshOptions& o, const nonbloppy::ResolvedParameters& p)
+{
+    static std::atomic<bool> printed{false};
+    if (p.thresholdReachesSurface || printed.exchange(true)) return;
+    std::cerr << "nonbloppy: warning: --blend " << formatNumber(o.blend) << " --iterations " << o.iterations
+              << " relax too strongly for --threshold to be calibrated: flat faces end inside the "
+                 "particles; lower --blend or --iterations, or give --spacing to correct the volume"
+              << std::endl;
+}
+
 // ---------------------------------------------------------------------------------------
 // Frame sequences
 
@@ -580,6 +591,7 @@ int runSequence(const MeshOptions& o)
         std::unique_ptr<ResidentSampler> sampler;
         if (o.verbose) sampler = std::make_unique<ResidentSampler>();
         const FrameOutcome outcome = meshFrame(f, interrupter);
+        warnIfFacesEndInside(o, outcome.result.parameters);
 
         FrameReport report;
         const nonbloppy::SurfaceResult& result = outcome.result;
@@ -630,6 +642,7 @@ int runMesh(const MeshOptions& o)
 
     try {
         const FrameOutcome outcome = meshFrame(o, interrupter);
+        warnIfFacesEndInside(o, outcome.result.parameters);
         if (sampler) {
             sampler->stop();
             std::cerr << sampler->report(outcome.timings, outcome.result.particleCount);
