@@ -308,8 +308,10 @@ ResolvedParameters resolveParameters(const SurfaceParameters& params,
         out.volumeOffset = params.volumeOffset ? *params.volumeOffset
                            : calibratedForRelaxedSurface ? VolumeOffset::Convex : VolumeOffset::Uniform;
         out.repairFolds = params.repairFolds;
-        // The volume target N·s³ needs s even when r_e, r_0 and h were all given.
-        if (out.preserveVolume && !(out.spacing > 0.0)) {
+        out.smoothSurface = params.smoothSurface ? *params.smoothSurface : out.preserveVolume;
+        // The volume target N·s³ and the smoothing's width need s even when r_e, r_0 and h
+        // were all given.
+        if ((out.preserveVolume || out.smoothSurface) && !(out.spacing > 0.0)) {
             out.spacing = estimateSpacing(positions, kSpacingSamples, poll, interrupter);
         }
     }

@@ -12,6 +12,7 @@
 #include <nonbloppy/ExtractSurface.h>
 #include <nonbloppy/RasterizeDensity.h>
 #include <nonbloppy/RelaxVertices.h>
+#include <nonbloppy/SmoothSurface.h>
 #include <nonbloppy/Version.h>
 
 #include <string>
@@ -91,6 +92,16 @@ void runSurfaceStages(const ParticleIndex& index, bool keepDensity, SurfaceResul
                                                                      : kMaxVolumeOffsetOverSpacing) * s;
         preserveVolume(result.mesh, volume, interrupter);
         checkCancelled(interrupter, "correct surface");
+    }
+    if (p.smoothSurface) {
+        // After the volume correction: smoothing first would leave the edges it rounds
+        // nothing to put their volume back (docs/fidelity.md).
+        StageScope scope(result.timings, interrupter, "smooth surface");
+        SmoothSettings settings;
+        settings.spatialWidth = kDefaultSmoothWidthOverSpacing * p.spacing;
+        smoothSurface(result.mesh, settings, interrupter);
+        computeNormals(result.mesh, interrupter);
+        checkCancelled(interrupter, "smooth surface");
     }
 }
 

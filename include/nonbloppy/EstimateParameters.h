@@ -129,6 +129,13 @@ struct SurfaceParameters
     std::optional<VolumeOffset> volumeOffset;
     /// Faithful only: unfold triangles relaxation folded over (repairFolds()).
     bool repairFolds = true;
+    /// Faithful only: smooth the surface after the volume correction without rounding its
+    /// edges (smoothSurface(), spatial width kDefaultSmoothWidthOverSpacing·s). Default: on
+    /// when the volume correction runs. The two belong together: the volume correction puts
+    /// back at edges and thin features what relaxation took, the smoothing then removes the
+    /// particles' jitter from the faces (docs/fidelity.md, row "− smoothing"); without the
+    /// correction the smoothing alone leaves box and slab no closer.
+    std::optional<bool> smoothSurface;
     /// With adaptivity 0 the surface is extracted region by region, about this many density
     /// leaves that the surface touches per region (0: the whole grid at once). The extracted
     /// surface has the same polygons and vertices whatever the value (only their order changes);
@@ -160,6 +167,7 @@ struct ResolvedParameters
     bool preserveVolume = false;            ///< the volume correction runs
     VolumeOffset volumeOffset = VolumeOffset::Convex;  ///< how it spreads its offset
     bool repairFolds = false;               ///< fold repair runs
+    bool smoothSurface = false;             ///< the feature-preserving smoothing runs
     size_t regionLeaves = kDefaultRegionLeaves;  ///< leaves per extraction region; 0: whole grid
     /// False when r_0 was calibrated for the relaxed surface but no start height within
     /// reach lets relaxation end a flat face at s/2 (calibrateRelaxedThreshold()'s
