@@ -30,7 +30,10 @@ namespace {
 /// The stages in the order buildSurface() runs them, as announced through start().
 const char* const kStages[] = {"estimate parameters", "index particles", "rasterize density",
                                "extract surface",     "relax vertices",  "correct surface",
-                               "compute normals"};
+                               "compute normals",     "smooth surface"};
+
+/// Runs only when the spacing is given (with the volume correction).
+bool needsSpacing(const std::string& stage) { return stage == "smooth surface"; }
 
 /// Says stop from the moment stage @a target is announced, ever after.
 struct StopInStage : openvdb::util::NullInterrupter
@@ -94,6 +97,7 @@ TEST(Cancellation, EveryStageOfBuildSurfaceThrowsItsOwnMessage)
     const auto frame = ballFrame(0.5);
     for (const SurfaceParameters& params : {SurfaceParameters(), withSpacing()}) {
         for (const char* stage : kStages) {
+            if (!params.spacing && needsSpacing(stage)) continue;
             SCOPED_TRACE(stage);
             StopInStage stop(stage);
             EXPECT_EQ(cancelMessage([&] { buildSurface(frame, params, &stop); }),

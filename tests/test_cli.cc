@@ -54,11 +54,32 @@ TEST_F(CliTest, MeshWritesObjAndVdbAndSummary)
     EXPECT_NE(r.out.find("2366"), std::string::npos) << r.out;
     EXPECT_NE(r.out.find("(derived)"), std::string::npos) << r.out;
     EXPECT_NE(r.out.find("volume offset        off            (needs --spacing)"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("smoothing            off            (needs --spacing)"), std::string::npos) << r.out;
     EXPECT_NE(r.out.find("region leaves        1024           (default)"), std::string::npos) << r.out;
     EXPECT_NE(r.out.find("rasterize density"), std::string::npos) << r.out;
     EXPECT_EQ(listDir(dir() + "/out"), (std::vector<std::string>{"cube.obj", "cube.vdb"}));
     EXPECT_GT(fs::file_size(out("cube.obj")), 1000u);
     EXPECT_GT(fs::file_size(out("cube.vdb")), 1000u);
+}
+
+TEST_F(CliTest, SpacingTurnsOnVolumeOffsetAndSmoothingAndNoSmoothTurnsItOff)
+{
+    const RunResult smoothed = meshCube("smoothed", "--spacing 0.05");
+    ASSERT_EQ(smoothed.exitCode, 0) << smoothed.err;
+    EXPECT_NE(smoothed.out.find("volume offset        convex         (N*s^3, --spacing given)"), std::string::npos)
+        << smoothed.out;
+    EXPECT_NE(smoothed.out.find("smoothing            on             (with the volume offset)"), std::string::npos)
+        << smoothed.out;
+    EXPECT_NE(smoothed.out.find("smooth surface"), std::string::npos) << smoothed.out;  // its timing
+    const RunResult plain = meshCube("plain", "--spacing 0.05 --no-smooth");
+    ASSERT_EQ(plain.exitCode, 0) << plain.err;
+    EXPECT_NE(plain.out.find("smoothing            off            (--no-smooth)"), std::string::npos) << plain.out;
+    EXPECT_EQ(plain.out.find("smooth surface"), std::string::npos) << plain.out;
+    // Same polygons, other vertex positions.
+    const std::string smoothedObj = readText(out("smoothed.obj")), plainObj = readText(out("plain.obj"));
+    EXPECT_EQ(count(smoothedObj, "\nf "), count(plainObj, "\nf "));
+    EXPECT_GT(count(plainObj, "\nf "), 1000u);
+    EXPECT_NE(smoothedObj, plainObj);
 }
 
 TEST_F(CliTest, QuietPrintsNothing)

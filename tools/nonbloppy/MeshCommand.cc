@@ -184,6 +184,7 @@ struct MeshOptions
     long long regionLeaves = nonbloppy::kDefaultRegionLeaves;  ///< signed, so that -1 is refused
     std::string method = "faithful";  ///< --method: faithful (default) or paper
     CLI::Option* methodOpt = nullptr;
+    bool noSmooth = false;  ///< --no-smooth: skip smoothSurface() after the volume correction
     int threads = 0;
     bool quads = false, quiet = false, verbose = false;
     MeshOutputOptions outputs;  ///< --attributes, --vdb-surface, --vdb-points (MeshOutputs.h)
@@ -356,6 +357,8 @@ void printSummary(const MeshOptions& o, const nonbloppy::SurfaceResult& result,
         row("volume offset",
             !p.preserveVolume ? "off" : p.volumeOffset == nonbloppy::VolumeOffset::Convex ? "convex" : "uniform",
             p.preserveVolume ? "(N*s^3, --spacing given)" : "(needs --spacing)");
+        row("smoothing", p.smoothSurface ? "on" : "off",
+            o.noSmooth ? "(--no-smooth)" : p.smoothSurface ? "(with the volume offset)" : "(needs --spacing)");
     }
     row("region leaves", std::to_string(p.regionLeaves), origin(o.regionLeavesOpt->count() > 0, "(default)"));
     row("threads", std::to_string(threads), origin(o.threadsOpt->count() > 0, "(default)"));
@@ -445,6 +448,7 @@ FrameOutcome meshFrame(const MeshOptions& o, ProgressInterrupter& interrupter)
     params.iterations = o.iterations;
     params.adaptivity = o.adaptivity;
     params.method = o.method == "paper" ? nonbloppy::Method::Paper : nonbloppy::Method::Faithful;
+    if (o.noSmooth) params.smoothSurface = false;
     // Without --vdb nothing needs the grid: the library frees it before relaxing, which
     // lowers the peak memory of large frames.
     params.keepDensity = !o.vdbPath.empty();
@@ -695,8 +699,11 @@ Command setupMeshCommand(CLI::App& parent)
         "Relaxation iterations t >= 0 (default: 2)")->group(kGroupNumerical);
     o.methodOpt = cmd->add_option("--method", o.method,
         "faithful (default): r_0 calibrated for the relaxed surface, steps capped at s/2, folds "
-        "repaired, volume N*s^3 kept when --spacing is given; paper: the paper's plain method")
+        "repaired, volume N*s^3 kept and faces smoothed when --spacing is given; paper: the paper's plain method")
         ->check(CLI::IsMember({"faithful", "paper"}))->group(kGroupNumerical);
+    cmd->add_flag("--no-smooth", o.noSmooth,
+        "faithful: skip the edge-preserving smoothing that follows the volume correction "
+        "(on when --spacing is given)")->group(kGroupNumerical);
 
     o.adaptivityOpt = cmd->add_option("--adaptivity", o.adaptivity,
         "Polygon merging in flat regions, in [0,1] (default: 0)")->group(kGroupAdvanced);
