@@ -9,7 +9,8 @@
 /// nonbloppy::writeMesh(result.mesh, "fluid.obj");
 /// @endcode
 /// The stages it chains are callable one by one: estimateSpacing/resolveParameters →
-/// buildParticleIndex → rasterizeDensity → extractSurface → relaxVertices → computeNormals.
+/// buildParticleIndex → rasterizeDensity → extractSurface → relaxVertices → (Faithful:
+/// repairFolds) → computeNormals → (spacing given: preserveVolume → smoothSurface → computeNormals).
 
 #ifndef NONBLOPPY_BUILD_SURFACE_H
 #define NONBLOPPY_BUILD_SURFACE_H
