@@ -7,7 +7,9 @@
 
 #include <tbb/parallel_for.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <cstdint>
 #include <sstream>
 #include <vector>
@@ -59,6 +61,72 @@ VertexTriangles vertexTriangles(const Triangles& triangles, size_t vertexCount, 
         const Vec3I t = triangles[n];
         for (int k = 0; k < 3; ++k) out.triangleOf[fill[t[k]]++] = uint32_t(n);
     }
+    return out;
+}
+
+/// For each triangle i, every triangle j sharing a vertex with it (i itself included), once,
+/// in ascending order, with the part of the normal filter's weight that stays the same from
+/// round to round: area_j · (number of vertices shared) · exp(−|c_i − c_j|²/2σ_c²).
+/// Triangle i's are triangle[start[i] .. start[i + 1]).
+struct TriangleNeighbours
+{
+    std::vector<uint64_t> start;
+    std::vector<uint32_t> triangle;
+    std::vector<float> weight;
+};
+
+TriangleNeighbours triangleNeighbours(const Triangles& triangles, const VertexTriangles& around,
+                                      const std::vector<Vec3s>& centroid, const std::vector<float>& area,
+                                      float spatialScale, CancelPoll& poll)
+{
+    const size_t triangleCount = triangles.size();
+    // The triangles around i's three vertices, sorted: a triangle sharing k vertices with i
+    // appears k times in a row. Calls @a visit(j, k) for each.
+    auto forEachNeighbour = [&](size_t i, std::vector<uint32_t>& scratch, auto&& visit) {
+        scratch.clear();
+        const Vec3I t = triangles[i];
+        for (int k = 0; k < 3; ++k) {
+            scratch.insert(scratch.end(), around.triangleOf.begin() + ptrdiff_t(around.start[t[k]]),
+                           around.triangleOf.begin() + ptrdiff_t(around.start[t[k] + 1]));
+        }
+        std::sort(scratch.begin(), scratch.end());
+        for (size_t a = 0; a < scratch.size();) {
+            size_t b = a + 1;
+            while (b < scratch.size() && scratch[b] == scratch[a]) ++b;
+            visit(scratch[a], float(b - a));
+            a = b;
+        }
+    };
+    TriangleNeighbours out;
+    out.start.assign(triangleCount + 1, 0);
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, triangleCount),
+        [&](const tbb::blocked_range<size_t>& range) {
+            std::vector<uint32_t> scratch;
+            for (size_t i = range.begin(); i < range.end(); ++i) {
+                if (poll.stoppedAt(i - range.begin())) return;
+                uint64_t count = 0;
+                forEachNeighbour(i, scratch, [&](uint32_t, float) { ++count; });
+                out.start[i + 1] = count;
+            }
+        });
+    poll.throwIfStopped();
+    for (size_t i = 0; i < triangleCount; ++i) out.start[i + 1] += out.start[i];
+    out.triangle.resize(out.start.back());
+    out.weight.resize(out.start.back());
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, triangleCount),
+        [&](const tbb::blocked_range<size_t>& range) {
+            std::vector<uint32_t> scratch;
+            for (size_t i = range.begin(); i < range.end(); ++i) {
+                if (poll.stoppedAt(i - range.begin())) return;
+                uint64_t e = out.start[i];
+                forEachNeighbour(i, scratch, [&](uint32_t j, float shared) {
+                    out.triangle[e] = j;
+                    out.weight[e] = area[j] * shared * std::exp(-spatialScale * (centroid[j] - centroid[i]).lengthSqr());
+                    ++e;
+                });
+            }
+        });
+    poll.throwIfStopped();
     return out;
 }
 
@@ -116,30 +184,35 @@ void smoothSurface(SurfaceMesh& mesh, const SmoothSettings& settings, openvdb::u
 
     // Normal rounds: every triangle reads the previous round's normals only (double
     // buffered), in a fixed neighbour order, so the result does not depend on the threads.
+    // The centroids do not move during these rounds: their part of the weight is computed once.
     const float spatialScale = float(0.5 / (settings.spatialWidth * settings.spatialWidth));
     const float normalScale = float(0.5 / (settings.normalWidth * settings.normalWidth));
-    for (int round = 0; round < settings.normalRounds; ++round) {
-        tbb::parallel_for(tbb::blocked_range<size_t>(0, triangleCount),
-            [&](const tbb::blocked_range<size_t>& range) {
-                for (size_t n = range.begin(); n < range.end(); ++n) {
-                    if (poll.stoppedAt(n - range.begin())) return;
-                    const Vec3I t = triangles[n];
-                    const Vec3s c = centroid[n], own = normal[n];
-                    Vec3d sum(0.0);
-                    for (int k = 0; k < 3; ++k) {
-                        for (uint64_t e = around.start[t[k]]; e < around.start[t[k] + 1]; ++e) {
-                            const uint32_t m = around.triangleOf[e];
-                            const float exponent = spatialScale * (centroid[m] - c).lengthSqr()
-                                                   + normalScale * (normal[m] - own).lengthSqr();
-                            sum += Vec3d(normal[m]) * double(area[m] * std::exp(-exponent));
+    {
+        const TriangleNeighbours neighbours =
+            triangleNeighbours(triangles, around, centroid, area, spatialScale, poll);
+        std::vector<float>().swap(area);
+        for (int round = 0; round < settings.normalRounds; ++round) {
+            tbb::parallel_for(tbb::blocked_range<size_t>(0, triangleCount),
+                [&](const tbb::blocked_range<size_t>& range) {
+                    for (size_t n = range.begin(); n < range.end(); ++n) {
+                        if (poll.stoppedAt(n - range.begin())) return;
+                        const Vec3s own = normal[n];
+                        float x = 0.0f, y = 0.0f, z = 0.0f;
+                        for (uint64_t e = neighbours.start[n]; e < neighbours.start[n + 1]; ++e) {
+                            const Vec3s other = normal[neighbours.triangle[e]];
+                            const float dx = other[0] - own[0], dy = other[1] - own[1], dz = other[2] - own[2];
+                            const float w = neighbours.weight[e] * std::exp(-normalScale * (dx * dx + dy * dy + dz * dz));
+                            x += w * other[0];
+                            y += w * other[1];
+                            z += w * other[2];
                         }
+                        const float length = std::sqrt(x * x + y * y + z * z);
+                        filtered[n] = length > 0.0f ? Vec3s(x / length, y / length, z / length) : own;
                     }
-                    const double length = sum.length();
-                    filtered[n] = length > 0.0 ? Vec3s(sum / length) : own;
-                }
-            });
-        poll.throwIfStopped();
-        normal.swap(filtered);
+                });
+            poll.throwIfStopped();
+            normal.swap(filtered);
+        }
     }
 
     // Vertex rounds: move each vertex along its triangles' filtered normals onto their planes.

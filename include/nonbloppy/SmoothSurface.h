@@ -35,13 +35,13 @@ constexpr double kDefaultSmoothWidthOverSpacing = 0.5;
 /// 0.3 weighs a 10° neighbour 0.95, a 45° one 0.02 and a 90° one (a box's edge) 10⁻⁵.
 constexpr double kDefaultNormalWidth = 0.3;
 /// Default rounds of normal filtering: each round reaches one ring of faces further.
-constexpr int kDefaultNormalRounds = 25;
+constexpr int kDefaultNormalRounds = 35;
 /// Default rounds of moving the vertices onto the filtered face planes.
-constexpr int kDefaultVertexRounds = 80;
+constexpr int kDefaultVertexRounds = 40;
 
 /// How smoothSurface() filters. The defaults were chosen on docs/fidelity_sweep.md's shapes
 /// (meshed at h = s/2): with them, after the volume correction, the mean distance to the true
-/// surface is 2.1–4.0x lower than blobs' on the box, slab, ball and jet.
+/// surface is 2.1–4.2x lower than blobs' on the box, slab, ball and jet.
 struct SmoothSettings
 {
     /// σ_c, world units, > 0: face normals are weighted by exp(−d²/2σ_c²) with d the distance
@@ -61,9 +61,13 @@ struct SmoothSettings
 /// the mean over its triangles of n_j (n_j · (c_j − v)), c_j from the previous round.
 /// Vertices move only along the filtered normals; the polygons are not changed. A mesh
 /// without polygons is left as it is. Normals are not updated (computeNormals() after).
-/// Cost: O(rounds · 18 P) exponentials, parallel over triangles and vertices; scratch about
-/// 60 bytes per triangle and 24 per vertex. Deterministic: each element reads only the previous
-/// round, so the result is the same bits for any thread count.
+/// Cost: once, the list of each triangle's neighbours (about 13, found by sorting the
+/// triangles around its vertices) with the spatial part of their weights; then per normal
+/// round one exponential per neighbour, per vertex round one pass over the triangles around
+/// each vertex. Parallel over triangles and vertices. Scratch about 170 bytes per triangle.
+/// On the 2x2x2-tiled dam-break frame's mesh (283,000 vertices, two threads) the defaults
+/// take about 1.7 s (tests/bench/bench_stages.cc). Deterministic: each element reads only the
+/// previous round, in a fixed order, so the result is the same bits for any thread count.
 /// @param mesh         vertices moved; polygon indices must be valid (see measureMesh())
 /// @param settings     the filter's widths and rounds; spatialWidth has no default
 /// @param interrupter  optional; asked every 4096 elements of each parallel task (no
