@@ -23,71 +23,81 @@ using openvdb::Vec3d;
 using openvdb::Vec3I;
 using openvdb::Vec3s;
 
-/// The mesh's polygons as triangles: its triangles, then each quad as (0,1,2) and (0,2,3).
-struct Triangles
+/// One polygon's corners: three for a triangle, four for a quad.
+struct Corners
+{
+    uint32_t vertex[4];
+    int count;
+};
+
+/// The mesh's polygons, triangles first, then quads.
+struct Polygons
 {
     const SurfaceMesh& mesh;
-    size_t size() const { return mesh.triangles.size() + 2 * mesh.quads.size(); }
-    Vec3I operator[](size_t n) const
+    size_t size() const { return mesh.triangles.size() + mesh.quads.size(); }
+    Corners operator[](size_t n) const
     {
-        if (n < mesh.triangles.size()) return mesh.triangles[n];
-        const openvdb::Vec4I& q = mesh.quads[(n - mesh.triangles.size()) / 2];
-        return (n - mesh.triangles.size()) % 2 == 0 ? Vec3I(q[0], q[1], q[2]) : Vec3I(q[0], q[2], q[3]);
+        if (n < mesh.triangles.size()) {
+            const Vec3I& t = mesh.triangles[n];
+            return Corners{{t[0], t[1], t[2], 0}, 3};
+        }
+        const openvdb::Vec4I& q = mesh.quads[n - mesh.triangles.size()];
+        return Corners{{q[0], q[1], q[2], q[3]}, 4};
     }
 };
 
-/// Triangles around each vertex, in ascending order: vertex v's are
-/// triangleOf[start[v] .. start[v + 1]).
-struct VertexTriangles
+/// Polygons around each vertex, in ascending order: vertex v's are
+/// polygonOf[start[v] .. start[v + 1]).
+struct VertexPolygons
 {
     std::vector<uint64_t> start;
-    std::vector<uint32_t> triangleOf;
+    std::vector<uint32_t> polygonOf;
 };
 
-VertexTriangles vertexTriangles(const Triangles& triangles, size_t vertexCount, CancelPoll& poll)
+VertexPolygons vertexPolygons(const Polygons& polygons, size_t vertexCount, CancelPoll& poll)
 {
-    VertexTriangles out;
+    VertexPolygons out;
     out.start.assign(vertexCount + 1, 0);
-    for (size_t n = 0; n < triangles.size(); ++n) {
+    for (size_t n = 0; n < polygons.size(); ++n) {
         if (poll.stoppedAt(n)) poll.throwIfStopped();
-        const Vec3I t = triangles[n];
-        for (int k = 0; k < 3; ++k) ++out.start[t[k] + 1];
+        const Corners t = polygons[n];
+        for (int k = 0; k < t.count; ++k) ++out.start[t.vertex[k] + 1];
     }
     for (size_t v = 0; v < vertexCount; ++v) out.start[v + 1] += out.start[v];
-    out.triangleOf.resize(out.start.back());
+    out.polygonOf.resize(out.start.back());
     std::vector<uint64_t> fill(out.start.begin(), out.start.end() - 1);
-    for (size_t n = 0; n < triangles.size(); ++n) {
+    for (size_t n = 0; n < polygons.size(); ++n) {
         if (poll.stoppedAt(n)) poll.throwIfStopped();
-        const Vec3I t = triangles[n];
-        for (int k = 0; k < 3; ++k) out.triangleOf[fill[t[k]]++] = uint32_t(n);
+        const Corners t = polygons[n];
+        for (int k = 0; k < t.count; ++k) out.polygonOf[fill[t.vertex[k]]++] = uint32_t(n);
     }
     return out;
 }
 
-/// For each triangle i, every triangle j sharing a vertex with it (i itself included), once,
+/// For each polygon i, every polygon j sharing a vertex with it (i itself included), once,
 /// in ascending order, with the part of the normal filter's weight that stays the same from
 /// round to round: area_j · (number of vertices shared) · exp(−|c_i − c_j|²/2σ_c²).
-/// Triangle i's are triangle[start[i] .. start[i + 1]).
-struct TriangleNeighbours
+/// Polygon i's are polygon[start[i] .. start[i + 1]).
+struct PolygonNeighbours
 {
     std::vector<uint64_t> start;
-    std::vector<uint32_t> triangle;
+    std::vector<uint32_t> polygon;
     std::vector<float> weight;
 };
 
-TriangleNeighbours triangleNeighbours(const Triangles& triangles, const VertexTriangles& around,
+PolygonNeighbours polygonNeighbours(const Polygons& polygons, const VertexPolygons& around,
                                       const std::vector<Vec3s>& centroid, const std::vector<float>& area,
                                       float spatialScale, CancelPoll& poll)
 {
-    const size_t triangleCount = triangles.size();
-    // The triangles around i's three vertices, sorted: a triangle sharing k vertices with i
+    const size_t polygonCount = polygons.size();
+    // The polygons around i's corners, sorted: a polygon sharing k vertices with i
     // appears k times in a row. Calls @a visit(j, k) for each.
     auto forEachNeighbour = [&](size_t i, std::vector<uint32_t>& scratch, auto&& visit) {
         scratch.clear();
-        const Vec3I t = triangles[i];
-        for (int k = 0; k < 3; ++k) {
-            scratch.insert(scratch.end(), around.triangleOf.begin() + ptrdiff_t(around.start[t[k]]),
-                           around.triangleOf.begin() + ptrdiff_t(around.start[t[k] + 1]));
+        const Corners t = polygons[i];
+        for (int k = 0; k < t.count; ++k) {
+            scratch.insert(scratch.end(), around.polygonOf.begin() + ptrdiff_t(around.start[t.vertex[k]]),
+                           around.polygonOf.begin() + ptrdiff_t(around.start[t.vertex[k] + 1]));
         }
         std::sort(scratch.begin(), scratch.end());
         for (size_t a = 0; a < scratch.size();) {
@@ -97,9 +107,9 @@ TriangleNeighbours triangleNeighbours(const Triangles& triangles, const VertexTr
             a = b;
         }
     };
-    TriangleNeighbours out;
-    out.start.assign(triangleCount + 1, 0);
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, triangleCount),
+    PolygonNeighbours out;
+    out.start.assign(polygonCount + 1, 0);
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, polygonCount),
         [&](const tbb::blocked_range<size_t>& range) {
             std::vector<uint32_t> scratch;
             for (size_t i = range.begin(); i < range.end(); ++i) {
@@ -110,17 +120,17 @@ TriangleNeighbours triangleNeighbours(const Triangles& triangles, const VertexTr
             }
         });
     poll.throwIfStopped();
-    for (size_t i = 0; i < triangleCount; ++i) out.start[i + 1] += out.start[i];
-    out.triangle.resize(out.start.back());
+    for (size_t i = 0; i < polygonCount; ++i) out.start[i + 1] += out.start[i];
+    out.polygon.resize(out.start.back());
     out.weight.resize(out.start.back());
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, triangleCount),
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, polygonCount),
         [&](const tbb::blocked_range<size_t>& range) {
             std::vector<uint32_t> scratch;
             for (size_t i = range.begin(); i < range.end(); ++i) {
                 if (poll.stoppedAt(i - range.begin())) return;
                 uint64_t e = out.start[i];
                 forEachNeighbour(i, scratch, [&](uint32_t j, float shared) {
-                    out.triangle[e] = j;
+                    out.polygon[e] = j;
                     out.weight[e] = area[j] * shared * std::exp(-spatialScale * (centroid[j] - centroid[i]).lengthSqr());
                     ++e;
                 });
@@ -130,20 +140,22 @@ TriangleNeighbours triangleNeighbours(const Triangles& triangles, const VertexTr
     return out;
 }
 
-/// Centroid of every triangle, and (when asked) its area and unit normal.
-void measureTriangles(const Triangles& triangles, const std::vector<Vec3s>& points,
+/// Centroid of every polygon, and (when asked) its area and unit normal.
+void measurePolygons(const Polygons& polygons, const std::vector<Vec3s>& points,
                       std::vector<Vec3s>& centroid, std::vector<float>* area, std::vector<Vec3s>* normal,
                       CancelPoll& poll)
 {
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, triangles.size()),
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, polygons.size()),
         [&](const tbb::blocked_range<size_t>& range) {
             for (size_t n = range.begin(); n < range.end(); ++n) {
                 if (poll.stoppedAt(n - range.begin())) return;
-                const Vec3I t = triangles[n];
-                const Vec3s a = points[t[0]], b = points[t[1]], c = points[t[2]];
-                centroid[n] = (a + b + c) * (1.0f / 3.0f);
+                const Corners t = polygons[n];
+                const Vec3s a = points[t.vertex[0]], b = points[t.vertex[1]], c = points[t.vertex[2]];
+                const Vec3s d = t.count == 4 ? points[t.vertex[3]] : Vec3s(0.0f);
+                centroid[n] = t.count == 4 ? (a + b + c + d) * 0.25f : (a + b + c) * (1.0f / 3.0f);
                 if (!area) continue;
-                const Vec3s cross = (b - a).cross(c - a);
+                // Twice the vector area: of a quad, the cross product of its diagonals.
+                const Vec3s cross = t.count == 4 ? (c - a).cross(d - b) : (b - a).cross(c - a);
                 const float length = cross.length();
                 (*area)[n] = 0.5f * length;
                 (*normal)[n] = length > 0.0f ? cross / length : Vec3s(0.0f);
@@ -170,36 +182,36 @@ void smoothSurface(SurfaceMesh& mesh, const SmoothSettings& settings, openvdb::u
             << settings.vertexRounds << " vertex rounds";
         throw ParameterError(msg.str());
     }
-    const Triangles triangles{mesh};
-    if (settings.normalRounds == 0 || settings.vertexRounds == 0 || triangles.size() == 0) return;
-    if (triangles.size() > UINT32_MAX) throw ParameterError("cannot smooth more than 2^32 triangles");
+    const Polygons polygons{mesh};
+    if (settings.normalRounds == 0 || settings.vertexRounds == 0 || polygons.size() == 0) return;
+    if (polygons.size() > UINT32_MAX) throw ParameterError("cannot smooth more than 2^32 polygons");
 
     CancelPoll poll(interrupter, "smooth surface");
-    const size_t triangleCount = triangles.size();
-    const VertexTriangles around = vertexTriangles(triangles, mesh.points.size(), poll);
+    const size_t polygonCount = polygons.size();
+    const VertexPolygons around = vertexPolygons(polygons, mesh.points.size(), poll);
 
-    std::vector<Vec3s> centroid(triangleCount), normal(triangleCount), filtered(triangleCount);
-    std::vector<float> area(triangleCount);
-    measureTriangles(triangles, mesh.points, centroid, &area, &normal, poll);
+    std::vector<Vec3s> centroid(polygonCount), normal(polygonCount), filtered(polygonCount);
+    std::vector<float> area(polygonCount);
+    measurePolygons(polygons, mesh.points, centroid, &area, &normal, poll);
 
-    // Normal rounds: every triangle reads the previous round's normals only (double
+    // Normal rounds: every polygon reads the previous round's normals only (double
     // buffered), in a fixed neighbour order, so the result does not depend on the threads.
     // The centroids do not move during these rounds: their part of the weight is computed once.
     const float spatialScale = float(0.5 / (settings.spatialWidth * settings.spatialWidth));
     const float normalScale = float(0.5 / (settings.normalWidth * settings.normalWidth));
     {
-        const TriangleNeighbours neighbours =
-            triangleNeighbours(triangles, around, centroid, area, spatialScale, poll);
+        const PolygonNeighbours neighbours =
+            polygonNeighbours(polygons, around, centroid, area, spatialScale, poll);
         std::vector<float>().swap(area);
         for (int round = 0; round < settings.normalRounds; ++round) {
-            tbb::parallel_for(tbb::blocked_range<size_t>(0, triangleCount),
+            tbb::parallel_for(tbb::blocked_range<size_t>(0, polygonCount),
                 [&](const tbb::blocked_range<size_t>& range) {
                     for (size_t n = range.begin(); n < range.end(); ++n) {
                         if (poll.stoppedAt(n - range.begin())) return;
                         const Vec3s own = normal[n];
                         float x = 0.0f, y = 0.0f, z = 0.0f;
                         for (uint64_t e = neighbours.start[n]; e < neighbours.start[n + 1]; ++e) {
-                            const Vec3s other = normal[neighbours.triangle[e]];
+                            const Vec3s other = normal[neighbours.polygon[e]];
                             const float dx = other[0] - own[0], dy = other[1] - own[1], dz = other[2] - own[2];
                             const float w = neighbours.weight[e] * std::exp(-normalScale * (dx * dx + dy * dy + dz * dz));
                             x += w * other[0];
@@ -215,10 +227,10 @@ void smoothSurface(SurfaceMesh& mesh, const SmoothSettings& settings, openvdb::u
         }
     }
 
-    // Vertex rounds: move each vertex along its triangles' filtered normals onto their planes.
+    // Vertex rounds: move each vertex along its polygons' filtered normals onto their planes.
     std::vector<Vec3s> next(mesh.points.size());
     for (int round = 0; round < settings.vertexRounds; ++round) {
-        if (round > 0) measureTriangles(triangles, mesh.points, centroid, nullptr, nullptr, poll);
+        if (round > 0) measurePolygons(polygons, mesh.points, centroid, nullptr, nullptr, poll);
         tbb::parallel_for(tbb::blocked_range<size_t>(0, mesh.points.size()),
             [&](const tbb::blocked_range<size_t>& range) {
                 for (size_t v = range.begin(); v < range.end(); ++v) {
@@ -228,7 +240,7 @@ void smoothSurface(SurfaceMesh& mesh, const SmoothSettings& settings, openvdb::u
                     if (begin == end) { next[v] = p; continue; }
                     Vec3d move(0.0);
                     for (uint64_t e = begin; e < end; ++e) {
-                        const uint32_t m = around.triangleOf[e];
+                        const uint32_t m = around.polygonOf[e];
                         move += Vec3d(normal[m]) * double(normal[m].dot(centroid[m] - p));
                     }
                     next[v] = p + Vec3s(move / double(end - begin));

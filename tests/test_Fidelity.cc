@@ -69,25 +69,25 @@ void expectTargets(const Shape& shape, const Targets& targets, double blobRatio)
 // particle method rounds; the loosening is stated per shape from the values measured at these
 // sizes (docs/fidelity.md has the full sizes, which meet the absolute targets unloosened).
 // The "2× closer than blobs" is held unloosened; the measured margins are in the
-// comments (docs/fidelity.md has the full sizes: 2.1–4.2×).
+// comments (docs/fidelity.md has the full sizes: 2.3–5.2×).
 
 TEST(Fidelity, SmallBox)
 {
-    // 8³ instead of 16³, unloosened: measured mean 0.027, truth p95 0.094, 2.8× closer than
-    // blobs (2.2× at 16³; without smoothSurface() 1.73×).
+    // 8³ instead of 16³, unloosened: measured mean 0.025, truth p95 0.083, 3.0× closer than
+    // blobs (2.3× at 16³; without smoothSurface() 1.73×).
     expectTargets(makeBox(8), Targets(), 2.0);
 }
 
 TEST(Fidelity, SmallSlabTwoParticlesThick)
 {
-    // 12×12 instead of 24×24, unloosened: measured mean 0.024, truth p95 0.102, 3.3× closer
-    // than blobs (2.4× at 24²; without smoothSurface() 1.95×).
+    // 12×12 instead of 24×24, unloosened: measured mean 0.021, truth p95 0.089, 3.8× closer
+    // than blobs (2.5× at 24²; without smoothSurface() 1.95×).
     expectTargets(makeSlab(12), Targets(), 2.0);
 }
 
 TEST(Fidelity, SmallBall)
 {
-    // Unloosened; measured mean 0.038, 2.5× closer than blobs (2.2× at radius 8.5 s; without
+    // Unloosened; measured mean 0.031, 3.1× closer than blobs (2.3× at radius 8.5 s; without
     // smoothSurface() 1.12×: relaxation follows the staircase of the lattice ball, which
     // the normal filter smooths since its steps turn the normal by far less than 90°).
     expectTargets(makeBall(4.5), Targets(), 2.0);
@@ -95,13 +95,13 @@ TEST(Fidelity, SmallBall)
 
 TEST(Fidelity, SmallJetThreeParticlesAcross)
 {
-    // Unloosened; measured mean 0.034, truth p95 0.126, 3.5× closer than blobs.
+    // Unloosened; measured mean 0.029, truth p95 0.106, 4.1× closer than blobs.
     expectTargets(makeJet(14), Targets(), 2.0);
 }
 
 TEST(Fidelity, SmoothingIsWhatBringsTheBallTwiceAsClose)
 {
-    // The same ball without smoothSurface() (measured 0.085 against 0.038).
+    // The same ball without smoothSurface() (measured 0.085 against 0.031).
     const Shape ball = makeBall(4.5);
     SurfaceParameters params;
     params.smoothSurface = false;

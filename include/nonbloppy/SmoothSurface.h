@@ -30,7 +30,7 @@
 namespace nonbloppy {
 
 /// Default spatial width of the normal filter, in units of the particle spacing s.
-constexpr double kDefaultSmoothWidthOverSpacing = 0.5;
+constexpr double kDefaultSmoothWidthOverSpacing = 0.7;
 /// Default width of the normal filter's range weight, in units of |n_i − n_j| (dimensionless):
 /// 0.3 weighs a 10° neighbour 0.95, a 45° one 0.02 and a 90° one (a box's edge) 10⁻⁵.
 constexpr double kDefaultNormalWidth = 0.3;
@@ -41,7 +41,7 @@ constexpr int kDefaultVertexRounds = 40;
 
 /// How smoothSurface() filters. The defaults were chosen on docs/fidelity_sweep.md's shapes
 /// (meshed at h = s/2): with them, after the volume correction, the mean distance to the true
-/// surface is 2.1–4.2x lower than blobs' on the box, slab, ball and jet.
+/// surface is 2.3–5.2x lower than blobs' on the box, slab, ball and jet.
 struct SmoothSettings
 {
     /// σ_c, world units, > 0: face normals are weighted by exp(−d²/2σ_c²) with d the distance
@@ -53,21 +53,23 @@ struct SmoothSettings
     int vertexRounds = kDefaultVertexRounds;  ///< ≥ 0; 0 leaves the mesh as it is
 };
 
-/// Smooth @a mesh without rounding its edges. Quads count as two triangles split along the
-/// 0–2 diagonal. Each normal round replaces every triangle's unit normal n_i by the normalized
-/// sum, over the triangles j sharing a vertex with it (counted once per shared vertex, itself
-/// included), of area_j · exp(−|c_i − c_j|²/2σ_c² − |n_i − n_j|²/2σ_r²) · n_j, with the
-/// centroids c and areas of the unsmoothed mesh. Each vertex round then moves every vertex v by
-/// the mean over its triangles of n_j (n_j · (c_j − v)), c_j from the previous round.
-/// Vertices move only along the filtered normals; the polygons are not changed. A mesh
-/// without polygons is left as it is. Normals are not updated (computeNormals() after).
-/// Cost: once, the list of each triangle's neighbours (about 13, found by sorting the
-/// triangles around its vertices) with the spatial part of their weights; then per normal
-/// round one exponential per neighbour, per vertex round one pass over the triangles around
-/// each vertex. Parallel over triangles and vertices. Scratch about 170 bytes per triangle.
+/// Smooth @a mesh without rounding its edges. Its polygons, triangles and quads alike, are the
+/// faces: a face's normal and area are those of its vector area (for a quad, half the cross
+/// product of its diagonals), its centroid the mean of its corners. Each normal round
+/// replaces every face's unit normal n_i by the normalized sum, over the faces j sharing a
+/// vertex with it (weighted by the number of vertices shared, itself included), of
+/// area_j · exp(−|c_i − c_j|²/2σ_c² − |n_i − n_j|²/2σ_r²) · n_j, with the centroids c and areas
+/// of the unsmoothed mesh. Each vertex round then moves every vertex v by the mean over its
+/// faces of n_j (n_j · (c_j − v)), c_j from the previous round. Vertices move only along the
+/// filtered normals; the polygons are not changed. A mesh without polygons is left as it
+/// is. Normals are not updated (computeNormals() after).
+/// Cost: once, the list of each face's neighbours (9 for a quad of a regular grid, found by
+/// sorting the faces around its corners) with the spatial part of their weights; then per
+/// normal round one exponential per neighbour, per vertex round one pass over the faces
+/// around each vertex. Parallel over faces and vertices. Scratch about 140 bytes per quad.
 /// On the 2x2x2-tiled dam-break frame's mesh (283,000 vertices, two threads) the defaults
-/// take about 1.7 s (tests/bench/bench_stages.cc). Deterministic: each element reads only the
-/// previous round, in a fixed order, so the result is the same bits for any thread count.
+/// take about 0.77 s (tests/bench/bench_stages.cc). Deterministic: each element reads only
+/// the previous round, in a fixed order, so the result is the same bits for any thread count.
 /// @param mesh         vertices moved; polygon indices must be valid (see measureMesh())
 /// @param settings     the filter's widths and rounds; spatialWidth has no default
 /// @param interrupter  optional; asked every 4096 elements of each parallel task (no

@@ -357,14 +357,14 @@ int main(int argc, char** argv)
        << "would make them bulge, and the offset is uniform.\n"
        << "- **smoothing** (smoothSurface(), SmoothSurface.h, `SurfaceParameters::smoothSurface`, "
        << "`--no-smooth`): after the volume correction, a bilateral filter of the face normals "
-       << "(one ring of faces per round, 35 rounds, spatial width s/2, normal width 0.3) and 40 rounds "
+       << "(one ring of faces per round, 35 rounds, spatial width 0.7 s, normal width 0.3) and 40 rounds "
        << "moving the vertices along the filtered normals onto their faces' planes. Relaxation makes "
        << "the mesh follow the particles' jitter and, on the ball, the lattice's staircase; the filter "
        << "averages normals only across faces that point nearly the same way, so the jitter goes and "
-       << "the 90° edges stay (row *− smoothing*: the ball goes from 1.4× to 2.2× closer than blobs, "
-       << "the box from 1.5× to 2.2×). On by default with the volume correction, that is when the "
+       << "the 90° edges stay (row *− smoothing*: the ball goes from 1.4× to 2.3× closer than blobs, "
+       << "the box from 1.5× to 2.3×). On by default with the volume correction, that is when the "
        << "spacing is given; without it the smoothing alone leaves box and slab no closer. Cost: it "
-       << "is the most expensive stage when it runs (about 13 exponentials per triangle per round).\n"
+       << "costs about as much as the rest of the pipeline when it runs (about 9 exponentials per quad per round).\n"
        << "- **step cap** (RelaxSettings::maxStep, s/2) and **fold repair** (repairFolds()): guards for "
        << "sparse, splashing particles and large blends; no effect on these shapes (identical rows).\n";
     md << "\nMethods:\n\n";
