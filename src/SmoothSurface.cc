@@ -86,8 +86,8 @@ struct PolygonNeighbours
 };
 
 PolygonNeighbours polygonNeighbours(const Polygons& polygons, const VertexPolygons& around,
-                                      const std::vector<Vec3s>& centroid, const std::vector<float>& area,
-                                      float spatialScale, CancelPoll& poll)
+                                    const std::vector<Vec3s>& centroid, const std::vector<float>& area,
+                                    float spatialScale, CancelPoll& poll)
 {
     const size_t polygonCount = polygons.size();
     // The polygons around i's corners, sorted: a polygon sharing k vertices with i
@@ -142,8 +142,8 @@ PolygonNeighbours polygonNeighbours(const Polygons& polygons, const VertexPolygo
 
 /// Centroid of every polygon, and (when asked) its area and unit normal.
 void measurePolygons(const Polygons& polygons, const std::vector<Vec3s>& points,
-                      std::vector<Vec3s>& centroid, std::vector<float>* area, std::vector<Vec3s>* normal,
-                      CancelPoll& poll)
+                     std::vector<Vec3s>& centroid, std::vector<float>* area, std::vector<Vec3s>* normal,
+                     CancelPoll& poll)
 {
     tbb::parallel_for(tbb::blocked_range<size_t>(0, polygons.size()),
         [&](const tbb::blocked_range<size_t>& range) {
