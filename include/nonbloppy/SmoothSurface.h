@@ -5,9 +5,9 @@
 ///
 /// Relaxation pulls each vertex onto the weighted mean of the particles near it, so the mesh
 /// follows their jitter and, on curved fluid, the lattice's staircase: on the jittered box of
-/// docs/fidelity.md the faces lie 0.033 s from the true surface, where blobs (which average
-/// the jitter away but round the edges) lie 0.050 s. A bilateral filter of the face normals
-/// averages normals only with neighbours that point nearly the same way, so flat faces and
+/// docs/fidelity.md the relaxed mesh lies 0.033 s from the true surface on average, blobs
+/// (which average the jitter away but round the edges) 0.050 s. A bilateral filter of the
+/// face normals averages normals only with neighbours that point nearly the same way, so flat faces and
 /// gentle curves get smooth while the 90° normal jump of an edge or a corner is left alone;
 /// the vertices are then moved, along the filtered normals only, onto the planes of their
 /// faces (Zheng et al. 2011, "Bilateral normal filtering for mesh denoising", local scheme,
@@ -32,14 +32,14 @@ namespace nonbloppy {
 /// Default spatial width of the normal filter, in units of the particle spacing s.
 constexpr double kDefaultSmoothWidthOverSpacing = 0.7;
 /// Default width of the normal filter's range weight, in units of |n_i − n_j| (dimensionless):
-/// 0.3 weighs a 10° neighbour 0.95, a 45° one 0.02 and a 90° one (a box's edge) 10⁻⁵.
+/// 0.3 weighs a 10° neighbour 0.84, a 45° one 0.04 and a 90° one (a box's edge) 1.5·10⁻⁵.
 constexpr double kDefaultNormalWidth = 0.3;
 /// Default rounds of normal filtering: each round reaches one ring of faces further.
 constexpr int kDefaultNormalRounds = 35;
 /// Default rounds of moving the vertices onto the filtered face planes.
 constexpr int kDefaultVertexRounds = 40;
 
-/// How smoothSurface() filters. The defaults were chosen on docs/fidelity_sweep.md's shapes
+/// How smoothSurface() filters. The defaults were chosen on the shapes of docs/fidelity.md
 /// (meshed at h = s/2): with them, after the volume correction, the mean distance to the true
 /// surface is 2.3–5.2x lower than blobs' on the box, slab, ball and jet.
 struct SmoothSettings
