@@ -70,6 +70,37 @@ TEST(RasterizeDensity, MatchesBruteForceSumAndActivatesExactlyTheSupport)
     EXPECT_EQ(activeSeen, grid->activeVoxelCount());  // nothing active outside the box
 }
 
+TEST(RasterizeDensity, WideSupportsAndGappedColumnsMatchTheBruteForceSum)
+{
+    // r_e = 10.5 h: each support is 21 voxels tall, three 8-voxel vectors. Two clusters 1.2
+    // apart in z put leaves with a gap between them into one column of the task (8 leaves,
+    // 64 voxels, from the lowest), and the clusters' supports overlap neither the gap nor
+    // each other.
+    const double radius = 0.21, voxelSize = 0.02;
+    std::mt19937 random(3);
+    std::uniform_real_distribution<float> offset(-0.05f, 0.05f);
+    std::vector<openvdb::Vec3f> positions;
+    for (const float z : {0.0f, 1.2f}) {
+        for (int n = 0; n < 40; ++n) positions.emplace_back(offset(random), offset(random), z + offset(random));
+    }
+    const openvdb::FloatGrid::Ptr grid = rasterize(positions, radius, voxelSize);
+    auto accessor = grid->getConstAccessor();
+    size_t activeSeen = 0;
+    const openvdb::CoordBBox box(openvdb::Coord(-14, -14, -14), openvdb::Coord(14, 14, 75));
+    for (auto ijk = box.begin(); ijk; ++ijk) {
+        const double expected = bruteForceDensity(positions, grid->indexToWorld(*ijk), radius);
+        float value = 0.0f;
+        const bool active = accessor.probeValue(*ijk, value);
+        ASSERT_EQ(active, expected > 0.0) << *ijk;
+        if (active) {
+            ++activeSeen;
+            ASSERT_NEAR(value, expected, 1e-4 * (1.0 + expected)) << *ijk;
+        }
+    }
+    EXPECT_EQ(activeSeen, grid->activeVoxelCount());
+    EXPECT_FALSE(accessor.isValueOn(openvdb::Coord(0, 0, 30)));  // the gap stays empty
+}
+
 TEST(RasterizeDensity, VoxelOnTopOfAParticleStaysFinite)
 {
     const std::vector<openvdb::Vec3f> one{openvdb::Vec3f(0.2f, 0.0f, -0.4f)};

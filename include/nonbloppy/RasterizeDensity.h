@@ -28,16 +28,18 @@ struct DensitySettings
 ///
 /// The result is a FloatGrid named "density", class GRID_FOG_VOLUME (φ grows inwards, so
 /// it is not a level set), background 0; exactly the voxels within r_e of a particle are
-/// active. Each leaf is filled by one task from the particles whose support overlaps it,
-/// visited in a fixed order, so values are bit-identical for any thread count.
+/// active. Each column of up to 8 leaves stacked along z is filled by one task from the
+/// particles whose support overlaps it, visited in a fixed order, so values are
+/// bit-identical for any thread count (and for any grouping of leaves into columns).
 /// Cost: O(N·(r_e/h)³) kernel evaluations; memory: the grid (≈ 4.5 bytes per active voxel).
 /// @param particles    the particle index (its cell size does not affect the result)
 /// @param settings     r_e and h in world units, or a caller's transform
 /// @param interrupter  optional; start("rasterize density"), then wasInterrupted() every
 ///                     64 particle-index leaves while listing candidate leaves, every 1 ms
-///                     (from a helper thread) while sorting them, every 8 density leaves
-///                     of each task (~0.1–0.5 ms of work) with wasInterrupted(percent) at
-///                     each task's end, every 4096 leaves while assembling the tree; end().
+///                     (from a helper thread) while sorting them, before each column once
+///                     8 density leaves of the task are done (~0.1–1 ms of work) with
+///                     wasInterrupted(percent) at each task's end, every 4096 leaves
+///                     while assembling the tree; end().
 ///                     After a stop the partial grid is freed.
 /// Thread-safety: reentrant; the index is only read.
 /// @throw ParameterError if r_e ≤ 0 or h ≤ 0; CancelledError if @a interrupter says so.
