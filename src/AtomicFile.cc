@@ -6,15 +6,22 @@
 
 #include <nonbloppy/Error.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
+#include <streambuf>
 #include <vector>
 
+#include <fcntl.h>
 #include <sys/stat.h>
 #include <unistd.h>
+#if defined(__linux__)
+#include <linux/magic.h>
+#include <sys/vfs.h>
+#endif
 
 namespace nonbloppy {
 
@@ -50,7 +57,174 @@ newFileMode(const std::string& path)
     return 0666 & ~mask;
 }
 
+/// A std::streambuf writing a file with O_DIRECT: bytes collect in a 4 MiB buffer aligned to
+/// 4096 bytes, written whenever it fills (whole blocks at block-aligned offsets, as O_DIRECT
+/// requires on every Linux file system); finish() writes the whole blocks left and then the
+/// last partial block with O_DIRECT cleared.
+class DirectFileBuf : public std::streambuf
+{
+public:
+    DirectFileBuf() = default;
+    ~DirectFileBuf() override
+    {
+        if (mFd >= 0) ::close(mFd);
+        std::free(mBuffer);
+    }
+    DirectFileBuf(const DirectFileBuf&) = delete;
+    DirectFileBuf& operator=(const DirectFileBuf&) = delete;
+
+    /// Open @a path (it exists) for writing with O_DIRECT. False if that is refused.
+    bool open(const std::string& path)
+    {
+#if defined(O_DIRECT)
+        mBuffer = static_cast<char*>(std::aligned_alloc(kAlignment, kBufferBytes));
+        if (!mBuffer) return false;
+        mFd = ::open(path.c_str(), O_WRONLY | O_TRUNC | O_CLOEXEC | O_DIRECT);
+        if (mFd < 0) return false;
+        setp(mBuffer, mBuffer + kBufferBytes);
+        return true;
+#else
+        (void)path;
+        return false;
+#endif
+    }
+
+    /// Write what is left and close the file. False with errno set on failure.
+    bool finish()
+    {
+        const size_t size = size_t(pptr() - pbase());
+        const size_t whole = size & ~(kAlignment - 1);
+        bool ok = writeAll(mBuffer, whole) && (size == whole || (buffered() && writeAll(mBuffer + whole, size - whole)));
+        setp(mBuffer, mBuffer + kBufferBytes);
+        const int fd = mFd;
+        mFd = -1;
+        if (::close(fd) != 0) ok = false;
+        return ok;
+    }
+
+protected:
+    int_type overflow(int_type ch) override
+    {
+        if (!flushBuffer()) return traits_type::eof();
+        if (!traits_type::eq_int_type(ch, traits_type::eof())) {
+            *pptr() = traits_type::to_char_type(ch);
+            pbump(1);
+        }
+        return traits_type::not_eof(ch);
+    }
+
+    std::streamsize xsputn(const char* data, std::streamsize count) override
+    {
+        std::streamsize done = 0;
+        while (done < count) {
+            if (pptr() == epptr() && !flushBuffer()) return done;
+            const std::streamsize room = std::min<std::streamsize>(epptr() - pptr(), count - done);
+            std::memcpy(pptr(), data + done, size_t(room));
+            pbump(int(room));
+            done += room;
+        }
+        return done;
+    }
+
+private:
+    static constexpr size_t kAlignment = 4096;
+    static constexpr size_t kBufferBytes = size_t(4) << 20;
+
+    /// Write the full buffer; false on an error.
+    bool flushBuffer()
+    {
+        const bool ok = writeAll(mBuffer, size_t(pptr() - pbase()));
+        setp(mBuffer, mBuffer + kBufferBytes);
+        return ok;
+    }
+
+    /// Clear O_DIRECT: the following writes go through the page cache.
+    bool buffered()
+    {
+#if defined(O_DIRECT)
+        const int flags = ::fcntl(mFd, F_GETFL);
+        return flags >= 0 && ::fcntl(mFd, F_SETFL, flags & ~O_DIRECT) == 0;
+#else
+        return true;
+#endif
+    }
+
+    /// Write @a size bytes, retrying on EINTR. A direct write the file system rejects
+    /// (EINVAL: stricter alignment than 4096) or cuts short (which leaves the offset
+    /// unaligned) is finished through the page cache.
+    bool writeAll(const char* data, size_t size)
+    {
+        while (size > 0) {
+            const ssize_t written = ::write(mFd, data, size);
+            if (written < 0) {
+                if (errno == EINTR) continue;
+                if (errno == EINVAL && !mBuffered) {
+                    mBuffered = true;
+                    if (!buffered()) return false;
+                    continue;
+                }
+                return false;
+            }
+            if (written == 0) {
+                errno = EIO;
+                return false;
+            }
+            data += written;
+            size -= size_t(written);
+            if (size > 0 && !mBuffered) {
+                mBuffered = true;
+                if (!buffered()) return false;
+            }
+        }
+        return true;
+    }
+
+    int mFd = -1;
+    char* mBuffer = nullptr;
+    bool mBuffered = false;  ///< O_DIRECT was cleared after a rejected or short write
+};
+
+/// Run @a writeContents on a stream over @a buffer, then @a finish it; errors as
+/// writeFileAtomically() documents.
+template<typename FinishT>
+void writeThrough(std::streambuf& buffer, const std::string& path,
+                  const std::function<void(std::ostream&)>& writeContents, FinishT finish)
+{
+    errno = 0; // so a stream failure reports its own cause, not a stale one
+    std::ostream os(&buffer);
+    try {
+        writeContents(os);
+    } catch (const Error&) {
+        throw; // already one line naming what went wrong (e.g. cancelled)
+    } catch (const std::exception& e) {
+        throw FileError("cannot write " + path + ": " + e.what());
+    }
+    os.flush();
+    if (!os) throwWriteError(path, errno ? errno : EIO);
+    if (!finish()) throwWriteError(path, errno ? errno : EIO);
+}
+
 } // namespace
+
+bool
+directIoSuitable(const std::string& path)
+{
+#if defined(__linux__) && defined(O_DIRECT)
+    struct statfs info;
+    if (::statfs(path.c_str(), &info) != 0) return false;
+    switch (static_cast<unsigned long>(info.f_type)) {
+    case EXT4_SUPER_MAGIC:  // also ext2 and ext3
+    case XFS_SUPER_MAGIC:
+    case BTRFS_SUPER_MAGIC:
+        return true;
+    default:
+        return false;
+    }
+#else
+    (void)path;
+    return false;
+#endif
+}
 
 AtomicFile::AtomicFile(const std::string& path)
     : mPath(path)
@@ -84,28 +258,28 @@ AtomicFile::commit()
     mCommitted = true;
 }
 
-void
+bool
 writeFileAtomically(const std::string& path,
-                    const std::function<void(std::ostream&)>& writeContents)
+                    const std::function<void(std::ostream&)>& writeContents,
+                    size_t expectedBytes)
 {
     AtomicFile file(path);
-    {
-        errno = 0; // so a stream failure reports its own cause, not a stale one
-        std::ofstream os(file.tempPath(), std::ios::binary | std::ios::trunc);
-        if (!os) throwWriteError(path, errno ? errno : EIO);
-        try {
-            writeContents(os);
-        } catch (const Error&) {
-            throw; // already one line naming what went wrong (e.g. cancelled)
-        } catch (const std::exception& e) {
-            throw FileError("cannot write " + path + ": " + e.what());
+    if (expectedBytes >= kDirectIoMinBytes && directIoSuitable(file.tempPath())) {
+        DirectFileBuf direct;
+        if (direct.open(file.tempPath())) {
+            writeThrough(direct, path, writeContents, [&] { return direct.finish(); });
+            file.commit();
+            return true;
         }
-        os.flush();
-        if (!os) throwWriteError(path, errno ? errno : EIO);
-        os.close();
-        if (!os) throwWriteError(path, errno ? errno : EIO);
     }
+    std::filebuf buffer;
+    errno = 0;
+    if (!buffer.open(file.tempPath(), std::ios::out | std::ios::binary | std::ios::trunc)) {
+        throwWriteError(path, errno ? errno : EIO);
+    }
+    writeThrough(buffer, path, writeContents, [&] { return buffer.close() != nullptr; });
     file.commit();
+    return false;
 }
 
 } // namespace nonbloppy

@@ -20,6 +20,7 @@
 #ifndef NONBLOPPY_ATOMIC_FILE_H
 #define NONBLOPPY_ATOMIC_FILE_H
 
+#include <cstddef>
 #include <functional>
 #include <ostream>
 #include <string>
@@ -59,14 +60,33 @@ private:
     bool mCommitted = false;
 };
 
+/// Files expected to be at least this large may be written with direct I/O (see
+/// writeFileAtomically()).
+constexpr size_t kDirectIoMinBytes = size_t(1) << 20;
+
+/// True when @a path lies on a local disk file system where nonbloppy writes large files
+/// with direct I/O: ext2/3/4, XFS or Btrfs on Linux. Network and FUSE file systems may
+/// accept O_DIRECT but turn every write into a synchronous round trip, and tmpfs refuses it.
+bool directIoSuitable(const std::string& path);
+
 /// Write @a path atomically: @a writeContents fills a binary std::ostream on a temporary
 /// file, which is then renamed over @a path.
+///
+/// When @a expectedBytes (the caller's estimate of the size; 0 = unknown) is at least
+/// kDirectIoMinBytes and directIoSuitable(), the file is written with O_DIRECT, in 4 MiB
+/// blocks from an aligned buffer, past the page cache; the last partial block goes through
+/// the page cache. A mesh is written once and read by another program, so caching it only
+/// costs: on the benchmark machine a new 119 MB file took 0.6–0.8 s through the page cache
+/// and 0.11 s direct. If the file system rejects a direct write, the rest is written
+/// buffered. The bytes are the same either way.
+/// @return true if direct I/O was used.
 /// @throw FileError naming @a path if the file cannot be created, written or renamed, or if
 ///        @a writeContents throws a non-nonbloppy exception; nonbloppy::Error exceptions
 ///        (e.g. CancelledError) thrown by @a writeContents pass through unchanged.
 ///        In every failure case no temporary file is left behind and @a path is untouched.
-void writeFileAtomically(const std::string& path,
-                         const std::function<void(std::ostream&)>& writeContents);
+bool writeFileAtomically(const std::string& path,
+                         const std::function<void(std::ostream&)>& writeContents,
+                         size_t expectedBytes = 0);
 
 } // namespace nonbloppy
 

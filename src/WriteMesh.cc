@@ -390,11 +390,13 @@ writeMesh(const SurfaceMesh& mesh, const std::string& path, const MeshWriteSetti
     }
     validateMesh(mesh, path);
     const PolygonView polygons{mesh, settings.keepQuads};
+    // A lower bound of every format's size: binary positions and corner indices.
+    const size_t expectedBytes = mesh.points.size() * sizeof(openvdb::Vec3s) + polygons.cornerCount() * 4;
     writeFileAtomically(path, [&](std::ostream& os) {
         if (ext == ".obj") writeObj(mesh, polygons, os);
         else if (ext == ".ply") writePly(mesh, polygons, path, os);
         else writeVtk(mesh, polygons, path, os);
-    });
+    }, settings.directIo ? expectedBytes : 0);
 }
 
 bool

@@ -401,7 +401,7 @@ writeParticles(const ParticleSet& particles, const std::string& path)
         else if (ext == ".vtu") writeVtu(particles, os);
         else if (ext == ".xyz") writeXyz(particles, os);
         else writeCsv(particles, os);
-    });
+    }, /*expectedBytes=*/particles.positions.size() * sizeof(openvdb::Vec3f));
 }
 
 bool

@@ -364,6 +364,63 @@ TEST_F(WriteMeshTest, AtomicFileRemovesItsTemporaryUnlessCommitted)
     EXPECT_EQ(readBytes(target), "newest");
 }
 
+TEST_F(WriteMeshTest, LargeFilesGoPastThePageCacheWithTheSameBytes)
+{
+    // Sizes around the direct writer's edges: exactly the threshold, whole 4 KiB blocks past
+    // one 4 MiB buffer, and partial last blocks after one and two full buffers.
+    const bool suitable = nonbloppy::directIoSuitable(dir());
+    std::mt19937 random(7);
+    size_t index = 0;
+    for (const size_t size : {nonbloppy::kDirectIoMinBytes, (size_t(4) << 20) + 4096,
+                              (size_t(2) << 20) + 1, (size_t(9) << 20) + 123}) {
+        std::string bytes(size, '\0');
+        for (char& b : bytes) b = char(random());
+        const std::string target = path("large" + std::to_string(index++) + ".bin");
+        // Written in uneven pieces: a 1000-byte write, a single character, then the rest.
+        const bool direct = nonbloppy::writeFileAtomically(target, [&](std::ostream& os) {
+            os.write(bytes.data(), 1000);
+            os.put(bytes[1000]);
+            os.write(bytes.data() + 1001, std::streamsize(size - 1001));
+        }, size);
+        EXPECT_EQ(direct, suitable) << size;
+        EXPECT_TRUE(readBytes(target) == bytes) << size;
+    }
+    // Small or unknown sizes always go through the page cache.
+    EXPECT_FALSE(nonbloppy::writeFileAtomically(path("small.bin"), [](std::ostream& os) { os << "x"; }, 100));
+    EXPECT_FALSE(nonbloppy::writeFileAtomically(path("unknown.bin"), [](std::ostream& os) { os << "y"; }));
+    EXPECT_EQ(readBytes(path("small.bin")), "x");
+    // Only the targets remain: no temporary files.
+    EXPECT_EQ(listDirectory(dir()).size(), 6u);
+}
+
+TEST_F(WriteMeshTest, DirectIoSettingDoesNotChangeTheFile)
+{
+    // A 300 x 300 grid of quads: 1.1 MB of positions and normals, over the threshold.
+    SurfaceMesh grid;
+    const uint32_t n = 300;
+    for (uint32_t i = 0; i < n; ++i) {
+        for (uint32_t j = 0; j < n; ++j) {
+            grid.points.emplace_back(0.01f * float(i), 0.01f * float(j), 0.001f * float((i * j) % 7));
+            grid.normals.emplace_back(0.0f, 0.0f, 1.0f);
+        }
+    }
+    for (uint32_t i = 0; i + 1 < n; ++i) {
+        for (uint32_t j = 0; j + 1 < n; ++j) {
+            grid.quads.emplace_back(i * n + j, (i + 1) * n + j, (i + 1) * n + j + 1, i * n + j + 1);
+        }
+    }
+    for (const char* ext : {".ply", ".vtk", ".obj"}) {
+        MeshWriteSettings settings;
+        settings.directIo = true;
+        writeMesh(grid, path(std::string("direct") + ext), settings);
+        settings.directIo = false;
+        writeMesh(grid, path(std::string("cached") + ext), settings);
+        const std::string direct = readBytes(path(std::string("direct") + ext));
+        EXPECT_GT(direct.size(), nonbloppy::kDirectIoMinBytes) << ext;
+        EXPECT_TRUE(direct == readBytes(path(std::string("cached") + ext))) << ext;
+    }
+}
+
 // ------------------------------------------------------------------------------------------
 // readMesh on files from other writers
 

@@ -186,6 +186,18 @@ TEST_F(CliTest, OutputDoesNotDependOnThreadCount)
     EXPECT_TRUE(readText(out("t1.vdb")) == readText(out("t2.vdb"))) << ".vdb files differ";
 }
 
+TEST_F(CliTest, NoDirectIoWritesTheSameMesh)
+{
+    // The dam-break frame's PLY (2.7 MB) is over the 1 MiB from which meshes bypass the page
+    // cache; --no-direct-io writes it through the cache, with the same bytes.
+    const std::string frame = quote(kData + "/dam_break_frame_23_24389_particles.vtk");
+    ASSERT_EQ(run("mesh " + frame + " -o " + quote(out("direct.ply")) + " -q").exitCode, 0);
+    ASSERT_EQ(run("mesh " + frame + " -o " + quote(out("cached.ply")) + " -q --no-direct-io").exitCode, 0);
+    const std::string direct = readText(out("direct.ply"));
+    EXPECT_GT(direct.size(), size_t(1) << 20);
+    EXPECT_TRUE(direct == readText(out("cached.ply"))) << "PLY files differ";
+}
+
 TEST_F(CliTest, MissingInputFile)
 {
     const std::string missing = in("missing.vtk");

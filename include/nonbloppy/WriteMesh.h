@@ -18,6 +18,12 @@ struct MeshWriteSettings
     /// Keep quads as quads (OBJ, PLY and VTK all allow them); false splits every quad
     /// (q0,q1,q2,q3) into triangles (q0,q1,q2) and (q0,q2,q3).
     bool keepQuads = false;
+    /// Write files of 1 MiB or more with direct I/O (O_DIRECT, past the page cache) on
+    /// local ext4, XFS or Btrfs disks; other file systems, and false, use the page cache.
+    /// The bytes are the same. A mesh is written once and read by another program, so
+    /// caching it only costs: on the benchmark machine a new 119 MB mesh took 0.6–0.8 s
+    /// through the page cache and 0.11 s direct.
+    bool directIo = true;
 };
 
 /// Write @a mesh to @a path; the format follows the extension: `.obj` (v, vn, f; 1-based),

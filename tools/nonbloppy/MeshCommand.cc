@@ -187,6 +187,7 @@ struct MeshOptions
     bool noSmooth = false;  ///< --no-smooth: skip smoothSurface() after the volume correction
     int threads = 0;
     bool quads = false, quiet = false, verbose = false;
+    bool noDirectIo = false;  ///< --no-direct-io: write the mesh through the page cache
     MeshOutputOptions outputs;  ///< --attributes, --vdb-surface, --vdb-points (MeshOutputs.h)
     // Frame sequences (FrameSequence.h, BatchRun.h).
     std::string frames, logPath;
@@ -472,6 +473,7 @@ FrameOutcome meshFrame(const MeshOptions& o, ProgressInterrupter& interrupter)
         StageScope stage(interrupter, after, "write mesh");
         nonbloppy::MeshWriteSettings settings;
         settings.keepQuads = o.quads;
+        settings.directIo = !o.noDirectIo;
         nonbloppy::writeMesh(result.mesh, o.output, settings);
         cleanup.add(o.output);
     }
@@ -682,6 +684,10 @@ Command setupMeshCommand(CLI::App& parent)
         "Mesh to write (.obj, .ply or .vtk); for a sequence, with a placeholder: mesh_{}.obj")
         ->required()->group(kGroupInputOutput);
     cmd->add_flag("--quads", o.quads, "Keep quads instead of splitting them into triangles")
+        ->group(kGroupInputOutput);
+    cmd->add_flag("--no-direct-io", o.noDirectIo,
+        "Write the mesh through the page cache (by default meshes of 1 MiB or more bypass it on "
+        "local ext4, XFS and Btrfs disks; the bytes are the same)")
         ->group(kGroupInputOutput);
 
     o.spacingOpt = cmd->add_option("--spacing", o.spacing,
