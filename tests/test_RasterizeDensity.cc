@@ -40,6 +40,26 @@ openvdb::FloatGrid::Ptr rasterize(const std::vector<openvdb::Vec3f>& positions, 
     return rasterizeDensity(index, settings);
 }
 
+/// Every voxel of @a box (which holds all particles' supports) is active exactly where some
+/// particle is closer than r_e, with the brute-force value; nothing is active outside it.
+void expectBruteForceValues(const openvdb::FloatGrid& grid, const std::vector<openvdb::Vec3f>& positions,
+                            double radius, const openvdb::CoordBBox& box)
+{
+    auto accessor = grid.getConstAccessor();
+    size_t activeSeen = 0;
+    for (auto ijk = box.begin(); ijk; ++ijk) {
+        const double expected = bruteForceDensity(positions, grid.indexToWorld(*ijk), radius);
+        float value = 0.0f;
+        const bool active = accessor.probeValue(*ijk, value);
+        ASSERT_EQ(active, expected > 0.0) << *ijk;
+        if (active) {
+            ++activeSeen;
+            ASSERT_NEAR(value, expected, 1e-4 * (1.0 + expected)) << *ijk;
+        }
+    }
+    EXPECT_EQ(activeSeen, grid.activeVoxelCount());
+}
+
 } // namespace
 
 TEST(RasterizeDensity, MatchesBruteForceSumAndActivatesExactlyTheSupport)
@@ -51,23 +71,7 @@ TEST(RasterizeDensity, MatchesBruteForceSumAndActivatesExactlyTheSupport)
     EXPECT_EQ(grid->getGridClass(), openvdb::GRID_FOG_VOLUME);
     EXPECT_EQ(grid->background(), 0.0f);
 
-    // Every voxel of a box around the particles: active exactly where some particle is
-    // closer than r_e, with the brute-force value.
-    auto accessor = grid->getConstAccessor();
-    size_t activeSeen = 0;
-    const openvdb::CoordBBox box(openvdb::Coord(-15), openvdb::Coord(20));
-    for (auto ijk = box.begin(); ijk; ++ijk) {
-        const openvdb::Vec3d x = grid->indexToWorld(*ijk);
-        const double expected = bruteForceDensity(positions, x, radius);
-        float value = 0.0f;
-        const bool active = accessor.probeValue(*ijk, value);
-        ASSERT_EQ(active, expected > 0.0) << *ijk;
-        if (active) {
-            ++activeSeen;
-            ASSERT_NEAR(value, expected, 1e-4 * (1.0 + expected)) << *ijk;
-        }
-    }
-    EXPECT_EQ(activeSeen, grid->activeVoxelCount());  // nothing active outside the box
+    expectBruteForceValues(*grid, positions, radius, openvdb::CoordBBox(openvdb::Coord(-15), openvdb::Coord(20)));
 }
 
 TEST(RasterizeDensity, WideSupportsAndGappedColumnsMatchTheBruteForceSum)
@@ -84,21 +88,9 @@ TEST(RasterizeDensity, WideSupportsAndGappedColumnsMatchTheBruteForceSum)
         for (int n = 0; n < 40; ++n) positions.emplace_back(offset(random), offset(random), z + offset(random));
     }
     const openvdb::FloatGrid::Ptr grid = rasterize(positions, radius, voxelSize);
-    auto accessor = grid->getConstAccessor();
-    size_t activeSeen = 0;
-    const openvdb::CoordBBox box(openvdb::Coord(-14, -14, -14), openvdb::Coord(14, 14, 75));
-    for (auto ijk = box.begin(); ijk; ++ijk) {
-        const double expected = bruteForceDensity(positions, grid->indexToWorld(*ijk), radius);
-        float value = 0.0f;
-        const bool active = accessor.probeValue(*ijk, value);
-        ASSERT_EQ(active, expected > 0.0) << *ijk;
-        if (active) {
-            ++activeSeen;
-            ASSERT_NEAR(value, expected, 1e-4 * (1.0 + expected)) << *ijk;
-        }
-    }
-    EXPECT_EQ(activeSeen, grid->activeVoxelCount());
-    EXPECT_FALSE(accessor.isValueOn(openvdb::Coord(0, 0, 30)));  // the gap stays empty
+    expectBruteForceValues(*grid, positions, radius,
+                           openvdb::CoordBBox(openvdb::Coord(-14, -14, -14), openvdb::Coord(14, 14, 75)));
+    EXPECT_FALSE(grid->tree().isValueOn(openvdb::Coord(0, 0, 30)));  // the gap stays empty
 }
 
 TEST(RasterizeDensity, VoxelOnTopOfAParticleStaysFinite)
