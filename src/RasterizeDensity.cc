@@ -111,7 +111,7 @@ constexpr int kColumnRowStride = kColumnVoxels + 8;
 struct ZSpan
 {
     static constexpr int kMaxVectors = kColumnVoxels / 8;
-    int count = 0;                                ///< vectors used (1 when r_e < 4 h)
+    int count = 0;                                ///< vectors used: 1 for a span of 8 voxels or fewer
     int start[kMaxVectors] = {};                  ///< first column voxel of each vector
     alignas(32) float dz2[kMaxVectors][8];        ///< (z_voxel − p_z)² per lane
     alignas(32) uint32_t keep[kMaxVectors][8];    ///< ~0u inside the support's z-range, else 0
@@ -263,6 +263,7 @@ struct RasterizeColumnOp
             leavesSincePoll += column.end - column.first;
             const openvdb::Coord origin = origins[column.first];
             const int height = origins[column.end - 1][2] + kDim - origin[2];  // voxels in z
+            const int extent[3] = {kDim, kDim, height};
             std::fill(values, values + kDim * kDim * kColumnRowStride, 0.0f);
             const openvdb::Vec3d columnMin = origin.asVec3d() * voxelSize;
             const openvdb::Vec3d columnMax =
@@ -275,55 +276,54 @@ struct RasterizeColumnOp
                 columnMin - openvdb::Vec3d(effectiveRadius), columnMax + openvdb::Vec3d(effectiveRadius),
                 [&](uint32_t first, uint32_t end) { runs.emplace_back(first, end); });
             for (const auto& [first, end] : runs) {
-                    for (uint32_t k = first; k < end; ++k) {
-                        const openvdb::Vec3f& p = positions[k];
-                        // Voxel range of the particle's support, relative to the column origin.
-                        int lo[3], hi[3];
-                        const int extent[3] = {kDim, kDim, height};
-                        bool empty = false;
-                        for (int a = 0; a < 3; ++a) {
-                            lo[a] = ceilToInt((p[a] - radius) * invH) - origin[a];
-                            hi[a] = floorToInt((p[a] + radius) * invH) - origin[a];
-                            empty |= std::max(0, lo[a]) > std::min(extent[a] - 1, hi[a]);
+                for (uint32_t k = first; k < end; ++k) {
+                    const openvdb::Vec3f& p = positions[k];
+                    // Voxel range of the particle's support, relative to the column origin.
+                    int lo[3], hi[3];
+                    bool empty = false;
+                    for (int a = 0; a < 3; ++a) {
+                        lo[a] = ceilToInt((p[a] - radius) * invH) - origin[a];
+                        hi[a] = floorToInt((p[a] + radius) * invH) - origin[a];
+                        empty |= std::max(0, lo[a]) > std::min(extent[a] - 1, hi[a]);
+                    }
+                    if (empty) continue;
+                    // The z-vectors: lanes from the first voxel in the column, masked to
+                    // the support's range [lo, hi] (the same voxels in either copy).
+                    const int zFirst = std::max(0, lo[2]), zLast = std::min(height - 1, hi[2]);
+                    span.count = 0;
+                    for (int start = zFirst; start <= zLast; start += 8) {
+                        const int v = span.count++;
+                        span.start[v] = start;
+                        for (int l = 0; l < 8; ++l) {
+                            const int z = start + l;
+                            // Distance from the voxel's own leaf origin, as leaf by leaf.
+                            const float pz = p[2] - float(origin[2] + (z & ~(kDim - 1))) * h;
+                            const float dz = float(z & (kDim - 1)) * h - pz;
+                            span.dz2[v][l] = dz * dz;
+                            span.keep[v][l] = (z >= lo[2] && z <= hi[2]) ? ~0u : 0u;
                         }
-                        if (empty) continue;
-                        // The z-vectors: lanes from the first voxel in the column, masked to
-                        // the support's range [lo, hi] (the same voxels in either copy).
-                        const int zFirst = std::max(0, lo[2]), zLast = std::min(height - 1, hi[2]);
-                        span.count = 0;
-                        for (int start = zFirst; start <= zLast; start += 8) {
-                            const int v = span.count++;
-                            span.start[v] = start;
-                            for (int l = 0; l < 8; ++l) {
-                                const int z = start + l;
-                                // Distance from the voxel's own leaf origin, as leaf by leaf.
-                                const float pz = p[2] - float(origin[2] + (z & ~(kDim - 1))) * h;
-                                const float dz = float(z & (kDim - 1)) * h - pz;
-                                span.dz2[v][l] = dz * dz;
-                                span.keep[v][l] = (z >= lo[2] && z <= hi[2]) ? ~0u : 0u;
-                            }
-                        }
-                        for (int i = std::max(0, lo[0]); i <= std::min(kDim - 1, hi[0]); ++i) {
-                            const float dx = float(origin[0] + i) * h - p[0];
-                            for (int j = std::max(0, lo[1]); j <= std::min(kDim - 1, hi[1]); ++j) {
-                                const float dy = float(origin[1] + j) * h - p[1];
-                                const float dxy2 = dx * dx + dy * dy;
-                                if (!(dxy2 < radius2)) continue;
-                                float* row = values + (i * kDim + j) * kColumnRowStride;
-                                for (int v = 0; v < span.count; ++v) {
+                    }
+                    for (int i = std::max(0, lo[0]); i <= std::min(kDim - 1, hi[0]); ++i) {
+                        const float dx = float(origin[0] + i) * h - p[0];
+                        for (int j = std::max(0, lo[1]); j <= std::min(kDim - 1, hi[1]); ++j) {
+                            const float dy = float(origin[1] + j) * h - p[1];
+                            const float dxy2 = dx * dx + dy * dy;
+                            if (!(dxy2 < radius2)) continue;
+                            float* row = values + (i * kDim + j) * kColumnRowStride;
+                            for (int v = 0; v < span.count; ++v) {
 #if NONBLOPPY_HAS_AVX2_COPY
-                                    if constexpr (Avx2) {
-                                        addRowVectorAvx2(row + span.start[v], span.dz2[v], span.keep[v], dxy2,
-                                                         radius, minDistance2);
-                                        continue;
-                                    }
-#endif
-                                    addRowVector(row + span.start[v], span.dz2[v], span.keep[v], dxy2, radius,
-                                                 minDistance2);
+                                if constexpr (Avx2) {
+                                    addRowVectorAvx2(row + span.start[v], span.dz2[v], span.keep[v], dxy2,
+                                                     radius, minDistance2);
+                                    continue;
                                 }
+#endif
+                                addRowVector(row + span.start[v], span.dz2[v], span.keep[v], dxy2, radius,
+                                             minDistance2);
                             }
                         }
                     }
+                }
             }
             for (size_t n = column.first; n < column.end; ++n) {
                 results[n] = makeLeaf(origins[n], values + (origins[n][2] - origin[2]));
