@@ -94,7 +94,7 @@ public:
     {
         const size_t size = size_t(pptr() - pbase());
         const size_t whole = size & ~(kAlignment - 1);
-        bool ok = writeAll(mBuffer, whole) && (size == whole || (buffered() && writeAll(mBuffer + whole, size - whole)));
+        bool ok = writeAll(mBuffer, whole) && (size == whole || (stopDirect() && writeAll(mBuffer + whole, size - whole)));
         setp(mBuffer, mBuffer + kBufferBytes);
         const int fd = mFd;
         mFd = -1;
@@ -138,9 +138,11 @@ private:
         return ok;
     }
 
-    /// Clear O_DIRECT: the following writes go through the page cache.
-    bool buffered()
+    /// Clear O_DIRECT (once): the following writes go through the page cache.
+    bool stopDirect()
     {
+        if (mBuffered) return true;
+        mBuffered = true;
 #if defined(O_DIRECT)
         const int flags = ::fcntl(mFd, F_GETFL);
         return flags >= 0 && ::fcntl(mFd, F_SETFL, flags & ~O_DIRECT) == 0;
@@ -159,8 +161,7 @@ private:
             if (written < 0) {
                 if (errno == EINTR) continue;
                 if (errno == EINVAL && !mBuffered) {
-                    mBuffered = true;
-                    if (!buffered()) return false;
+                    if (!stopDirect()) return false;
                     continue;
                 }
                 return false;
@@ -171,17 +172,14 @@ private:
             }
             data += written;
             size -= size_t(written);
-            if (size > 0 && !mBuffered) {
-                mBuffered = true;
-                if (!buffered()) return false;
-            }
+            if (size > 0 && !stopDirect()) return false;
         }
         return true;
     }
 
     int mFd = -1;
     char* mBuffer = nullptr;
-    bool mBuffered = false;  ///< O_DIRECT was cleared after a rejected or short write
+    bool mBuffered = false;  ///< O_DIRECT cleared: after a rejected or short write, or for the tail
 };
 
 /// Run @a writeContents on a stream over @a buffer, then @a finish it; errors as
