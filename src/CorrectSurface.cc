@@ -10,6 +10,7 @@
 #include <nonbloppy/ComputeNormals.h>
 
 #include "Cancellation.h"
+#include "VectorArea.h"
 
 #include <tbb/parallel_for.h>
 
@@ -104,8 +105,7 @@ double planeDensity(double ratio, double z)
 /// Twice the area-weighted normal of triangle abc.
 inline openvdb::Vec3d triangleNormal(const openvdb::Vec3s& a, const openvdb::Vec3s& b, const openvdb::Vec3s& c)
 {
-    const openvdb::Vec3d pa(a), pb(b), pc(c);
-    return (pb - pa).cross(pc - pa);
+    return twiceVectorArea(openvdb::Vec3d(a), openvdb::Vec3d(b), openvdb::Vec3d(c));
 }
 
 /// Call @a op(i, j, k) for every triangle of the mesh (quads split along 0–2); asks @a poll

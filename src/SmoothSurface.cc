@@ -4,6 +4,7 @@
 #include <nonbloppy/Error.h>
 
 #include "Cancellation.h"
+#include "VectorArea.h"
 
 #include <tbb/parallel_for.h>
 
@@ -154,8 +155,7 @@ void measurePolygons(const Polygons& polygons, const std::vector<Vec3s>& points,
                 const Vec3s d = t.count == 4 ? points[t.vertex[3]] : Vec3s(0.0f);
                 centroid[n] = t.count == 4 ? (a + b + c + d) * 0.25f : (a + b + c) * (1.0f / 3.0f);
                 if (!area) continue;
-                // Twice the vector area: of a quad, the cross product of its diagonals.
-                const Vec3s cross = t.count == 4 ? (c - a).cross(d - b) : (b - a).cross(c - a);
+                const Vec3s cross = t.count == 4 ? twiceVectorArea(a, b, c, d) : twiceVectorArea(a, b, c);
                 const float length = cross.length();
                 (*area)[n] = 0.5f * length;
                 (*normal)[n] = length > 0.0f ? cross / length : Vec3s(0.0f);
