@@ -28,10 +28,11 @@ constexpr size_t kLanes = 8;
 /// Vertex groups of a task between two polls: each group gathers its candidate particles
 /// and sums over them for every vertex, so a task of many groups runs for milliseconds.
 constexpr size_t kGroupsPerPoll = 16;
-/// Edge of a vertex group in particle-index cells. Larger groups share one gather among more
-/// vertices but give each a longer candidate list. 64x benchmark input, relax stage (t = 2),
-/// 3 runs each alternating: 2 cells 1.30-1.49 s at one thread / 0.67-0.78 s at two, 3 cells
-/// 1.03-1.21 / 0.53-0.69 s, 4 cells 1.03-1.13 / 0.60-0.66 s.
+/// Edge of the cells vertices are grouped by, in particle-index cells. Larger groups share one
+/// gather among more vertices but give each a longer candidate list. 64x benchmark input,
+/// relax stage (t = 2), groups bounded by their vertices' box, one thread / two: 2 cells
+/// 0.80-0.87 / 0.54-0.61 s, 3 cells 0.61-0.65 / 0.41-0.43 s, 4 cells 0.64-0.83 / 0.34-0.39 s,
+/// 5 cells 0.68-0.71 / 0.39-0.44 s.
 constexpr double kGroupCells = 3.0;
 
 /// Candidate particles of one group of vertices, as separate x, y, z arrays padded to a
@@ -93,15 +94,15 @@ private:
 };
 
 /// One relaxation step: reads `previous`, writes `next`. Vertices are processed in groups
-/// sharing a particle-index cell; each group gathers the particles within r_e of its cell
-/// once, and every vertex of the group then sums over that contiguous list with per-lane
+/// that shared a cell when the relaxation began; each group gathers the particles within r_e
+/// of its vertices' current box once, and every vertex of the group then sums over that contiguous list with per-lane
 /// accumulators (vectorizable without reassociating any sum, so results stay exact and
 /// independent of threads: a vertex's sum order depends only on its group's list).
 struct RelaxStepOp
 {
     const ParticleIndex& particles;
-    const std::vector<uint32_t>& vertexOrder;   ///< vertices sorted by cell
-    const std::vector<size_t>& groupStart;      ///< groups of vertexOrder sharing a cell
+    const std::vector<uint32_t>& vertexOrder;   ///< vertices sorted by their first cell
+    const std::vector<size_t>& groupStart;      ///< groups of vertexOrder sharing that cell
     const std::vector<openvdb::Vec3s>& previous;
     std::vector<openvdb::Vec3s>& next;
     float effectiveRadius;
@@ -129,29 +130,33 @@ struct RelaxStepOp
         const auto& positions = particles.sortedPositions();
         auto accessor = particles.impl().grid->getConstAccessor();
         const double cellSize = particles.cellSize();
-        const double groupSize = kGroupCells * cellSize;
         const float radius = effectiveRadius;
         const float minDistance2 = (kMinDistanceFraction * radius) * (kMinDistanceFraction * radius);
         CandidateBuffer candidates;
         for (size_t g = range.begin(); g < range.end(); ++g) {
             if ((g - range.begin()) % kGroupsPerPoll == 0 && poll.stopped()) return;
             const size_t begin = groupStart[g], end = groupStart[g + 1];
-            // The group's cell, grown by r_e, holds every particle near any of its vertices.
-            const openvdb::Coord cell = particle_index_internal::cellOf(previous[vertexOrder[begin]], groupSize);
-            const openvdb::Vec3d cellMin = (cell.asVec3d() - 0.5) * groupSize;
-            const openvdb::Vec3d cellMax = (cell.asVec3d() + 0.5) * groupSize;
-            // Vertices sit in the cell up to float rounding: grow it by a hair so the filter
-            // never drops a particle that a vertex on the cell's face can reach.
+            // The box of the group's vertices, grown by r_e, holds every particle near any of
+            // them. Their own box rather than the cell they were grouped by: it is thinner (a
+            // surface crosses the cell as a sheet), and it stays right as they move.
+            openvdb::Vec3f vertexMin = previous[vertexOrder[begin]], vertexMax = vertexMin;
+            for (size_t n = begin + 1; n < end; ++n) {
+                const openvdb::Vec3f& v = previous[vertexOrder[n]];
+                vertexMin = openvdb::math::minComponent(vertexMin, v);
+                vertexMax = openvdb::math::maxComponent(vertexMax, v);
+            }
+            // Float rounding of the distances: grow the box by a hair so the filter never
+            // drops a particle that a vertex on the box's face can reach.
             const float slack = 1e-4f * float(cellSize);
-            const openvdb::Vec3f boxMin = openvdb::Vec3f(cellMin) - openvdb::Vec3f(slack);
-            const openvdb::Vec3f boxMax = openvdb::Vec3f(cellMax) + openvdb::Vec3f(slack);
+            const openvdb::Vec3f boxMin = vertexMin - openvdb::Vec3f(slack);
+            const openvdb::Vec3f boxMax = vertexMax + openvdb::Vec3f(slack);
             candidates.clear();
             particle_index_internal::forEachRunInBox(accessor, cellSize,
-                cellMin - openvdb::Vec3d(radius), cellMax + openvdb::Vec3d(radius),
+                openvdb::Vec3d(boxMin) - openvdb::Vec3d(radius), openvdb::Vec3d(boxMax) + openvdb::Vec3d(radius),
                 [&](uint32_t first, uint32_t last) {
                     candidates.gather(positions, first, last, boxMin, boxMax, radius * radius);
                 });
-            candidates.pad(float(cellMax[0] + 4.0 * radius));
+            candidates.pad(boxMax[0] + 4.0f * radius);
             const size_t count = candidates.count;
             const float* cx = candidates.x.data();
             const float* cy = candidates.y.data();
@@ -205,8 +210,8 @@ struct RelaxStepOp
     }
 };
 
-/// Buffers of groupVerticesByCell(), kept across iterations.
-struct GroupScratch
+/// Buffers of groupVerticesByCell().
+struct GroupBuffers
 {
     std::vector<uint64_t> packed, spare;               ///< cell rank and vertex, for the radix sort
     std::vector<std::pair<uint64_t, uint32_t>> keyed;  ///< cell key and vertex, for the comparison sort
@@ -301,17 +306,15 @@ void writeGroups(size_t count, const KeyAt& keyAt, const VertexAt& vertexAt, std
 /// return the start of each run of equal cells (plus the end). Cells are packed into 64-bit
 /// keys relative to the smallest cell, so the sort compares integers, not coordinates through
 /// an index; ties keep vertex order, so grouping is deterministic. Every pass is parallel:
-/// run once per iteration on millions of vertices, serial passes left the second thread
-/// idle. When the cells of the vertices' box number fewer than 2^32 (always, but for
+/// on millions of vertices, serial passes left the second thread idle. When the cells of the vertices' box number fewer than 2^32 (always, but for
 /// scattered vertices), the key is the cell's rank in that box and the vertex number packed
 /// into 64 bits, sorted by a stable radix sort on the rank's bits (two passes where a surface
-/// crosses a million cells; the comparison sort cost a tenth of the step). @a scratch is
-/// kept by the caller across iterations (its tens of megabytes would otherwise be faulted in
-/// anew each time). Asks @a poll as it goes and throws its CancelledError on a stop (the
+/// crosses a million cells; the comparison sort cost a tenth of the step). Asks @a poll as it goes and throws its CancelledError on a stop (the
 /// sort is stopped through runStoppable()).
-void groupVerticesByCell(const std::vector<openvdb::Vec3s>& points, double groupSize, GroupScratch& scratch,
+void groupVerticesByCell(const std::vector<openvdb::Vec3s>& points, double groupSize,
                          std::vector<uint32_t>& order, std::vector<size_t>& groupStart, CancelPoll& poll)
 {
+    GroupBuffers scratch;
     using particle_index_internal::cellOf;
     using Bounds = std::pair<openvdb::Coord, openvdb::Coord>;
     const Bounds bounds = tbb::parallel_reduce(tbb::blocked_range<size_t>(0, points.size()),
@@ -415,12 +418,14 @@ void instruction_set_internal::relaxVertices(SurfaceMesh& mesh, const ParticleIn
     CancelPoll poll(interrupter, "relax vertices");
     const bool avx2 = instruction_set_internal::useAvx2(set);
     try {
-        std::vector<openvdb::Vec3s> next(mesh.points.size());
-        GroupScratch scratch;
         std::vector<uint32_t> order;
         std::vector<size_t> groupStart;
+        // Grouped once: each step bounds a group by its vertices' current box, so its
+        // candidate lists stay exact however the vertices move, and as a step moves a vertex
+        // less than r_e (towards its particles) the groups stay compact.
+        groupVerticesByCell(mesh.points, kGroupCells * particles.cellSize(), order, groupStart, poll);
+        std::vector<openvdb::Vec3s> next(mesh.points.size());
         for (int iteration = 0; iteration < settings.iterations; ++iteration) {
-            groupVerticesByCell(mesh.points, kGroupCells * particles.cellSize(), scratch, order, groupStart, poll);
             tbb::parallel_for(tbb::blocked_range<size_t>(0, groupStart.size() - 1, 64),
                 RelaxStepOp{particles, order, groupStart, mesh.points, next, float(settings.effectiveRadius),
                             float(settings.blend), float(settings.maxStep), poll, avx2});

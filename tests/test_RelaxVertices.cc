@@ -3,6 +3,7 @@
 
 #include <nonbloppy/Error.h>
 #include <nonbloppy/ExtractSurface.h>
+#include <nonbloppy/Kernel.h>
 #include <nonbloppy/ParticleIndex.h>
 #include <nonbloppy/RasterizeDensity.h>
 #include <nonbloppy/RelaxVertices.h>
@@ -119,6 +120,55 @@ TEST(RelaxVertices, PiecesFarApartRelaxAsEachWouldAlone)
     }
     // And they did move: by 1 − 0.7² of their distance to the particle.
     EXPECT_NEAR((near.points[0] - kCentre).length(), 0.49 * 0.5, 0.01);
+}
+
+TEST(RelaxVertices, VerticesThatTravelFarMatchTheDirectSum)
+{
+    // Vertices are grouped by cell once, before the first iteration. With c = 1 each step
+    // moves a vertex all the way to its weighted mean: vertices starting up to 0.95 r_e from a
+    // block of particles cross several grouping cells (3 index cells of 0.2 = 0.6 wide) on the
+    // way in. Every step must still see every particle within r_e of every vertex: the result
+    // is the direct sum over all particles, in double precision, iteration by iteration.
+    std::vector<openvdb::Vec3f> particles;
+    uint32_t state = 12345u;
+    const auto jitter = [&] {
+        state = state * 1664525u + 1013904223u;
+        return float(state >> 8) / float(1u << 24) - 0.5f;  // [-0.5, 0.5)
+    };
+    for (int i = 0; i < 6; ++i)
+        for (int j = 0; j < 6; ++j)
+            for (int k = 0; k < 6; ++k)
+                particles.push_back(openvdb::Vec3f(0.3f * (float(i) + 0.3f * jitter()), 0.3f * (float(j) + 0.3f * jitter()),
+                                                   0.3f * (float(k) + 0.3f * jitter())));
+    const double radius = 1.0;
+    SurfaceMesh mesh;
+    for (int n = 0; n < 3000; ++n) {  // around the block, most within r_e of some particle
+        mesh.points.push_back(openvdb::Vec3s(0.75f + 3.8f * jitter(), 0.75f + 3.8f * jitter(), 0.75f + 3.8f * jitter()));
+    }
+    std::vector<openvdb::Vec3d> expected(mesh.points.begin(), mesh.points.end());
+    const int iterations = 3;
+    for (int t = 0; t < iterations; ++t) {
+        for (openvdb::Vec3d& v : expected) {
+            double weightSum = 0.0;
+            openvdb::Vec3d weighted(0.0);
+            for (const openvdb::Vec3f& p : particles) {
+                const double d = (openvdb::Vec3d(p) - v).length();
+                if (d >= radius) continue;
+                const double w = radius / std::max(d, double(kMinDistanceFraction) * radius) - 1.0;
+                weightSum += w;
+                weighted += w * openvdb::Vec3d(p);
+            }
+            if (weightSum > 0.0) v = weighted / weightSum;
+        }
+    }
+    const std::vector<openvdb::Vec3s> start = mesh.points;
+    relaxVertices(mesh, ParticleIndex::build(particles, 0.2), relaxSettings(1.0, iterations));
+    size_t farTravellers = 0;
+    for (size_t i = 0; i < mesh.points.size(); ++i) {
+        ASSERT_NEAR((openvdb::Vec3d(mesh.points[i]) - expected[i]).length(), 0.0, 1e-5) << "vertex " << i;
+        farTravellers += (mesh.points[i] - start[i]).length() > 0.6f;
+    }
+    EXPECT_GT(farTravellers, 500u);  // the case this test is about did occur
 }
 
 TEST(RelaxVertices, RejectsBadSettings)

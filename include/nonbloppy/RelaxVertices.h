@@ -36,11 +36,11 @@ struct RelaxSettings
 /// @param mesh         vertices moved in place (world units); polygons untouched
 /// @param particles    index of the particles to relax against (any frame's, any mesh's)
 /// @param settings     r_e (world units), c, t
-/// @param interrupter  optional; start("relax vertices"), then per iteration
-///                     wasInterrupted() every 4096 vertices while grouping them by cell,
-///                     every 1 ms (from a helper thread) during the parallel sort, every 16
-///                     vertex groups of each task, and wasInterrupted(percent) after the
-///                     iteration; end(), also when it throws. A stop leaves the mesh at the
+/// @param interrupter  optional; start("relax vertices"), then wasInterrupted() every 4096
+///                     vertices while grouping them by cell (once, before the first
+///                     iteration) and every 1 ms (from a helper thread) if that takes the
+///                     parallel sort, then per iteration every 16 vertex groups of each task
+///                     and wasInterrupted(percent) after it; end(), also when it throws. A stop leaves the mesh at the
 ///                     last completed iteration.
 /// Thread-safety: reentrant; the index is only read, the mesh is written.
 /// @throw ParameterError for r_e ≤ 0, c outside [0,1], t < 0 or maxStep < 0;
