@@ -7,6 +7,7 @@
 namespace nonbloppy {
 
 using surface_stages_internal::checkCancelled;
+using surface_stages_internal::givenRadius;
 using surface_stages_internal::kCellOverRadius;
 using surface_stages_internal::StageScope;
 
@@ -15,20 +16,23 @@ SurfaceResult buildSurface(std::vector<openvdb::Vec3f> positions, const SurfaceP
 {
     SurfaceResult result;
     result.particleCount = positions.size();
+    ParticleIndex index;
+    const auto indexParticles = [&](double effectiveRadius) {
+        StageScope scope(result.timings, interrupter, "index particles");
+        index = ParticleIndex::build(std::move(positions), kCellOverRadius * effectiveRadius, interrupter);
+        checkCancelled(interrupter, "index particles");
+    };
+    // With r_e given, the index the stages use can be built first and serve the spacing
+    // estimate too; otherwise r_e (hence the index's cells) waits for the estimate.
+    const bool indexFirst = givenRadius(params);
+    if (indexFirst) indexParticles(*params.effectiveRadius);
     {
         StageScope scope(result.timings, interrupter, "estimate parameters");
-        result.parameters = resolveParameters(params, positions, interrupter);
+        result.parameters = indexFirst ? resolveParametersIndexed(params, index, interrupter)
+                                       : resolveParameters(params, positions, interrupter);
         checkCancelled(interrupter, "estimate parameters");
     }
-    const ResolvedParameters& p = result.parameters;
-
-    ParticleIndex index;
-    {
-        StageScope scope(result.timings, interrupter, "index particles");
-        index = ParticleIndex::build(std::move(positions), kCellOverRadius * p.effectiveRadius,
-                                     interrupter);
-        checkCancelled(interrupter, "index particles");
-    }
+    if (!indexFirst) indexParticles(result.parameters.effectiveRadius);
     std::vector<openvdb::Vec3s> unrelaxed;  // freed after fold repair, before the normals
     surface_stages_internal::runSurfaceStages(index, params.keepDensity, result, unrelaxed,
                                               surface_stages_internal::UnrelaxedBuffer::Release,

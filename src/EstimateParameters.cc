@@ -140,8 +140,10 @@ constexpr double kMinInteriorFraction = 0.01;
 
 namespace {
 
-double estimateSpacing(const std::vector<openvdb::Vec3f>& positions, size_t maxSamples, CancelPoll& poll,
-                       openvdb::util::NullInterrupter* interrupter)
+/// First search radius of estimateSpacing(): the spacing of the particles spread evenly over
+/// their bounding box (or along its longest side when they are flat). Fluids rarely fill
+/// their box, so this tends to be too large, which only costs a wider first search.
+double spacingGuess(const std::vector<openvdb::Vec3f>& positions, CancelPoll& poll)
 {
     if (positions.size() < 2) {
         throw ParameterError("cannot estimate the particle spacing from " +
@@ -155,21 +157,19 @@ double estimateSpacing(const std::vector<openvdb::Vec3f>& positions, size_t maxS
     }
     const openvdb::Vec3d extent = bounds.extents();
     const double count = double(positions.size());
-    // First guess: the spacing of the particles spread evenly over their bounding box (or
-    // along its longest side when they are flat). Fluids rarely fill their box, so this
-    // tends to be too large, which only costs a wider first search.
     double guess = std::cbrt(extent[0] * extent[1] * extent[2] / count);
     guess = std::max(guess, std::max({extent[0], extent[1], extent[2]}) / count);
     if (!(guess > 0.0)) {
         throw ParameterError("cannot estimate the particle spacing: all particles are at the same position");
     }
+    return guess;
+}
 
-    ParticleIndex index;
-    try {
-        index = ParticleIndex::build(positions, guess, interrupter);
-    } catch (const CancelledError&) {
-        throw CancelledError(std::string("interrupted during ") + poll.stage());  // this stage's name
-    }
+/// estimateSpacing() over @a index (any cell size), searching from @a guess outwards. The
+/// samples are evenly spread over the index's sorted slots.
+double estimateSpacingOf(const ParticleIndex& index, double guess, size_t maxSamples, CancelPoll& poll)
+{
+    const std::vector<openvdb::Vec3f>& positions = index.sortedPositions();
     const size_t sampleCount = std::min(std::max<size_t>(maxSamples, 1), positions.size());
     std::vector<size_t> samples(sampleCount);
     for (size_t i = 0; i < sampleCount; ++i) samples[i] = i * positions.size() / sampleCount;
@@ -207,13 +207,33 @@ double estimateSpacing(const std::vector<openvdb::Vec3f>& positions, size_t maxS
     throw ParameterError("cannot estimate the particle spacing; give --spacing");
 }
 
+/// estimateSpacing() of @a positions, or of @a shared's particles when it is given (the
+/// particles themselves, indexed: no index of its own to build).
+double estimateSpacingWith(const std::vector<openvdb::Vec3f>& positions, const ParticleIndex* shared,
+                           size_t maxSamples, CancelPoll& poll, openvdb::util::NullInterrupter* interrupter)
+{
+    const double guess = spacingGuess(shared ? shared->sortedPositions() : positions, poll);
+    if (shared) return estimateSpacingOf(*shared, guess, maxSamples, poll);
+    ParticleIndex index;
+    try {
+        index = ParticleIndex::build(positions, guess, interrupter);
+    } catch (const CancelledError&) {
+        throw CancelledError(std::string("interrupted during ") + poll.stage());  // this stage's name
+    }
+    return estimateSpacingOf(index, guess, maxSamples, poll);
+}
+
+/// resolveParameters() of @a positions, or of @a shared's particles when it is given.
+ResolvedParameters resolveParametersWith(const SurfaceParameters& params, const std::vector<openvdb::Vec3f>& positions,
+                                         const ParticleIndex* shared, openvdb::util::NullInterrupter* interrupter);
+
 } // namespace
 
 double estimateSpacing(const std::vector<openvdb::Vec3f>& positions, size_t maxSamples,
                        openvdb::util::NullInterrupter* interrupter)
 {
     CancelPoll poll(interrupter, "estimate parameters");
-    return estimateSpacing(positions, maxSamples, poll, interrupter);
+    return estimateSpacingWith(positions, nullptr, maxSamples, poll, interrupter);
 }
 
 double calibrateThreshold(double effectiveRadiusOverSpacing)
@@ -248,6 +268,20 @@ ResolvedParameters resolveParameters(const SurfaceParameters& params,
                                      const std::vector<openvdb::Vec3f>& positions,
                                      openvdb::util::NullInterrupter* interrupter)
 {
+    return resolveParametersWith(params, positions, nullptr, interrupter);
+}
+
+ResolvedParameters resolveParametersIndexed(const SurfaceParameters& params, const ParticleIndex& index,
+                                     openvdb::util::NullInterrupter* interrupter)
+{
+    return resolveParametersWith(params, index.sortedPositions(), &index, interrupter);
+}
+
+namespace {
+
+ResolvedParameters resolveParametersWith(const SurfaceParameters& params, const std::vector<openvdb::Vec3f>& positions,
+                                         const ParticleIndex* shared, openvdb::util::NullInterrupter* interrupter)
+{
     CancelPoll poll(interrupter, "estimate parameters");
     auto requirePositive = [](const std::optional<double>& value, const char* name) {
         if (value && (!(*value > 0.0) || !std::isfinite(*value))) {
@@ -281,7 +315,7 @@ ResolvedParameters resolveParameters(const SurfaceParameters& params,
 
     const bool needSpacing = !params.effectiveRadius || !params.threshold || !params.voxelSize;
     if (params.spacing) out.spacing = *params.spacing;
-    else if (needSpacing) out.spacing = estimateSpacing(positions, kSpacingSamples, poll, interrupter);
+    else if (needSpacing) out.spacing = estimateSpacingWith(positions, shared, kSpacingSamples, poll, interrupter);
     poll.throwIfStopped();
 
     out.effectiveRadius = params.effectiveRadius ? *params.effectiveRadius
@@ -312,7 +346,7 @@ ResolvedParameters resolveParameters(const SurfaceParameters& params,
         // The volume target N·s³ and the smoothing's width need s even when r_e, r_0 and h
         // were all given.
         if ((out.preserveVolume || out.smoothSurface) && !(out.spacing > 0.0)) {
-            out.spacing = estimateSpacing(positions, kSpacingSamples, poll, interrupter);
+            out.spacing = estimateSpacingWith(positions, shared, kSpacingSamples, poll, interrupter);
         }
     }
 
@@ -325,5 +359,7 @@ ResolvedParameters resolveParameters(const SurfaceParameters& params,
     }
     return out;
 }
+
+} // namespace
 
 } // namespace nonbloppy

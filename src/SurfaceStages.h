@@ -11,6 +11,8 @@
 #include <nonbloppy/ParticleIndex.h>
 
 #include <openvdb/openvdb.h>
+
+#include <cmath>
 #include <openvdb/util/NullInterrupter.h>
 
 #include <vector>
@@ -22,6 +24,14 @@ namespace surface_stages_internal {
 /// five cells per axis, which wastes less work on particles outside the support sphere than
 /// cells of r_e (three per axis, 27 r_e³ visited for a 4.2 r_e³ sphere).
 constexpr double kCellOverRadius = 0.5;
+
+/// Whether @a params gives a usable r_e (> 0, finite): the particles can then be indexed before
+/// the parameters are resolved, and the spacing estimate searches that index (a bad r_e is
+/// left for resolveParameters() to refuse with its own message).
+inline bool givenRadius(const SurfaceParameters& params)
+{
+    return params.effectiveRadius && *params.effectiveRadius > 0.0 && std::isfinite(*params.effectiveRadius);
+}
 
 /// Throw CancelledError("interrupted during <stage>") if @a interrupter (may be null) asks to
 /// stop. Cost: one wasInterrupted() call. Thread-safety: as the interrupter's.

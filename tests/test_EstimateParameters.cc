@@ -5,6 +5,7 @@
 #include <nonbloppy/CorrectSurface.h>
 #include <nonbloppy/Error.h>
 #include <nonbloppy/EstimateParameters.h>
+#include <nonbloppy/ParticleIndex.h>
 #include <nonbloppy/ReadParticles.h>
 
 #include <gtest/gtest.h>
@@ -88,6 +89,47 @@ TEST(EstimateParameters, ThresholdGrowsWithTheRadius)
     EXPECT_GT(calibrateThreshold(3.0), calibrateThreshold(2.0));
     EXPECT_GT(calibrateThreshold(2.0), 0.0);
     EXPECT_THROW(calibrateThreshold(0.5), ParameterError);
+}
+
+TEST(EstimateParameters, AnIndexOfAnyCellSizeServesTheEstimate)
+{
+    // resolveParametersIndexed() searches the caller's index instead of building its own:
+    // the samples are spread over that index's slots, so s moves in its last digits only.
+    const ParticleSet frame = readParticles(nonbloppy_test::dataPath("dam_break_frame_23_24389_particles.vtk"));
+    SurfaceParameters params;
+    params.effectiveRadius = 0.1;
+    const ResolvedParameters own = resolveParameters(params, frame.positions);
+    for (const double cellSize : {0.02, 0.05, 0.3}) {
+        const ParticleIndex index = ParticleIndex::build(frame.positions, cellSize);
+        const ResolvedParameters shared = resolveParametersIndexed(params, index);
+        EXPECT_NEAR(shared.spacing, own.spacing, 1e-3 * own.spacing) << "cell " << cellSize;
+        EXPECT_NEAR(shared.threshold, own.threshold, 3e-3 * own.threshold) << "cell " << cellSize;
+        EXPECT_DOUBLE_EQ(shared.voxelSize, 0.5 * shared.spacing);
+        EXPECT_DOUBLE_EQ(shared.effectiveRadius, 0.1);
+    }
+    // buildSurface() with r_e given indexes first (cells of r_e / 2) and estimates through
+    // that index, bit for bit; its stages say so in their order.
+    const SurfaceResult built = buildSurface(frame.positions, params);
+    const ResolvedParameters expected =
+        resolveParametersIndexed(params, ParticleIndex::build(frame.positions, 0.5 * 0.1));
+    EXPECT_EQ(built.parameters.spacing, expected.spacing);
+    EXPECT_EQ(built.parameters.threshold, expected.threshold);
+    ASSERT_GE(built.timings.entries.size(), 2u);
+    EXPECT_EQ(built.timings.entries[0].stage, "index particles");
+    EXPECT_EQ(built.timings.entries[1].stage, "estimate parameters");
+    // Without r_e the estimate comes first: r_e, hence the index's cells, depend on it.
+    const SurfaceResult estimated = buildSurface(frame.positions, SurfaceParameters());
+    EXPECT_EQ(estimated.timings.entries[0].stage, "estimate parameters");
+    EXPECT_EQ(estimated.parameters.spacing, resolveParameters(SurfaceParameters(), frame.positions).spacing);
+    // A bad r_e is refused by the parameter check, not by the index.
+    SurfaceParameters bad;
+    bad.effectiveRadius = -0.1;
+    try {
+        buildSurface(frame.positions, bad);
+        ADD_FAILURE() << "negative radius accepted";
+    } catch (const ParameterError& e) {
+        EXPECT_STREQ(e.what(), "--radius must be > 0, got -0.1");
+    }
 }
 
 TEST(EstimateParameters, ResolveReportsWhatWasGivenAndChecksRanges)

@@ -9,7 +9,8 @@
 /// nonbloppy::writeMesh(result.mesh, "fluid.obj");
 /// @endcode
 /// The stages it chains are callable one by one: estimateSpacing/resolveParameters →
-/// buildParticleIndex → rasterizeDensity → extractSurface → relaxVertices → (Faithful:
+/// ParticleIndex::build (with r_e given, the index comes first and the estimate searches it:
+/// ParticleIndex::build → resolveParametersIndexed) → rasterizeDensity → extractSurface → relaxVertices → (Faithful:
 /// repairFolds) → computeNormals → (spacing given: preserveVolume → smoothSurface → computeNormals).
 
 #ifndef NONBLOPPY_BUILD_SURFACE_H

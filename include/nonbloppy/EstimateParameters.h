@@ -8,6 +8,7 @@
 
 #include <nonbloppy/CorrectSurface.h>
 #include <nonbloppy/Export.h>
+#include <nonbloppy/ParticleIndex.h>
 
 #include <openvdb/openvdb.h>
 #include <openvdb/util/NullInterrupter.h>
@@ -189,6 +190,15 @@ struct ResolvedParameters
 /// Thread-safety (all functions of this header): reentrant, no shared state.
 NONBLOPPY_API ResolvedParameters resolveParameters(const SurfaceParameters& params,
                                      const std::vector<openvdb::Vec3f>& positions,
+                                     openvdb::util::NullInterrupter* interrupter = nullptr);
+
+/// resolveParameters() for particles already indexed (any cell size): the spacing, when it
+/// must be estimated, is searched through @a index instead of an index of its own, which
+/// saves building one (on 1.5 million particles about 0.1 s, most of the estimate).
+/// buildSurface() takes this path when --radius is given, indexing the particles first; the
+/// samples are then spread over this index's slots, so s may differ from the other
+/// overload's in its last digits.
+NONBLOPPY_API ResolvedParameters resolveParametersIndexed(const SurfaceParameters& params, const ParticleIndex& index,
                                      openvdb::util::NullInterrupter* interrupter = nullptr);
 
 } // namespace nonbloppy
