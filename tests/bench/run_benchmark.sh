@@ -44,8 +44,14 @@ nb_args=(--voxel-size 0.025 --radius 0.1 --blend 0.3 --iterations 2)
 # Every timed run writes a new file (the caller removes the old one first, untimed): replacing
 # an existing 100 MB mesh adds its deletion to the run, 0.3 s on this machine's ext4 (mounted
 # with discard), which measures the file system rather than either tool.
+# Each timed run also starts with no dirty page cache (an untimed `sync`): vdb_tool writes its
+# ~100 MB mesh through the page cache and exits before the kernel has flushed it, and that
+# flush otherwise ran during the next run (nonbloppy's; 64x, 3 pairs: 1.92-2.28 s after
+# vdb_tool, 1.85-2.04 s with a sync between). nonbloppy's own meshes leave nothing to flush
+# (direct I/O).
 run_timed() {
   local log="$1"; shift
+  sync
   /usr/bin/time -f "%e %U %S %M" -o "$log.time" "$@" > "$log.out" 2> "$log.err"
   awk '{printf "%s %.2f %s\n", $1, $2 + $3, $4}' "$log.time" >> "$log"
 }
