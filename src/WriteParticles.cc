@@ -380,7 +380,7 @@ makePointDataGrid(const ParticleSet& particles, double voxelSize)
 }
 
 void
-writeParticles(const ParticleSet& particles, const std::string& path)
+writeParticles(const ParticleSet& particles, const std::string& path, const ParticleWriteSettings& settings)
 {
     const std::string ext = lowerExtension(path);
     if (!isParticleOutputFile(path)) {
@@ -401,7 +401,7 @@ writeParticles(const ParticleSet& particles, const std::string& path)
         else if (ext == ".vtu") writeVtu(particles, os);
         else if (ext == ".xyz") writeXyz(particles, os);
         else writeCsv(particles, os);
-    }, /*expectedBytes=*/particles.positions.size() * sizeof(openvdb::Vec3f));
+    }, /*expectedBytes=*/settings.directIo ? particles.positions.size() * sizeof(openvdb::Vec3f) : 0);
 }
 
 bool

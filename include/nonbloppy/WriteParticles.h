@@ -15,6 +15,15 @@
 
 namespace nonbloppy {
 
+/// Options of writeParticles().
+struct ParticleWriteSettings
+{
+    /// Write files of 1 MiB or more with direct I/O (O_DIRECT, past the page cache) on local
+    /// ext4, XFS or Btrfs disks, as MeshWriteSettings::directIo; false, and other file
+    /// systems, use the page cache. The bytes are the same.
+    bool directIo = true;
+};
+
 /// Write @a particles to @a path; the format follows the extension:
 /// - `.ply`  binary little-endian; float x y z, then each attribute component as a vertex
 ///           property in its type ("velocity_x/_y/_z" for 3-vectors, "name_<c>" for other
@@ -27,9 +36,12 @@ namespace nonbloppy {
 /// - `.csv`  header "x,y,z,<name>" (multi-component: "<name>:0,<name>:1,...", as ParaView),
 ///           shortest round-trip decimal text.
 /// - `.vdb`  one PointDataGrid named "points" (see makePointDataGrid()).
-/// Written through a temporary file renamed into place; same particles, same bytes.
+/// Written through a temporary file renamed into place; same particles, same bytes (with
+/// or without direct I/O, see ParticleWriteSettings; `.vdb` goes through OpenVDB's own
+/// writer and always uses the page cache).
 /// @throw FileError for an unknown extension or an unwritable path.
-NONBLOPPY_API void writeParticles(const ParticleSet& particles, const std::string& path);
+NONBLOPPY_API void writeParticles(const ParticleSet& particles, const std::string& path,
+                                  const ParticleWriteSettings& settings = ParticleWriteSettings());
 
 /// True if @a path has an extension writeParticles() understands.
 NONBLOPPY_API bool isParticleOutputFile(const std::string& path);
