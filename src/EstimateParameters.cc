@@ -207,12 +207,12 @@ double estimateSpacingOf(const ParticleIndex& index, double guess, size_t maxSam
     throw ParameterError("cannot estimate the particle spacing; give --spacing");
 }
 
-/// estimateSpacing() of @a positions, or of @a shared's particles when it is given (the
-/// particles themselves, indexed: no index of its own to build).
+/// estimateSpacing() of @a positions, searched through @a shared when it is given (an index
+/// of those same particles: none of its own to build).
 double estimateSpacingWith(const std::vector<openvdb::Vec3f>& positions, const ParticleIndex* shared,
                            size_t maxSamples, CancelPoll& poll, openvdb::util::NullInterrupter* interrupter)
 {
-    const double guess = spacingGuess(shared ? shared->sortedPositions() : positions, poll);
+    const double guess = spacingGuess(positions, poll);
     if (shared) return estimateSpacingOf(*shared, guess, maxSamples, poll);
     ParticleIndex index;
     try {
@@ -222,10 +222,6 @@ double estimateSpacingWith(const std::vector<openvdb::Vec3f>& positions, const P
     }
     return estimateSpacingOf(index, guess, maxSamples, poll);
 }
-
-/// resolveParameters() of @a positions, or of @a shared's particles when it is given.
-ResolvedParameters resolveParametersWith(const SurfaceParameters& params, const std::vector<openvdb::Vec3f>& positions,
-                                         const ParticleIndex* shared, openvdb::util::NullInterrupter* interrupter);
 
 } // namespace
 
@@ -264,21 +260,10 @@ double calibrateThreshold(double effectiveRadiusOverSpacing)
     return sum / (kSamples * kSamples);
 }
 
-ResolvedParameters resolveParameters(const SurfaceParameters& params,
-                                     const std::vector<openvdb::Vec3f>& positions,
-                                     openvdb::util::NullInterrupter* interrupter)
-{
-    return resolveParametersWith(params, positions, nullptr, interrupter);
-}
-
-ResolvedParameters resolveParametersIndexed(const SurfaceParameters& params, const ParticleIndex& index,
-                                     openvdb::util::NullInterrupter* interrupter)
-{
-    return resolveParametersWith(params, index.sortedPositions(), &index, interrupter);
-}
-
 namespace {
 
+/// resolveParameters() of @a positions, searched through @a shared (an index of those same
+/// particles) when it is given.
 ResolvedParameters resolveParametersWith(const SurfaceParameters& params, const std::vector<openvdb::Vec3f>& positions,
                                          const ParticleIndex* shared, openvdb::util::NullInterrupter* interrupter)
 {
@@ -361,5 +346,18 @@ ResolvedParameters resolveParametersWith(const SurfaceParameters& params, const 
 }
 
 } // namespace
+
+ResolvedParameters resolveParameters(const SurfaceParameters& params,
+                                     const std::vector<openvdb::Vec3f>& positions,
+                                     openvdb::util::NullInterrupter* interrupter)
+{
+    return resolveParametersWith(params, positions, nullptr, interrupter);
+}
+
+ResolvedParameters resolveParametersIndexed(const SurfaceParameters& params, const ParticleIndex& index,
+                                            openvdb::util::NullInterrupter* interrupter)
+{
+    return resolveParametersWith(params, index.sortedPositions(), &index, interrupter);
+}
 
 } // namespace nonbloppy
