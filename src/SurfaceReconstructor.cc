@@ -12,11 +12,6 @@
 
 namespace nonbloppy {
 
-using surface_stages_internal::checkCancelled;
-using surface_stages_internal::givenRadius;
-using surface_stages_internal::kCellOverRadius;
-using surface_stages_internal::StageScope;
-
 SurfaceReconstructor::SurfaceReconstructor(const SurfaceParameters& params) : mParams(params) {}
 
 SurfaceReconstructor::~SurfaceReconstructor() = default;
@@ -49,30 +44,13 @@ SurfaceReconstructor::reconstructBuffered(openvdb::util::NullInterrupter* interr
     result.timings = StageTimings();
     result.density.reset();
     result.particleCount = mPositions.size();
-    const auto indexParticles = [&](double effectiveRadius) {
-        StageScope scope(result.timings, interrupter, "index particles");
-        // build() takes the vector over; positionBuffer() takes storage back next frame.
-        mIndex = ParticleIndex::build(std::move(mPositions), kCellOverRadius * effectiveRadius, interrupter);
-        mPositions = std::vector<openvdb::Vec3f>();
-        checkCancelled(interrupter, "index particles");
-    };
+    // Parameters kept from an earlier frame, or resolved for this one and kept from then on.
     const bool reuse = mKeepParameters && mHaveKeptParameters;
-    // As buildSurface(): with r_e given the index comes first and serves the spacing estimate.
-    const bool indexFirst = !reuse && givenRadius(mParams);
-    if (indexFirst) indexParticles(*mParams.effectiveRadius);
-    {
-        StageScope scope(result.timings, interrupter, "estimate parameters");
-        if (reuse) {
-            result.parameters = mKeptParameters;
-        } else {
-            result.parameters = indexFirst ? resolveParametersIndexed(mParams, mIndex, interrupter)
-                                           : resolveParameters(mParams, mPositions, interrupter);
-            mKeptParameters = result.parameters;
-            mHaveKeptParameters = true;
-        }
-        checkCancelled(interrupter, "estimate parameters");
-    }
-    if (!indexFirst) indexParticles(result.parameters.effectiveRadius);
+    surface_stages_internal::resolveAndIndex(mParams, reuse ? &mKeptParameters : nullptr, mPositions, mIndex,
+                                             result, interrupter, [&](const ResolvedParameters& resolved) {
+                                                 mKeptParameters = resolved;
+                                                 mHaveKeptParameters = true;
+                                             });
     surface_stages_internal::runSurfaceStages(mIndex, mParams.keepDensity, result, mUnrelaxed,
                                               surface_stages_internal::UnrelaxedBuffer::Keep,
                                               interrupter);

@@ -15,6 +15,7 @@
 #include <nonbloppy/SmoothSurface.h>
 #include <nonbloppy/Version.h>
 
+#include <cmath>
 #include <string>
 
 namespace nonbloppy {
@@ -23,6 +24,31 @@ namespace surface_stages_internal {
 void checkCancelled(openvdb::util::NullInterrupter* interrupter, const char* stage)
 {
     cancellation_internal::CancelPoll(interrupter, stage).throwIfStopped();
+}
+
+void resolveAndIndex(const SurfaceParameters& params, const ResolvedParameters* kept,
+                     std::vector<openvdb::Vec3f>& positions, ParticleIndex& index, SurfaceResult& result,
+                     openvdb::util::NullInterrupter* interrupter,
+                     const std::function<void(const ResolvedParameters&)>& onResolved)
+{
+    const auto indexParticles = [&](double effectiveRadius) {
+        StageScope scope(result.timings, interrupter, "index particles");
+        index = ParticleIndex::build(std::move(positions), kCellOverRadius * effectiveRadius, interrupter);
+        positions = std::vector<openvdb::Vec3f>();  // moved from: empty, not unspecified
+        checkCancelled(interrupter, "index particles");
+    };
+    const bool indexFirst = !kept && params.effectiveRadius && *params.effectiveRadius > 0.0
+                            && std::isfinite(*params.effectiveRadius);
+    if (indexFirst) indexParticles(*params.effectiveRadius);
+    {
+        StageScope scope(result.timings, interrupter, "estimate parameters");
+        result.parameters = kept ? *kept
+                          : indexFirst ? resolveParametersIndexed(params, index, interrupter)
+                                       : resolveParameters(params, positions, interrupter);
+        checkCancelled(interrupter, "estimate parameters");
+    }
+    if (onResolved) onResolved(result.parameters);
+    if (!indexFirst) indexParticles(result.parameters.effectiveRadius);
 }
 
 void runSurfaceStages(const ParticleIndex& index, bool keepDensity, SurfaceResult& result,

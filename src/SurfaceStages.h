@@ -11,10 +11,9 @@
 #include <nonbloppy/ParticleIndex.h>
 
 #include <openvdb/openvdb.h>
-
-#include <cmath>
 #include <openvdb/util/NullInterrupter.h>
 
+#include <functional>
 #include <vector>
 
 namespace nonbloppy {
@@ -24,14 +23,6 @@ namespace surface_stages_internal {
 /// five cells per axis, which wastes less work on particles outside the support sphere than
 /// cells of r_e (three per axis, 27 r_e³ visited for a 4.2 r_e³ sphere).
 constexpr double kCellOverRadius = 0.5;
-
-/// Whether @a params gives a usable r_e (> 0, finite): the particles can then be indexed before
-/// the parameters are resolved, and the spacing estimate searches that index (a bad r_e is
-/// left for resolveParameters() to refuse with its own message).
-inline bool givenRadius(const SurfaceParameters& params)
-{
-    return params.effectiveRadius && *params.effectiveRadius > 0.0 && std::isfinite(*params.effectiveRadius);
-}
 
 /// Throw CancelledError("interrupted during <stage>") if @a interrupter (may be null) asks to
 /// stop. Cost: one wasInterrupted() call. Thread-safety: as the interrupter's.
@@ -59,6 +50,21 @@ private:
     ScopedStageTimer mTimer;
     openvdb::util::NullInterrupter* mInterrupter;
 };
+
+/// The stages "estimate parameters" and "index particles", timed in result.timings and
+/// announced to @a interrupter: result.parameters from @a params (or @a kept, when given,
+/// as they are), and @a index over @a positions with cells of kCellOverRadius·r_e. With a
+/// usable r_e given (> 0, finite) the particles are indexed first and the spacing estimate
+/// searches that index (resolveParametersIndexed()); otherwise the estimate comes first, as
+/// r_e, hence the cells, may depend on it (a bad r_e is left for resolveParameters() to
+/// refuse with its own message). @a positions is moved into the index and left empty.
+/// @a onResolved, when given, is called with result.parameters as soon as the estimate stage
+/// has ended, whether or not the index is built yet.
+/// @throw ParameterError, CancelledError as buildSurface().
+void resolveAndIndex(const SurfaceParameters& params, const ResolvedParameters* kept,
+                     std::vector<openvdb::Vec3f>& positions, ParticleIndex& index, SurfaceResult& result,
+                     openvdb::util::NullInterrupter* interrupter,
+                     const std::function<void(const ResolvedParameters&)>& onResolved = {});
 
 /// What runSurfaceStages() does with the unrelaxed-vertex buffer after fold repair.
 enum class UnrelaxedBuffer
