@@ -95,8 +95,8 @@ private:
 
 /// One relaxation step: reads `previous`, writes `next`. Vertices are processed in groups
 /// that shared a cell when the relaxation began; each group gathers the particles within r_e
-/// of its vertices' current box once, and every vertex of the group then sums over that contiguous list with per-lane
-/// accumulators (vectorizable without reassociating any sum, so results stay exact and
+/// of its vertices' current box once, and every vertex of the group then sums over that
+/// contiguous list with per-lane accumulators (vectorizable without reassociating any sum, so results stay exact and
 /// independent of threads: a vertex's sum order depends only on its group's list).
 struct RelaxStepOp
 {
@@ -210,13 +210,6 @@ struct RelaxStepOp
     }
 };
 
-/// Buffers of groupVerticesByCell().
-struct GroupBuffers
-{
-    std::vector<uint64_t> packed, spare;               ///< cell rank and vertex, for the radix sort
-    std::vector<std::pair<uint64_t, uint32_t>> keyed;  ///< cell key and vertex, for the comparison sort
-};
-
 /// Stable LSD radix sort of @a values by their bits [@a low, @a low + @a bits), 11 bits a
 /// pass, through @a spare. The values are cut into a fixed number of chunks (not one per
 /// thread): each pass counts the digits of every chunk in parallel, takes the starts in
@@ -306,15 +299,15 @@ void writeGroups(size_t count, const KeyAt& keyAt, const VertexAt& vertexAt, std
 /// return the start of each run of equal cells (plus the end). Cells are packed into 64-bit
 /// keys relative to the smallest cell, so the sort compares integers, not coordinates through
 /// an index; ties keep vertex order, so grouping is deterministic. Every pass is parallel:
-/// on millions of vertices, serial passes left the second thread idle. When the cells of the vertices' box number fewer than 2^32 (always, but for
-/// scattered vertices), the key is the cell's rank in that box and the vertex number packed
-/// into 64 bits, sorted by a stable radix sort on the rank's bits (two passes where a surface
-/// crosses a million cells; the comparison sort cost a tenth of the step). Asks @a poll as it goes and throws its CancelledError on a stop (the
-/// sort is stopped through runStoppable()).
+/// on millions of vertices, serial passes left the second thread idle. When the cells of the
+/// vertices' box number fewer than 2^32 (always, but for scattered vertices), the key is the
+/// cell's rank in that box and the vertex number packed into 64 bits, sorted by a stable
+/// radix sort on the rank's bits (two passes where a surface crosses a million cells; the
+/// comparison sort cost a tenth of the step). Asks @a poll as it goes and throws its
+/// CancelledError on a stop (the sort is stopped through runStoppable()).
 void groupVerticesByCell(const std::vector<openvdb::Vec3s>& points, double groupSize,
                          std::vector<uint32_t>& order, std::vector<size_t>& groupStart, CancelPoll& poll)
 {
-    GroupBuffers scratch;
     using particle_index_internal::cellOf;
     using Bounds = std::pair<openvdb::Coord, openvdb::Coord>;
     const Bounds bounds = tbb::parallel_reduce(tbb::blocked_range<size_t>(0, points.size()),
@@ -343,8 +336,7 @@ void groupVerticesByCell(const std::vector<openvdb::Vec3s>& points, double group
     const openvdb::Coord dims = extent + openvdb::Coord(1);
     const uint64_t cellCount = uint64_t(dims[0]) * uint64_t(dims[1]) * uint64_t(dims[2]);
     if (cellCount <= (uint64_t(1) << 32)) {
-        std::vector<uint64_t>& packed = scratch.packed;
-        packed.resize(points.size());
+        std::vector<uint64_t> packed(points.size()), spare;  // cell rank and vertex
         tbb::parallel_for(tbb::blocked_range<size_t>(0, points.size()), [&](const tbb::blocked_range<size_t>& r) {
             for (size_t i = r.begin(); i < r.end(); ++i) {
                 if (poll.stoppedAt(i - r.begin())) return;
@@ -357,14 +349,13 @@ void groupVerticesByCell(const std::vector<openvdb::Vec3s>& points, double group
         poll.throwIfStopped();
         int bits = 0;
         while (bits < 32 && (uint64_t(1) << bits) < cellCount) ++bits;
-        radixSortHigh(packed, scratch.spare, 32, bits, poll);
+        radixSortHigh(packed, spare, 32, bits, poll);
         poll.throwIfStopped();
         writeGroups(packed.size(), [&](size_t n) { return packed[n] >> 32; },
                     [&](size_t n) { return uint32_t(packed[n]); }, order, groupStart, poll);
         return;
     }
-    std::vector<std::pair<uint64_t, uint32_t>>& keyed = scratch.keyed;
-    keyed.resize(points.size());
+    std::vector<std::pair<uint64_t, uint32_t>> keyed(points.size());  // cell key and vertex
     tbb::parallel_for(tbb::blocked_range<size_t>(0, points.size()), [&](const tbb::blocked_range<size_t>& r) {
         for (size_t i = r.begin(); i < r.end(); ++i) {
             if (poll.stoppedAt(i - r.begin())) return;

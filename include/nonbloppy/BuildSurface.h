@@ -10,8 +10,9 @@
 /// @endcode
 /// The stages it chains are callable one by one: estimateSpacing/resolveParameters →
 /// ParticleIndex::build (with r_e given, the index comes first and the estimate searches it:
-/// ParticleIndex::build → resolveParametersIndexed) → rasterizeDensity → extractSurface → relaxVertices → (Faithful:
-/// repairFolds) → computeNormals → (spacing given: preserveVolume → smoothSurface → computeNormals).
+/// ParticleIndex::build → resolveParametersIndexed) → rasterizeDensity → extractSurface →
+/// relaxVertices → (Faithful: repairFolds) → computeNormals → (spacing given:
+/// preserveVolume → smoothSurface → computeNormals).
 
 #ifndef NONBLOPPY_BUILD_SURFACE_H
 #define NONBLOPPY_BUILD_SURFACE_H

@@ -198,8 +198,9 @@ NONBLOPPY_API ResolvedParameters resolveParameters(const SurfaceParameters& para
 /// buildSurface() takes this path when --radius is given, indexing the particles first; the
 /// samples are then spread over this index's slots, so s may differ from the other
 /// overload's in its last digits.
-NONBLOPPY_API ResolvedParameters resolveParametersIndexed(const SurfaceParameters& params, const ParticleIndex& index,
-                                     openvdb::util::NullInterrupter* interrupter = nullptr);
+NONBLOPPY_API ResolvedParameters resolveParametersIndexed(const SurfaceParameters& params,
+                                                          const ParticleIndex& index,
+                                                          openvdb::util::NullInterrupter* interrupter = nullptr);
 
 } // namespace nonbloppy
 

@@ -40,8 +40,8 @@ struct RelaxSettings
 ///                     vertices while grouping them by cell (once, before the first
 ///                     iteration) and every 1 ms (from a helper thread) if that takes the
 ///                     parallel sort, then per iteration every 16 vertex groups of each task
-///                     and wasInterrupted(percent) after it; end(), also when it throws. A stop leaves the mesh at the
-///                     last completed iteration.
+///                     and wasInterrupted(percent) after it; end(), also when it throws. A
+///                     stop leaves the mesh at the last completed iteration.
 /// Thread-safety: reentrant; the index is only read, the mesh is written.
 /// @throw ParameterError for r_e ≤ 0, c outside [0,1], t < 0 or maxStep < 0;
 ///        CancelledError("interrupted during relax vertices") on interrupt.
