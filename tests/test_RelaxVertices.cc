@@ -10,6 +10,7 @@
 
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <cmath>
 
 using namespace nonbloppy;
@@ -169,6 +170,49 @@ TEST(RelaxVertices, VerticesThatTravelFarMatchTheDirectSum)
         farTravellers += (mesh.points[i] - start[i]).length() > 0.6f;
     }
     EXPECT_GT(farTravellers, 500u);  // the case this test is about did occur
+}
+
+TEST(RelaxVertices, AStopLeavesEachVertexWhereItWasOrFullyRelaxed)
+{
+    // Groups of vertices take all their steps at once and are written back whole, so a stop
+    // partway leaves a mix of untouched and finished vertices, never one between the two.
+    std::vector<openvdb::Vec3f> particles;
+    for (int i = 0; i < 2000; ++i) particles.push_back(openvdb::Vec3f(0.3f * float(i), 0.0f, 0.0f));
+    uint32_t state = 777u;
+    const auto jitter = [&] {
+        state = state * 1664525u + 1013904223u;
+        return float(state >> 8) / float(1u << 24) - 0.5f;  // [-0.5, 0.5)
+    };
+    SurfaceMesh start;
+    for (int n = 0; n < 20000; ++n) {
+        start.points.push_back(openvdb::Vec3s(600.0f * (jitter() + 0.5f), 1.2f * jitter(), 1.2f * jitter()));
+    }
+    const ParticleIndex index = ParticleIndex::build(particles, 0.5);
+    SurfaceMesh relaxed = start;
+    relaxVertices(relaxed, index, relaxSettings(0.3, 2));
+
+    /// Says stop once 30% of the work is reported done, ever after.
+    struct StopAtThirtyPercent : openvdb::util::NullInterrupter
+    {
+        bool wasInterrupted(int percent = -1) override
+        {
+            if (percent >= 30) fired = true;
+            return fired.load();
+        }
+        std::atomic<bool> fired{false};
+    } interrupter;
+    SurfaceMesh stopped = start;
+    EXPECT_THROW(relaxVertices(stopped, index, relaxSettings(0.3, 2), &interrupter), CancelledError);
+    size_t untouched = 0, finished = 0;
+    for (size_t i = 0; i < start.points.size(); ++i) {
+        const bool isStart = stopped.points[i] == start.points[i];
+        const bool isRelaxed = stopped.points[i] == relaxed.points[i];
+        ASSERT_TRUE(isStart || isRelaxed) << "vertex " << i;
+        untouched += isStart && !isRelaxed;
+        finished += isRelaxed && !isStart;
+    }
+    EXPECT_GT(untouched, 0u);  // the stop did come partway
+    EXPECT_GT(finished, 0u);
 }
 
 TEST(RelaxVertices, RejectsBadSettings)

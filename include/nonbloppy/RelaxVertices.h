@@ -30,18 +30,20 @@ struct RelaxSettings
 ///   t_i = Σ_j w(|v_i − r_j|) r_j / Σ_j w(|v_i − r_j|),   v_i ← (1 − c) v_i + c t_i.
 /// Each iteration reads only the previous iteration's positions, so the result does not
 /// depend on thread count or order. A vertex with no particle within r_e stays put.
+/// A vertex's step depends only on its own position, so vertices are relaxed group by group
+/// (vertices that share a cell), each group taking all t steps while it is in cache.
 /// Normals are not updated (call computeNormals() afterwards).
-/// Cost: t · V · (particles within r_e) kernel evaluations, parallel over vertices;
-/// scratch memory about 24 bytes per vertex.
+/// Cost: t · V · (particles within r_e) kernel evaluations, parallel over vertex groups;
+/// scratch memory about 20 bytes per vertex (the grouping).
 /// @param mesh         vertices moved in place (world units); polygons untouched
 /// @param particles    index of the particles to relax against (any frame's, any mesh's)
 /// @param settings     r_e (world units), c, t
 /// @param interrupter  optional; start("relax vertices"), then wasInterrupted() every 4096
-///                     vertices while grouping them by cell (once, before the first
-///                     iteration) and every 1 ms (from a helper thread) if that takes the
-///                     parallel sort, then per iteration every 16 vertex groups of each task
-///                     and wasInterrupted(percent) after it; end(), also when it throws. A
-///                     stop leaves the mesh at the last completed iteration.
+///                     vertices while grouping them by cell (once, before relaxing) and
+///                     every 1 ms (from a helper thread) if that takes the parallel sort,
+///                     then every 16 vertex groups of each task and wasInterrupted(percent)
+///                     after it; end(), also when it throws. A stop leaves every vertex
+///                     either where it was or fully relaxed (t steps).
 /// Thread-safety: reentrant; the index is only read, the mesh is written.
 /// @throw ParameterError for r_e ≤ 0, c outside [0,1], t < 0 or maxStep < 0;
 ///        CancelledError("interrupted during relax vertices") on interrupt.
