@@ -12,6 +12,7 @@
 #include "Cancellation.h"
 #include "VectorArea.h"
 
+#include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
@@ -153,21 +154,42 @@ void requireSameSize(const SurfaceMesh& mesh, const std::vector<openvdb::Vec3s>&
     }
 }
 
-/// Mark the vertices of folded triangles; return how many triangles are folded.
+/// Mark the vertices of folded triangles; return how many triangles are folded. Parallel over
+/// polygons; the folded triangles (few) are listed per task and marked afterwards, so the
+/// marks and the count are the same in any order.
 size_t markFolded(const SurfaceMesh& mesh, const std::vector<openvdb::Vec3s>& before,
                   std::vector<char>& marked, CancelPoll& poll)
 {
     std::fill(marked.begin(), marked.end(), 0);
-    size_t folded = 0;
-    forEachTriangle(mesh, poll, [&](unsigned i, unsigned j, unsigned k) {
+    const auto isFolded = [&](unsigned i, unsigned j, unsigned k) {
         const openvdb::Vec3d now = triangleNormal(mesh.points[i], mesh.points[j], mesh.points[k]);
         const openvdb::Vec3d then = triangleNormal(before[i], before[j], before[k]);
-        if (now.dot(then) < 0.0) {
-            ++folded;
-            marked[i] = marked[j] = marked[k] = 1;
-        }
-    });
-    return folded;
+        return now.dot(then) < 0.0;
+    };
+    tbb::enumerable_thread_specific<std::vector<openvdb::Vec3I>> foldedPerThread;
+    const size_t triangleCount = mesh.triangles.size();
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, triangleCount + mesh.quads.size()),
+        [&](const tbb::blocked_range<size_t>& range) {
+            std::vector<openvdb::Vec3I>& folded = foldedPerThread.local();
+            for (size_t n = range.begin(); n < range.end(); ++n) {
+                if (poll.stoppedAt(n - range.begin())) return;
+                if (n < triangleCount) {
+                    const openvdb::Vec3I& t = mesh.triangles[n];
+                    if (isFolded(t[0], t[1], t[2])) folded.push_back(t);
+                } else {
+                    const openvdb::Vec4I& q = mesh.quads[n - triangleCount];
+                    if (isFolded(q[0], q[1], q[2])) folded.push_back(openvdb::Vec3I(q[0], q[1], q[2]));
+                    if (isFolded(q[0], q[2], q[3])) folded.push_back(openvdb::Vec3I(q[0], q[2], q[3]));
+                }
+            }
+        });
+    poll.throwIfStopped();
+    size_t count = 0;
+    for (const std::vector<openvdb::Vec3I>& folded : foldedPerThread) {
+        count += folded.size();
+        for (const openvdb::Vec3I& t : folded) marked[t[0]] = marked[t[1]] = marked[t[2]] = 1;
+    }
+    return count;
 }
 
 /// Convexity of every vertex: (v − mean of its edge neighbours) · n, world units, > 0 where

@@ -70,10 +70,10 @@ constexpr int kDefaultRepairRounds = 4;
 /// @param mesh         relaxed mesh; vertices of folded triangles moved back
 /// @param before       vertex positions before relaxation (same count as mesh.points)
 /// @param maxRounds    halving rounds before the last resort of moving all the way back
-/// @param interrupter  optional; asked every 4096 polygons of each (serial) round, no
+/// @param interrupter  optional; asked every 4096 polygons of each task of each round, no
 ///                     start()/end() (buildSurface() announces "correct surface"); a stop
 ///                     leaves the vertices partly repaired
-/// Cost: O(rounds · P), serial. Deterministic. Normals are not updated.
+/// Cost: O(rounds · P), parallel over polygons. Deterministic. Normals are not updated.
 /// Thread-safety: reentrant; the mesh is written.
 /// @throw ParameterError if @a before and mesh.points differ in size;
 ///        CancelledError("interrupted during correct surface") when @a interrupter says stop.
