@@ -18,6 +18,7 @@
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
 
 #include <algorithm>
 #include <charconv>
@@ -205,21 +206,42 @@ validateMesh(const SurfaceMesh& mesh, const std::string& path)
                 std::to_string(attribute.components) + " components (" + path + ")");
         }
     }
-    auto check = [&](size_t polygon, uint32_t index) {
-        if (index >= vertexCount) {
-            throw ParameterError("polygon " + std::to_string(polygon) + " references vertex " +
-                std::to_string(index) + " but the mesh has " + std::to_string(vertexCount) +
-                " vertices (" + path + ")");
+    // The first polygon with an index out of range, in parallel (the mesh's largest pass
+    // before any byte is written: 17 ms serially for 2.4M quads).
+    const size_t triangleCount = mesh.triangles.size(), polygonCount = triangleCount + mesh.quads.size();
+    const auto isBad = [&](size_t polygon) {
+        if (polygon < triangleCount) {
+            const openvdb::Vec3I& t = mesh.triangles[polygon];
+            return std::max({t[0], t[1], t[2]}) >= vertexCount;
         }
+        const openvdb::Vec4I& q = mesh.quads[polygon - triangleCount];
+        return std::max({q[0], q[1], q[2], q[3]}) >= vertexCount;
     };
-    size_t polygon = 0;
-    for (const openvdb::Vec3I& t : mesh.triangles) {
-        for (int i = 0; i < 3; ++i) check(polygon, t[i]);
-        ++polygon;
-    }
-    for (const openvdb::Vec4I& q : mesh.quads) {
-        for (int i = 0; i < 4; ++i) check(polygon, q[i]);
-        ++polygon;
+    const size_t bad = tbb::parallel_reduce(tbb::blocked_range<size_t>(0, polygonCount), polygonCount,
+        [&](const tbb::blocked_range<size_t>& range, size_t found) {
+            for (size_t n = range.begin(); n < range.end() && n < found; ++n) {
+                if (isBad(n)) return n;
+            }
+            return found;
+        },
+        [](size_t a, size_t b) { return std::min(a, b); });
+    if (bad < polygonCount) {
+        const auto corners = [&](size_t polygon) {
+            std::vector<uint32_t> list;
+            if (polygon < triangleCount) {
+                for (int i = 0; i < 3; ++i) list.push_back(mesh.triangles[polygon][i]);
+            } else {
+                for (int i = 0; i < 4; ++i) list.push_back(mesh.quads[polygon - triangleCount][i]);
+            }
+            return list;
+        };
+        for (uint32_t index : corners(bad)) {
+            if (index >= vertexCount) {
+                throw ParameterError("polygon " + std::to_string(bad) + " references vertex " +
+                    std::to_string(index) + " but the mesh has " + std::to_string(vertexCount) +
+                    " vertices (" + path + ")");
+            }
+        }
     }
 }
 

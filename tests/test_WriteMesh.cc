@@ -303,6 +303,10 @@ TEST_F(WriteMeshTest, FailuresNameThePathAndLeaveNothingBehind)
     EXPECT_EQ(messageOf<nonbloppy::ParameterError>([&] { writeMesh(broken, path("b.ply")); }),
         "polygon 5 references vertex 8 but the mesh has 8 vertices (" + path("b.ply") + ")");
     EXPECT_TRUE(listDirectory(dir()).empty());
+    broken.quads[2][3] = 9;  // of two bad polygons, the first is named
+    EXPECT_EQ(messageOf<nonbloppy::ParameterError>([&] { writeMesh(broken, path("b.ply")); }),
+        "polygon 2 references vertex 9 but the mesh has 8 vertices (" + path("b.ply") + ")");
+    EXPECT_TRUE(listDirectory(dir()).empty());
 
     EXPECT_FALSE(nonbloppy::isMeshFile("x.stl"));
     EXPECT_TRUE(nonbloppy::isMeshFile("x.Vtk"));
