@@ -369,7 +369,7 @@ bool extractByRegionImpl(const openvdb::FloatGrid& density, double threshold, Su
     }
     int releasedLayers = 0;  // leaf layers [0, releasedLayers) freed from *release
     size_t leavesUntrimmed = 0;
-    constexpr size_t kLeavesPerTrim = 4096;  // about 8 MB of leaves
+    constexpr size_t kLeavesPerTrim = 32768;  // about 64 MB of leaves
     std::vector<Region> regions;
     size_t totalKept = 0;
     {
@@ -491,9 +491,12 @@ bool extractByRegionImpl(const openvdb::FloatGrid& density, double threshold, Su
         }
 #if defined(__GLIBC__)
         // Freed leaves (2 KB each) stay in malloc's free lists, which the mesh's large
-        // arrays cannot use; hand their pages back to the system in batches (each trim
-        // walks the heap). On the 64x benchmark input: peak RSS 366 -> 275-290 MB, at a
-        // cost of 0.1-0.3 s of CPU (16384 leaves per trim: 320 MB).
+        // arrays cannot use; hand their pages back to the system in batches. Each trim
+        // walks the heap, and its page releases stall the threads meshing meanwhile (TLB
+        // shootdowns), worst when the machine is busy. On the 64x benchmark input, two
+        // threads, peak RSS / extract stage against trimming every 4096 leaves (8 paired
+        // runs each): never 371 MB; every 32768 leaves 322 MB, -0.07 to -0.17 s; 16384
+        // 302 MB, -0.01 to -0.06 s; 8192 and 4096 292 MB.
         if (leavesUntrimmed >= kLeavesPerTrim) {
             malloc_trim(0);
             leavesUntrimmed = 0;
