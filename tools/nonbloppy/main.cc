@@ -20,6 +20,9 @@
 
 #include <exception>
 #include <iostream>
+#if defined(__GLIBC__)
+#include <malloc.h>
+#endif
 #include <new>
 #include <vector>
 
@@ -106,6 +109,17 @@ int run(int argc, char** argv)
 
 int main(int argc, char** argv)
 {
+#if defined(__GLIBC__)
+    // The program's allocator policy (the library leaves a host application's alone): blocks
+    // up to 32 MB come from the heap, and up to 256 MB freed at its top stay there, so the
+    // stages reuse each other's memory instead of mapping fresh zeroed pages and unmapping
+    // them, which also stalls the other threads (TLB shootdowns). The extraction still hands
+    // its freed leaves back (malloc_trim), so peak memory is unchanged. 64x benchmark input,
+    // two threads: page faults 140k -> 110k, system time 0.41-0.47 -> 0.28-0.33 s, wall
+    // -0.09 s median over 8 alternating pairs; peak RSS 322 MB either way.
+    mallopt(M_MMAP_THRESHOLD, 32 << 20);
+    mallopt(M_TRIM_THRESHOLD, 256 << 20);
+#endif
     try {
         return run(argc, argv);
     } catch (const nonbloppy::CancelledError&) {
