@@ -156,12 +156,15 @@ void requireSameSize(const SurfaceMesh& mesh, const std::vector<openvdb::Vec3s>&
 
 /// Mark the vertices of folded triangles; return how many triangles are folded. Parallel over
 /// polygons; the folded triangles (few) are listed per task and marked afterwards, so the
-/// marks and the count are the same in any order.
+/// marks and the count are the same in any order. Given @a moved (the vertices moved since
+/// the last call, which marked every folded triangle then), only triangles with a moved
+/// corner are tested: the others kept their shape, and were not folded.
 size_t markFolded(const SurfaceMesh& mesh, const std::vector<openvdb::Vec3s>& before,
-                  std::vector<char>& marked, CancelPoll& poll)
+                  std::vector<char>& marked, CancelPoll& poll, const std::vector<char>* moved = nullptr)
 {
     std::fill(marked.begin(), marked.end(), 0);
     const auto isFolded = [&](unsigned i, unsigned j, unsigned k) {
+        if (moved && !(*moved)[i] && !(*moved)[j] && !(*moved)[k]) return false;
         const openvdb::Vec3d now = triangleNormal(mesh.points[i], mesh.points[j], mesh.points[k]);
         const openvdb::Vec3d then = triangleNormal(before[i], before[j], before[k]);
         return now.dot(then) < 0.0;
@@ -307,17 +310,20 @@ size_t repairFolds(SurfaceMesh& mesh, const std::vector<openvdb::Vec3s>& before,
 {
     requireSameSize(mesh, before);
     CancelPoll poll(interrupter, "correct surface");
-    std::vector<char> marked(mesh.points.size());
+    std::vector<char> marked(mesh.points.size()), moved(mesh.points.size());
     const size_t first = markFolded(mesh, before, marked, poll);
     size_t folded = first;
     for (int round = 0; folded > 0; ++round) {
         const bool last = round >= maxRounds;
-        for (size_t i = 0; i < marked.size(); ++i) {
-            if (!marked[i]) continue;
-            mesh.points[i] = last ? before[i] : 0.5f * (mesh.points[i] + before[i]);
-        }
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, marked.size()), [&](const tbb::blocked_range<size_t>& range) {
+            for (size_t i = range.begin(); i < range.end(); ++i) {
+                if (marked[i]) mesh.points[i] = last ? before[i] : 0.5f * (mesh.points[i] + before[i]);
+            }
+        });
         if (last) break;
-        folded = markFolded(mesh, before, marked, poll);
+        // Only the triangles around the vertices just moved can have changed.
+        moved.swap(marked);
+        folded = markFolded(mesh, before, marked, poll, &moved);
     }
     return first;
 }

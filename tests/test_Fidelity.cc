@@ -240,6 +240,26 @@ TEST(Fidelity, FoldedTrianglesAreFoundAndUnfolded)
     EXPECT_THROW(repairFolds(mesh, {}), ParameterError);
 }
 
+TEST(Fidelity, DeepFoldsTakeSeveralHalvingRounds)
+{
+    // Vertex 3 pushed far across the edge 1–2 (the line x + y = 1): each round moves it
+    // halfway back, x = y: -5 -> -2 -> -0.5 -> 0.25 -> 0.625, and its triangle is folded
+    // until the fourth round takes it past the line. Triangle (4, 5, 6) was moved but not
+    // folded, and shares no vertex with the fold: it stays as it is, as does vertex 0.
+    SurfaceMesh mesh;
+    mesh.points = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1, 1, 0}, {5, 0, 0}, {6, 0, 0}, {5, 1, 0}};
+    mesh.triangles = {{0, 1, 2}, {1, 3, 2}, {4, 5, 6}};
+    const std::vector<openvdb::Vec3s> before = mesh.points;
+    mesh.points[3] = openvdb::Vec3s(-5.0f, -5.0f, 0.0f);
+    mesh.points[5] = openvdb::Vec3s(6.0f, 0.5f, 0.0f);
+    EXPECT_EQ(countFoldedTriangles(mesh, before), 1u);
+    EXPECT_EQ(repairFolds(mesh, before), 1u);
+    EXPECT_EQ(countFoldedTriangles(mesh, before), 0u);
+    EXPECT_EQ(mesh.points[3], openvdb::Vec3s(0.625f, 0.625f, 0.0f));
+    EXPECT_EQ(mesh.points[0], before[0]);
+    EXPECT_EQ(mesh.points[5], openvdb::Vec3s(6.0f, 0.5f, 0.0f));
+}
+
 TEST(Fidelity, MaxStepCapsEveryRelaxationStep)
 {
     // One particle; c = 1 would jump every vertex onto it, the cap stops each at 0.1.
