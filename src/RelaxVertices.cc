@@ -11,6 +11,7 @@
 #include <tbb/parallel_reduce.h>
 #include <tbb/parallel_sort.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <limits>
@@ -48,7 +49,11 @@ struct CandidateBuffer
     /// [boxMin, boxMax]: only they can reach a vertex inside the box. Skipping the others
     /// (the corners and edges of the grown box) halves the work of every vertex. Written
     /// without branches (store, then advance only if kept): half the particles are
-    /// dropped at random, which a branch would mispredict.
+    /// dropped at random, which a branch would mispredict. The distance to the box is the
+    /// distance to the particle clamped into it (min and max, no branch either: the same
+    /// value as the largest of 0, min - p and p - max, which GCC compiled to a branch per
+    /// axis). 64x benchmark input, relax stage, 4 paired runs at one thread: 0.56-0.63 s
+    /// with the branches, 0.47-0.54 s without.
     void gather(const std::vector<openvdb::Vec3f>& positions, uint32_t first, uint32_t end,
                 const openvdb::Vec3f& boxMin, const openvdb::Vec3f& boxMax, float radius2)
     {
@@ -56,14 +61,16 @@ struct CandidateBuffer
         float* __restrict px = x.data();
         float* __restrict py = y.data();
         float* __restrict pz = z.data();
+        // Locals, so the stores through px, py, pz cannot be taken to change them.
+        const float minX = boxMin[0], minY = boxMin[1], minZ = boxMin[2];
+        const float maxX = boxMax[0], maxY = boxMax[1], maxZ = boxMax[2];
         size_t n = count;
         for (uint32_t k = first; k < end; ++k) {
             const openvdb::Vec3f& p = positions[k];
-            float outside2 = 0.0f;
-            for (int a = 0; a < 3; ++a) {
-                const float gap = std::max(0.0f, std::max(boxMin[a] - p[a], p[a] - boxMax[a]));
-                outside2 += gap * gap;
-            }
+            const float dx = p[0] - std::min(std::max(p[0], minX), maxX);
+            const float dy = p[1] - std::min(std::max(p[1], minY), maxY);
+            const float dz = p[2] - std::min(std::max(p[2], minZ), maxZ);
+            const float outside2 = dx * dx + dy * dy + dz * dz;
             px[n] = p[0];
             py[n] = p[1];
             pz[n] = p[2];
