@@ -119,38 +119,40 @@ say '```'
 # Scaling with t and with threads on the 64x input.
 scan_runs=$runs
 ((quick)) && scan_runs=1
-scan() {  # scan LABEL ARGS...: median wall of nonbloppy with ARGS on the 64x input
+scan_once() {  # scan_once LABEL ARGS...: one timed run of nonbloppy with ARGS on the 64x input
   local log="$out/scan_$1"; shift
-  rm -f "$log"
-  for ((r = 0; r < scan_runs; ++r)); do
-    rm -f "$out/scan.ply"
-    run_timed "$log" "$nonbloppy" mesh "$out/dam_break_x64.ply" -o "$out/scan.ply" "$@"
-  done
-  median 1 "$log"
+  rm -f "$out/scan.ply"
+  run_timed "$log" "$nonbloppy" mesh "$out/dam_break_x64.ply" -o "$out/scan.ply" "$@"
 }
+# The settings take turns, run after run, so that a slow spell of the machine (seconds to
+# minutes here) hits them alike: when each setting ran its repetitions back to back, two runs
+# of the script measured t = 2 slower than t = 4 (1.79 / 1.77 s) and t = 0 slower than t = 1
+# (1.46 / 1.43 s).
+# r_0 is calibrated for the relaxed surface, so each t also extracts a surface of another size
+# (more vertices at larger t). With r_0 held at the t = 2 value, only the iterations vary.
+r0=$(awk '$1 == "threshold" {print $3}' "$out/nb_64.out")
+declare -A t_wall t_fixed
+for t in 0 1 2 4; do rm -f "$out/scan_t$t" "$out/scan_tfixed$t"; done
+rm -f "$out/scan_threads1" "$out/scan_threads2"
+for ((r = 0; r < scan_runs; ++r)); do
+  for t in 0 1 2 4; do
+    scan_once "t$t" --voxel-size 0.025 --radius 0.1 --blend 0.3 --iterations "$t"
+    scan_once "tfixed$t" --voxel-size 0.025 --radius 0.1 --blend 0.3 --threshold "$r0" --iterations "$t"
+  done
+  for threads in 1 2; do
+    scan_once "threads$threads" "${nb_args[@]}" --threads "$threads"
+  done
+done
 say ""
 say "| 64x input | wall s |"
 say "| --- | --- |"
-declare -A t_wall t_fixed
 for t in 0 1 2 4; do
-  t_wall[$t]=$(scan "t$t" --voxel-size 0.025 --radius 0.1 --blend 0.3 --iterations "$t")
+  t_wall[$t]=$(median 1 "$out/scan_t$t")
   say "| t = $t | ${t_wall[$t]} |"
 done
-# r_0 is calibrated for the relaxed surface, so each t above also extracts a surface of another
-# size (more vertices at larger t). With r_0 held at the t = 2 value, only the iterations vary.
-r0=$(awk '$1 == "threshold" {print $3}' "$out/nb_64.out")
 for t in 0 1 2 4; do
-  t_fixed[$t]=$(scan "tfixed$t" --voxel-size 0.025 --radius 0.1 --blend 0.3 --threshold "$r0" --iterations "$t")
+  t_fixed[$t]=$(median 1 "$out/scan_tfixed$t")
   say "| t = $t, --threshold $r0 (the t = 2 value) | ${t_fixed[$t]} |"
-done
-# One and two threads alternate, so that a slow spell of the machine hits both alike.
-rm -f "$out/scan_threads1" "$out/scan_threads2"
-for ((r = 0; r < scan_runs; ++r)); do
-  for threads in 1 2; do
-    rm -f "$out/scan.ply"
-    run_timed "$out/scan_threads$threads" "$nonbloppy" mesh "$out/dam_break_x64.ply" -o "$out/scan.ply" \
-      "${nb_args[@]}" --threads "$threads"
-  done
 done
 threads1=$(median 1 "$out/scan_threads1")
 threads2=$(median 1 "$out/scan_threads2")

@@ -115,8 +115,9 @@ int main(int argc, char** argv)
     // stages reuse each other's memory instead of mapping fresh zeroed pages and unmapping
     // them, which also stalls the other threads (TLB shootdowns). The extraction still hands
     // its freed leaves back (malloc_trim), so peak memory is unchanged. 64x benchmark input,
-    // two threads: page faults 140k -> 110k, system time 0.41-0.47 -> 0.28-0.33 s, wall
-    // -0.09 s median over 8 alternating pairs; peak RSS 322 MB either way.
+    // two threads: page faults 140k -> 110k, system time 0.41-0.47 -> 0.26-0.33 s, wall
+    // -0.13 s median over 8 alternating pairs (-0.09 s in an earlier set of 8, with the same
+    // settings as GLIBC_TUNABLES); peak RSS 322 MB either way.
     mallopt(M_MMAP_THRESHOLD, 32 << 20);
     mallopt(M_TRIM_THRESHOLD, 256 << 20);
 #endif
