@@ -550,7 +550,8 @@ bool extractByRegionImpl(const openvdb::FloatGrid& density, double threshold, Su
         // leaves (closed surfaces have about as many vertices as quads), so that the arrays
         // are seldom moved while they grow; re-extrapolated, not doubled, when they are full:
         // on the 512x benchmark input the first region's guess fell 2% short at region 135
-        // of 141, and doubling then moved and faulted in 0.5 GB of quads and vertices.
+        // of 141, and doubling gave quads and vertices 36M slots for an 18.4M mesh (no
+        // measurable change in time or page faults either way).
         keptWelded += region.kept;
         const auto roomFor = [&](size_t needed) {
             return std::max(needed, size_t(1.05 * double(needed) * double(totalKept)
@@ -563,7 +564,7 @@ bool extractByRegionImpl(const openvdb::FloatGrid& density, double threshold, Su
         } else if (quadsNeeded > mesh.quads.capacity()) {
             mesh.quads.reserve(roomFor(quadsNeeded));
         }
-        mesh.quads.resize(quadBase + claimedBefore[poolCount]);
+        mesh.quads.resize(quadsNeeded);
         tbb::parallel_for(tbb::blocked_range<size_t>(0, poolCount),
             [&](const tbb::blocked_range<size_t>& range) {
                 for (size_t p = range.begin(); p < range.end(); ++p) {
