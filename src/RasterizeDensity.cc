@@ -105,8 +105,9 @@ constexpr int kColumnVoxels = kColumnLeaves * int(FloatLeaf::DIM);
 constexpr int kColumnRowStride = kColumnVoxels + 8;
 
 /// A particle's z-span inside a column, as 8-voxel vectors, each starting at column voxel
-/// @c start, with per-lane squared z-distances and lane masks (all bits set for voxels in the
-/// support's z-range, zero outside) that every row of the particle reuses. The z-distance of
+/// @c start, with per-lane squared z-distances that every row of the particle reuses. Lanes
+/// outside the support's z-range hold kOutsideFactor r_e² instead, so their weight is
+/// r_e / (2 r_e) − 1 < 0, clamped to +0: the z-range needs no mask of its own. The z-distance of
 /// a voxel is measured from its own leaf's origin, exactly as a leaf-at-a-time evaluation
 /// would, so the values do not depend on how leaves are grouped into columns.
 struct ZSpan
@@ -114,14 +115,17 @@ struct ZSpan
     static constexpr int kMaxVectors = kColumnVoxels / 8;
     int count = 0;                                ///< vectors used: 1 for a span of 8 voxels or fewer
     int start[kMaxVectors] = {};                  ///< first column voxel of each vector
-    alignas(32) float dz2[kMaxVectors][8];        ///< (z_voxel − p_z)² per lane
-    alignas(32) uint32_t keep[kMaxVectors][8];    ///< ~0u inside the support's z-range, else 0
+    alignas(32) float dz2[kMaxVectors][8];        ///< (z_voxel − p_z)² per lane, or kOutsideFactor r_e²
 };
 
+/// Squared distance, in units of r_e², given to lanes outside the support's z-range.
+/// Finite: an infinite one would make the same +0 weight, but 4 keeps the inputs ordinary.
+constexpr float kOutsideFactor = 4.0f;
+
 /// The weights w = max(r_e / √max(d², d_min²) − 1, 0) of one 8-lane vector of a row, added to
-/// @a row (masked lanes add +0, which leaves any sum ≥ +0 as it is). Baseline copy: two SSE
+/// @a row (lanes beyond r_e add +0, which leaves any sum ≥ +0 as it is). Baseline copy: two SSE
 /// halves, or scalar; IEEE sqrt and division give the AVX2 copy's bits.
-inline void addRowVector(float* row, const float* dz2, const uint32_t* keep, float dxy2, float radius,
+inline void addRowVector(float* row, const float* dz2, float dxy2, float radius,
                          float minDistance2)
 {
 #if defined(__SSE2__)
@@ -130,28 +134,26 @@ inline void addRowVector(float* row, const float* dz2, const uint32_t* keep, flo
     for (int half = 0; half < 2; ++half) {
         const __m128 d2 = _mm_add_ps(vdxy2, _mm_load_ps(dz2 + 4 * half));
         __m128 w = _mm_sub_ps(_mm_div_ps(vradius, _mm_sqrt_ps(_mm_max_ps(d2, vmin))), one);
-        w = _mm_and_ps(_mm_max_ps(w, zero), _mm_castsi128_ps(_mm_load_si128(
-            reinterpret_cast<const __m128i*>(keep + 4 * half))));
+        w = _mm_max_ps(w, zero);
         _mm_storeu_ps(row + 4 * half, _mm_add_ps(_mm_loadu_ps(row + 4 * half), w));
     }
 #else
     for (int l = 0; l < 8; ++l) {
         const float w = radius / std::sqrt(std::max(dxy2 + dz2[l], minDistance2)) - 1.0f;
-        if (keep[l] && w > 0.0f) row[l] += w;
+        if (w > 0.0f) row[l] += w;
     }
 #endif
 }
 
 #if NONBLOPPY_HAS_AVX2_COPY
 /// addRowVector() for the AVX2 copy of the loop (InstructionSet.h): one register per vector.
-NONBLOPPY_TARGET_AVX2 inline void addRowVectorAvx2(float* row, const float* dz2, const uint32_t* keep,
+NONBLOPPY_TARGET_AVX2 inline void addRowVectorAvx2(float* row, const float* dz2,
                                                    float dxy2, float radius, float minDistance2)
 {
     const __m256 d2 = _mm256_add_ps(_mm256_set1_ps(dxy2), _mm256_load_ps(dz2));
     const __m256 distance = _mm256_sqrt_ps(_mm256_max_ps(d2, _mm256_set1_ps(minDistance2)));
     __m256 w = _mm256_sub_ps(_mm256_div_ps(_mm256_set1_ps(radius), distance), _mm256_set1_ps(1.0f));
-    w = _mm256_and_ps(_mm256_max_ps(w, _mm256_setzero_ps()),
-                      _mm256_castsi256_ps(_mm256_load_si256(reinterpret_cast<const __m256i*>(keep))));
+    w = _mm256_max_ps(w, _mm256_setzero_ps());
     _mm256_storeu_ps(row, _mm256_add_ps(_mm256_loadu_ps(row), w));
 }
 #endif
@@ -249,6 +251,7 @@ struct RasterizeColumnOp
         const float invH = 1.0f / h;
         const float radius = float(effectiveRadius);
         const float radius2 = radius * radius;
+        const float outside2 = kOutsideFactor * radius2;
         const float minDistance2 = (kMinDistanceFraction * radius) * (kMinDistanceFraction * radius);
         constexpr int kDim = int(FloatLeaf::DIM);
         alignas(32) float values[kDim * kDim * kColumnRowStride];
@@ -288,8 +291,8 @@ struct RasterizeColumnOp
                         empty |= std::max(0, lo[a]) > std::min(extent[a] - 1, hi[a]);
                     }
                     if (empty) continue;
-                    // The z-vectors: lanes from the first voxel in the column, masked to
-                    // the support's range [lo, hi] (the same voxels in either copy).
+                    // The z-vectors: lanes from the first voxel in the column; lanes outside
+                    // the support's range [lo, hi] get outside2 (the same voxels in either copy).
                     const int zFirst = std::max(0, lo[2]), zLast = std::min(height - 1, hi[2]);
                     span.count = 0;
                     for (int start = zFirst; start <= zLast; start += 8) {
@@ -300,8 +303,7 @@ struct RasterizeColumnOp
                             // Distance from the voxel's own leaf origin, as leaf by leaf.
                             const float pz = p[2] - float(origin[2] + (z & ~(kDim - 1))) * h;
                             const float dz = float(z & (kDim - 1)) * h - pz;
-                            span.dz2[v][l] = dz * dz;
-                            span.keep[v][l] = (z >= lo[2] && z <= hi[2]) ? ~0u : 0u;
+                            span.dz2[v][l] = (z >= lo[2] && z <= hi[2]) ? dz * dz : outside2;
                         }
                     }
                     for (int i = std::max(0, lo[0]); i <= std::min(kDim - 1, hi[0]); ++i) {
@@ -320,12 +322,12 @@ struct RasterizeColumnOp
                             for (int v = 0; v < span.count; ++v) {
 #if NONBLOPPY_HAS_AVX2_COPY
                                 if constexpr (Avx2) {
-                                    addRowVectorAvx2(row + span.start[v], span.dz2[v], span.keep[v], dxy2,
+                                    addRowVectorAvx2(row + span.start[v], span.dz2[v], dxy2,
                                                      radius, minDistance2);
                                     continue;
                                 }
 #endif
-                                addRowVector(row + span.start[v], span.dz2[v], span.keep[v], dxy2, radius,
+                                addRowVector(row + span.start[v], span.dz2[v], dxy2, radius,
                                              minDistance2);
                             }
                         }
