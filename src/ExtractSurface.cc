@@ -153,6 +153,35 @@ LeafRole roleOf(const openvdb::FloatTree& tree, const FloatLeaf& leaf, float iso
     return allBelow ? LeafRole::Below : LeafRole::Above;
 }
 
+/// Turn off every voxel of @a leaf outside @a box, setting it to @a background. Branch-free
+/// over the 512 voxels from per-axis plane flags and the mask's 64-bit words: a shell leaf
+/// of a region is cut this way, and the voxel-by-voxel setValueOff() with a box test per
+/// voxel cost about 2.5 us per leaf (a quarter of the leaves copied on the 64x benchmark
+/// input are shell leaves). Cost: O(512).
+void cutToBox(FloatLeaf& leaf, const openvdb::CoordBBox& box, float background)
+{
+    constexpr int kDim = int(FloatLeaf::DIM);
+    const openvdb::Coord origin = leaf.origin();
+    bool inside[3][kDim];
+    for (int a = 0; a < 3; ++a) {
+        for (int l = 0; l < kDim; ++l) inside[a][l] = box.min()[a] <= origin[a] + l && origin[a] + l <= box.max()[a];
+    }
+    // A row (x, y) of 8 voxels along z keeps the bits of the z-planes inside the box.
+    uint64_t zBits = 0;
+    for (int z = 0; z < kDim; ++z) zBits |= uint64_t(inside[2][z]) << z;
+    float* values = leaf.buffer().data();
+    auto& mask = leaf.getValueMask();
+    for (int x = 0; x < kDim; ++x) {
+        uint64_t keepWord = 0;  // voxels (x, y, z) for all y, z: one word of the mask
+        for (int y = 0; y < kDim; ++y) {
+            if (inside[0][x] && inside[1][y]) keepWord |= zBits << (y * kDim);
+        }
+        mask.template getWord<uint64_t>(openvdb::Index(x)) &= keepWord;
+        float* plane = values + x * kDim * kDim;
+        for (int n = 0; n < kDim * kDim; ++n) plane[n] = (keepWord >> n) & 1 ? plane[n] : background;
+    }
+}
+
 /// One leaf-sized piece of the grid: a leaf, or an active tile of leaf size.
 struct Piece
 {
@@ -465,11 +494,7 @@ bool extractByRegionImpl(const openvdb::FloatGrid& density, double threshold, Su
                 for (size_t k = range.begin(); k < range.end(); ++k) {
                     const FloatLeaf& leaf = *pieces[regionLeaves[k]].leaf;
                     auto* copy = new FloatLeaf(leaf);
-                    if (!keep.isInside(leaf.getNodeBoundingBox())) {  // a shell leaf: cut it
-                        for (openvdb::Index i = 0; i < FloatLeaf::SIZE; ++i) {
-                            if (!keep.isInside(leaf.offsetToGlobalCoord(i))) copy->setValueOff(i, tree.background());
-                        }
-                    }
+                    if (!keep.isInside(leaf.getNodeBoundingBox())) cutToBox(*copy, keep, tree.background());
                     leafCopies[k] = copy;
                 }
             });
