@@ -127,22 +127,26 @@ TEST(ExtractByRegion, ResolvesAmbiguousFacesAtASeamAsTheWholeGridDoes)
     // cell's ambiguous face from the signs of the cell beyond it, so a claimed cell two
     // voxels outside a slab reads a third plane of the shell: with two planes, seams lose
     // quads (it did on the 64x benchmark input, 5 to 10 of 6.6 M).
-    openvdb::FloatGrid::Ptr noise = openvdb::FloatGrid::create(0.0f);
-    noise->setTransform(openvdb::math::Transform::createLinearTransform(kVoxelSize));
-    uint32_t state = 12345u;  // a fixed linear congruential sequence: the same field everywhere
-    auto accessor = noise->getAccessor();
-    for (int i = 0; i < 64; ++i)
-        for (int j = 0; j < 16; ++j)
-            for (int k = 0; k < 16; ++k) {
-                state = state * 1664525u + 1013904223u;
-                accessor.setValue(openvdb::Coord(i, j, k), 2.0f * float(state >> 8) / float(1u << 24));
-            }
-    const std::vector<Quad> expected = canonicalQuads(extractSurface(*noise, 1.0));
-    ASSERT_GT(expected.size(), 10000u);
-    for (const size_t leavesPerRegion : {size_t(1), size_t(8)}) {
-        SurfaceMesh regions;
-        extractByRegion(*noise, 1.0, regions, nullptr, leavesPerRegion, 1);
-        EXPECT_TRUE(canonicalQuads(regions) == expected) << leavesPerRegion << " leaves per region";
+    // Two boxes: slabs along x cut into bands along y, and slabs along z cut into bands
+    // along x, so that the shell of a region is cut on every axis.
+    for (const openvdb::Coord& size : {openvdb::Coord(64, 16, 16), openvdb::Coord(24, 16, 64)}) {
+        openvdb::FloatGrid::Ptr noise = openvdb::FloatGrid::create(0.0f);
+        noise->setTransform(openvdb::math::Transform::createLinearTransform(kVoxelSize));
+        uint32_t state = 12345u;  // a fixed linear congruential sequence: the same field everywhere
+        auto accessor = noise->getAccessor();
+        for (int i = 0; i < size[0]; ++i)
+            for (int j = 0; j < size[1]; ++j)
+                for (int k = 0; k < size[2]; ++k) {
+                    state = state * 1664525u + 1013904223u;
+                    accessor.setValue(openvdb::Coord(i, j, k), 2.0f * float(state >> 8) / float(1u << 24));
+                }
+        const std::vector<Quad> expected = canonicalQuads(extractSurface(*noise, 1.0));
+        ASSERT_GT(expected.size(), 10000u);
+        for (const size_t leavesPerRegion : {size_t(1), size_t(8)}) {
+            SurfaceMesh regions;
+            extractByRegion(*noise, 1.0, regions, nullptr, leavesPerRegion, 1);
+            EXPECT_TRUE(canonicalQuads(regions) == expected) << size << ", " << leavesPerRegion << " leaves per region";
+        }
     }
 }
 
