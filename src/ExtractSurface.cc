@@ -22,6 +22,9 @@
 #include <tbb/task_arena.h>
 
 #include <algorithm>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 #if defined(__GLIBC__)
 #include <malloc.h>
 #endif
@@ -133,13 +136,34 @@ bool neighbourFaceIs(const openvdb::FloatTree& tree, const FloatLeaf& leaf, int 
 LeafRole roleOf(const openvdb::FloatTree& tree, const FloatLeaf& leaf, float iso, float& minValue)
 {
     const float* values = leaf.buffer().data();
-    // Counts rather than min/max: a branch-free loop the compiler vectorises.
     openvdb::Index below = 0;
     float low = values[0];
+#if defined(__SSE2__)
+    // Written out: GCC leaves the plain loop scalar (a compare, a setcc, an add and a minss
+    // per value: 0.5 us per leaf, a third of the collectPieces() pass over the grid).
+    // _mm_min_ps(v, m) is (v < m ? v : m), std::min(m, v) lane by lane.
+    const __m128 isoLanes = _mm_set1_ps(iso);
+    __m128i belowLanes = _mm_setzero_si128();
+    __m128 lowLanes = _mm_set1_ps(low);
+    for (openvdb::Index i = 0; i < FloatLeaf::SIZE; i += 4) {
+        const __m128 v = _mm_loadu_ps(values + i);
+        belowLanes = _mm_sub_epi32(belowLanes, _mm_castps_si128(_mm_cmplt_ps(v, isoLanes)));
+        lowLanes = _mm_min_ps(v, lowLanes);
+    }
+    alignas(16) uint32_t belowOf[4];
+    alignas(16) float lowOf[4];
+    _mm_store_si128(reinterpret_cast<__m128i*>(belowOf), belowLanes);
+    _mm_store_ps(lowOf, lowLanes);
+    for (int l = 0; l < 4; ++l) {
+        below += belowOf[l];
+        low = std::min(low, lowOf[l]);
+    }
+#else
     for (openvdb::Index i = 0; i < FloatLeaf::SIZE; ++i) {
         below += values[i] < iso;
         low = std::min(low, values[i]);
     }
+#endif
     minValue = low;
     const bool allBelow = below == FloatLeaf::SIZE;
     const bool allAbove = below == 0;
