@@ -106,21 +106,18 @@ constexpr int kColumnRowStride = kColumnVoxels + 8;
 
 /// A particle's z-span inside a column, as 8-voxel vectors, each starting at column voxel
 /// @c start, with per-lane squared z-distances that every row of the particle reuses. Lanes
-/// outside the support's z-range hold kOutsideFactor r_e² instead, so their weight is
-/// r_e / (2 r_e) − 1 < 0, clamped to +0: the z-range needs no mask of its own. The z-distance of
-/// a voxel is measured from its own leaf's origin, exactly as a leaf-at-a-time evaluation
-/// would, so the values do not depend on how leaves are grouped into columns.
+/// outside the support's z-range hold an infinite distance instead, as rows outside its disc
+/// do, so their weight r_e/∞ − 1 < 0 is clamped to +0: the z-range needs no mask of its own.
+/// The z-distance of a voxel is measured from its own leaf's origin, exactly as a
+/// leaf-at-a-time evaluation would, so the values do not depend on how leaves are grouped
+/// into columns.
 struct ZSpan
 {
     static constexpr int kMaxVectors = kColumnVoxels / 8;
     int count = 0;                                ///< vectors used: 1 for a span of 8 voxels or fewer
     int start[kMaxVectors] = {};                  ///< first column voxel of each vector
-    alignas(32) float dz2[kMaxVectors][8];        ///< (z_voxel − p_z)² per lane, or kOutsideFactor r_e²
+    alignas(32) float dz2[kMaxVectors][8];        ///< (z_voxel − p_z)² per lane, or +∞ outside the support
 };
-
-/// Squared distance, in units of r_e², given to lanes outside the support's z-range.
-/// Finite: an infinite one would make the same +0 weight, but 4 keeps the inputs ordinary.
-constexpr float kOutsideFactor = 4.0f;
 
 /// The weights w = max(r_e / √max(d², d_min²) − 1, 0) of one 8-lane vector of a row, added to
 /// @a row (lanes beyond r_e add +0, which leaves any sum ≥ +0 as it is). Baseline copy: two SSE
@@ -251,7 +248,6 @@ struct RasterizeColumnOp
         const float invH = 1.0f / h;
         const float radius = float(effectiveRadius);
         const float radius2 = radius * radius;
-        const float outside2 = kOutsideFactor * radius2;
         const float minDistance2 = (kMinDistanceFraction * radius) * (kMinDistanceFraction * radius);
         constexpr int kDim = int(FloatLeaf::DIM);
         alignas(32) float values[kDim * kDim * kColumnRowStride];
@@ -292,7 +288,7 @@ struct RasterizeColumnOp
                     }
                     if (empty) continue;
                     // The z-vectors: lanes from the first voxel in the column; lanes outside
-                    // the support's range [lo, hi] get outside2 (the same voxels in either copy).
+                    // the support's range [lo, hi] get +∞ (the same voxels in either copy).
                     const int zFirst = std::max(0, lo[2]), zLast = std::min(height - 1, hi[2]);
                     span.count = 0;
                     for (int start = zFirst; start <= zLast; start += 8) {
@@ -303,7 +299,8 @@ struct RasterizeColumnOp
                             // Distance from the voxel's own leaf origin, as leaf by leaf.
                             const float pz = p[2] - float(origin[2] + (z & ~(kDim - 1))) * h;
                             const float dz = float(z & (kDim - 1)) * h - pz;
-                            span.dz2[v][l] = (z >= lo[2] && z <= hi[2]) ? dz * dz : outside2;
+                            span.dz2[v][l] = (z >= lo[2] && z <= hi[2]) ? dz * dz
+                                                                        : std::numeric_limits<float>::infinity();
                         }
                     }
                     for (int i = std::max(0, lo[0]); i <= std::min(kDim - 1, hi[0]); ++i) {
