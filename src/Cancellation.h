@@ -88,6 +88,20 @@ private:
 /// @throw CancelledError("interrupted during <poll's stage>")
 void computeNormals(SurfaceMesh& mesh, CancelPoll& poll);
 
+/// calibrateThreshold() asking @a poll before each of its samples of the lattice cell
+/// (resolveParameters() calls it inside "estimate parameters"). Defined in
+/// EstimateParameters.cc.
+/// @throw CancelledError("interrupted during <poll's stage>"), or ParameterError as the
+///        public function
+double calibrateThreshold(double effectiveRadiusOverSpacing, CancelPoll& poll);
+
+/// calibrateRelaxedThreshold() asking @a poll before every relaxation step of a sample
+/// vertex: its cost grows with t, which the caller chooses. Defined in CorrectSurface.cc.
+/// @throw CancelledError("interrupted during <poll's stage>"), or ParameterError as the
+///        public function
+double calibrateRelaxedThreshold(double effectiveRadiusOverSpacing, double blend, int iterations,
+                                 bool* reachesSurface, double maxStepOverSpacing, CancelPoll& poll);
+
 /// Run @a work, parallel TBB code that polls nothing itself (tbb::parallel_sort), under a
 /// TBB context of its own while a helper thread asks @a poll every millisecond and cancels
 /// that context when it says stop: the TBB algorithms inside then skip their remaining

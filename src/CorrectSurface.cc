@@ -80,24 +80,33 @@ openvdb::Vec3d relaxOnLattice(double ratio, double blend, double maxStep, const 
 }
 
 /// Mean height, over the lattice cell, of vertices that start at height @a z0 after
-/// @a iterations relaxation steps of at most @a maxStep.
-double relaxedHeight(double ratio, double blend, double maxStep, int iterations, double z0)
+/// @a iterations relaxation steps of at most @a maxStep. A vertex that a step leaves where it
+/// is stays there, so its remaining steps are skipped (with c = 0.3 after about a hundred,
+/// which bounds the cost of a large t). Asks @a poll before every step.
+double relaxedHeight(double ratio, double blend, double maxStep, int iterations, double z0, CancelPoll& poll)
 {
     double sum = 0.0;
     for (int a = 0; a < kSamples; ++a)
         for (int b = 0; b < kSamples; ++b) {
             openvdb::Vec3d x((a + 0.5) / kSamples, (b + 0.5) / kSamples, z0);
-            for (int t = 0; t < iterations; ++t) x = relaxOnLattice(ratio, blend, maxStep, x);
+            for (int t = 0; t < iterations; ++t) {
+                poll.throwIfStopped();
+                const openvdb::Vec3d next = relaxOnLattice(ratio, blend, maxStep, x);
+                if (next == x) break;
+                x = next;
+            }
             sum += x[2];
         }
     return sum / (kSamples * kSamples);
 }
 
-double planeDensity(double ratio, double z)
+/// Mean density over the lattice cell at height @a z; asks @a poll before every sample.
+double planeDensity(double ratio, double z, CancelPoll& poll)
 {
     double sum = 0.0;
     for (int a = 0; a < kSamples; ++a)
         for (int b = 0; b < kSamples; ++b) {
+            poll.throwIfStopped();
             sum += latticeDensity(ratio, openvdb::Vec3d((a + 0.5) / kSamples, (b + 0.5) / kSamples, z));
         }
     return sum / (kSamples * kSamples);
@@ -254,6 +263,15 @@ void requireNormals(const SurfaceMesh& mesh)
 double calibrateRelaxedThreshold(double effectiveRadiusOverSpacing, double blend, int iterations,
                                  bool* reachesSurface, double maxStepOverSpacing)
 {
+    CancelPoll never(nullptr, "estimate parameters");
+    return cancellation_internal::calibrateRelaxedThreshold(effectiveRadiusOverSpacing, blend, iterations,
+                                                            reachesSurface, maxStepOverSpacing, never);
+}
+
+double cancellation_internal::calibrateRelaxedThreshold(double effectiveRadiusOverSpacing, double blend,
+                                                        int iterations, bool* reachesSurface,
+                                                        double maxStepOverSpacing, CancelPoll& poll)
+{
     if (reachesSurface) *reachesSurface = true;
     const double ratio = effectiveRadiusOverSpacing;
     if (!(blend >= 0.0 && blend <= 1.0)) {
@@ -270,7 +288,7 @@ double calibrateRelaxedThreshold(double effectiveRadiusOverSpacing, double blend
         throw ParameterError(msg.str());
     }
     const double maxStep = maxStepOverSpacing;
-    const double blobThreshold = calibrateThreshold(ratio);  // checks the ratio
+    const double blobThreshold = cancellation_internal::calibrateThreshold(ratio, poll);  // checks the ratio
     if (iterations == 0 || blend == 0.0) return blobThreshold;
 
     // Far from the particles few of them are in reach and relaxation jumps towards them, so
@@ -282,19 +300,19 @@ double calibrateRelaxedThreshold(double effectiveRadiusOverSpacing, double blend
     constexpr double kScanStep = 0.05, kMaxStart = 1.5;
     const double limit = std::min(kMaxStart, 0.75 * ratio);
     double low = 0.5, high = 0.5;
-    while (relaxedHeight(ratio, blend, maxStep, iterations, high) < 0.5) {
+    while (relaxedHeight(ratio, blend, maxStep, iterations, high, poll) < 0.5) {
         low = high;
         high += kScanStep;
         if (high >= limit) {
             if (reachesSurface) *reachesSurface = false;
-            return planeDensity(ratio, limit);
+            return planeDensity(ratio, limit, poll);
         }
     }
     for (int step = 0; step < 24; ++step) {
         const double middle = 0.5 * (low + high);
-        (relaxedHeight(ratio, blend, maxStep, iterations, middle) < 0.5 ? low : high) = middle;
+        (relaxedHeight(ratio, blend, maxStep, iterations, middle, poll) < 0.5 ? low : high) = middle;
     }
-    return planeDensity(ratio, 0.5 * (low + high));
+    return planeDensity(ratio, 0.5 * (low + high), poll);
 }
 
 size_t countFoldedTriangles(const SurfaceMesh& mesh, const std::vector<openvdb::Vec3s>& before)

@@ -234,10 +234,21 @@ double estimateSpacing(const std::vector<openvdb::Vec3f>& positions, size_t maxS
 
 double calibrateThreshold(double effectiveRadiusOverSpacing)
 {
+    CancelPoll never(nullptr, "estimate parameters");
+    return cancellation_internal::calibrateThreshold(effectiveRadiusOverSpacing, never);
+}
+
+double cancellation_internal::calibrateThreshold(double effectiveRadiusOverSpacing, CancelPoll& poll)
+{
     const double ratio = effectiveRadiusOverSpacing;
     if (!(ratio > 0.5) || !std::isfinite(ratio)) {
         throw ParameterError("--radius must exceed half the particle spacing to calibrate --threshold, got " +
                              formatNumber(ratio) + " spacings");
+    }
+    if (ratio > kMaxCalibratedRadiusOverSpacing) {
+        throw ParameterError("--radius must be at most " + formatNumber(kMaxCalibratedRadiusOverSpacing) +
+                             " particle spacings to calibrate --threshold, got " + formatNumber(ratio) +
+                             " spacings; give --threshold");
     }
     // Lattice of unit spacing filling z ≤ 0; average φ over the plane z = 1/2 by sampling one
     // lattice cell on a regular grid.
@@ -246,6 +257,7 @@ double calibrateThreshold(double effectiveRadiusOverSpacing)
     double sum = 0.0;
     for (int sx = 0; sx < kSamples; ++sx) {
         for (int sy = 0; sy < kSamples; ++sy) {
+            poll.throwIfStopped();  // a sample is up to ~10⁵ evaluations (1 ms) at the limit
             const double x = (sx + 0.5) / kSamples, y = (sy + 0.5) / kSamples, z = 0.5;
             for (int i = -reach; i <= reach + 1; ++i) {
                 for (int j = -reach; j <= reach + 1; ++j) {
@@ -306,6 +318,13 @@ ResolvedParameters resolveParametersWith(const SurfaceParameters& params, const 
     out.effectiveRadius = params.effectiveRadius ? *params.effectiveRadius
                                                  : kDefaultRadiusOverSpacing * out.spacing;
     out.voxelSize = params.voxelSize ? *params.voxelSize : kDefaultVoxelOverSpacing * out.spacing;
+    // The grid holds (2 r_e / h)³ voxels per particle: refuse sizes that would exhaust memory,
+    // before the threshold's calibration, whose cost grows as (r_e/s)³.
+    constexpr double kMaxVoxelsPerRadius = 32.0;
+    if (out.effectiveRadius / out.voxelSize > kMaxVoxelsPerRadius) {
+        throw ParameterError("--voxel-size " + formatNumber(out.voxelSize) + " is too small for --radius " +
+                             formatNumber(out.effectiveRadius) + ": at most 32 voxels per radius");
+    }
     out.method = params.method;
     const bool faithful = params.method == Method::Faithful;
     if (faithful) {
@@ -316,11 +335,10 @@ ResolvedParameters resolveParametersWith(const SurfaceParameters& params, const 
     }
     bool calibratedForRelaxedSurface = false;
     if (params.threshold) out.threshold = *params.threshold;
-    else if (faithful) out.threshold = calibrateRelaxedThreshold(out.effectiveRadius / out.spacing,
-                                                                 out.blend, out.iterations,
-                                                                 &calibratedForRelaxedSurface,
-                                                                 out.maxStep / out.spacing);
-    else out.threshold = calibrateThreshold(out.effectiveRadius / out.spacing);
+    else if (faithful) out.threshold = cancellation_internal::calibrateRelaxedThreshold(
+                           out.effectiveRadius / out.spacing, out.blend, out.iterations,
+                           &calibratedForRelaxedSurface, out.maxStep / out.spacing, poll);
+    else out.threshold = cancellation_internal::calibrateThreshold(out.effectiveRadius / out.spacing, poll);
     out.thresholdReachesSurface = params.threshold || !faithful || calibratedForRelaxedSurface;
     if (faithful) {
         out.preserveVolume = params.preserveVolume ? *params.preserveVolume : out.spacingGiven;
@@ -336,12 +354,6 @@ ResolvedParameters resolveParametersWith(const SurfaceParameters& params, const 
     }
 
     poll.throwIfStopped();
-    // The grid holds (2 r_e / h)³ voxels per particle: refuse sizes that would exhaust memory.
-    constexpr double kMaxVoxelsPerRadius = 32.0;
-    if (out.effectiveRadius / out.voxelSize > kMaxVoxelsPerRadius) {
-        throw ParameterError("--voxel-size " + formatNumber(out.voxelSize) + " is too small for --radius " +
-                             formatNumber(out.effectiveRadius) + ": at most 32 voxels per radius");
-    }
     return out;
 }
 

@@ -154,6 +154,8 @@ struct RelaxGroupsOp
             next.resize(end - begin);
             for (size_t n = begin; n < end; ++n) current[n - begin] = points[vertexOrder[n]];
             for (int iteration = 0; iteration < iterations; ++iteration) {
+                // A large t keeps one group busy for long: poll within it too.
+                if (iteration > 0 && iteration % kGroupsPerPoll == 0 && poll.stopped()) return;
                 step(current, next, positions, accessor, cellSize, radius, minDistance2, candidates);
                 current.swap(next);
             }

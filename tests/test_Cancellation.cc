@@ -174,6 +174,27 @@ TEST(Cancellation, StageFunctionsThrowTheirStagesMessage)
               "interrupted during correct surface");
 }
 
+TEST(Cancellation, ThresholdCalibrationStopsWithinALargeIterationCount)
+{
+    // Calibrating r_0 relaxes sample vertices t times each; with so small a blend they never
+    // settle, so t = 2³⁰ would take years unless the calibration itself polls.
+    // The stop comes after twice the polls of a whole calibration at t = 2: beyond any
+    // poll outside the relaxation steps.
+    const auto frame = ballFrame(0.5);
+    SurfaceParameters params;
+    params.spacing = 0.1;
+    params.blend = 1e-6;
+    params.iterations = 2;
+    StopAfterPolls counter(0);
+    resolveParameters(params, frame, &counter);
+    const long limit = 2 * counter.polls + 10;
+    params.iterations = 1 << 30;
+    StopAfterPolls stop(limit);
+    EXPECT_EQ(cancelMessage([&] { resolveParameters(params, frame, &stop); }),
+              "interrupted during estimate parameters");
+    EXPECT_GE(stop.polls, limit);
+}
+
 TEST(Cancellation, AnInterrupterThatNeverFiresChangesNoByte)
 {
     const auto frame = ballFrame(0.6);

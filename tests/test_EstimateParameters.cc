@@ -89,6 +89,8 @@ TEST(EstimateParameters, ThresholdGrowsWithTheRadius)
     EXPECT_GT(calibrateThreshold(3.0), calibrateThreshold(2.0));
     EXPECT_GT(calibrateThreshold(2.0), 0.0);
     EXPECT_THROW(calibrateThreshold(0.5), ParameterError);
+    EXPECT_THROW(calibrateThreshold(32.5), ParameterError);
+    EXPECT_THROW(calibrateRelaxedThreshold(32.5, 0.3, 2), ParameterError);
 }
 
 TEST(EstimateParameters, AnIndexOfAnyCellSizeServesTheEstimate)
@@ -177,6 +179,20 @@ TEST(EstimateParameters, ResolveReportsWhatWasGivenAndChecksRanges)
     bad.spacing = 0.05;
     bad.voxelSize = 0.0001;
     expectMessage(bad, "--voxel-size 0.0001 is too small for --radius 0.1: at most 32 voxels per radius");
+    // Checked before r_0 is calibrated, which at r_e = 1000 s would take hours.
+    bad = SurfaceParameters();
+    bad.spacing = 0.05;
+    bad.effectiveRadius = 50.0;
+    expectMessage(bad, "--voxel-size 0.025 is too small for --radius 50: at most 32 voxels per radius");
+    bad.voxelSize = 2.0;
+    expectMessage(bad, "--radius must be at most 32 particle spacings to calibrate --threshold, got 1000 "
+                       "spacings; give --threshold");
+    bad.effectiveRadius = 1.65;
+    bad.voxelSize = 0.06;
+    expectMessage(bad, "--radius must be at most 32 particle spacings to calibrate --threshold, got 33 "
+                       "spacings; give --threshold");
+    bad.threshold = 1.0;  // given: nothing to calibrate, any width
+    EXPECT_DOUBLE_EQ(resolveParameters(bad, ball).threshold, 1.0);
     try {
         resolveParameters(SurfaceParameters(), {});
         ADD_FAILURE() << "no particles accepted";

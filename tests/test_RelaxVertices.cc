@@ -215,6 +215,34 @@ TEST(RelaxVertices, AStopLeavesEachVertexWhereItWasOrFullyRelaxed)
     EXPECT_GT(finished, 0u);
 }
 
+TEST(RelaxVertices, StopsWithinTheStepsOfOneGroup)
+{
+    // Each vertex group takes all its steps before the next group starts: with t = 2³⁰, a
+    // stop must be heard between the steps of one group, not only between groups.
+    // The stop comes after twice the polls of a whole run at t = 1: beyond any poll before
+    // the steps or between groups.
+    OneParticle one;
+    struct StopAfterPolls : openvdb::util::NullInterrupter
+    {
+        explicit StopAfterPolls(long n) : limit(n) {}
+        bool wasInterrupted(int = -1) override { return ++polls >= limit && limit > 0; }
+        long limit;
+        std::atomic<long> polls{0};
+    };
+    StopAfterPolls counter(0);
+    SurfaceMesh mesh = one.mesh;
+    relaxVertices(mesh, one.index, relaxSettings(0.3, 1), &counter);
+    StopAfterPolls stop(2 * counter.polls + 10);
+    mesh = one.mesh;
+    try {
+        relaxVertices(mesh, one.index, relaxSettings(0.3, 1 << 30), &stop);
+        ADD_FAILURE() << "not stopped";
+    } catch (const CancelledError& e) {
+        EXPECT_STREQ(e.what(), "interrupted during relax vertices");
+    }
+    EXPECT_GE(stop.polls, stop.limit);
+}
+
 TEST(RelaxVertices, RejectsBadSettings)
 {
     OneParticle one;

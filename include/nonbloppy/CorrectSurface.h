@@ -33,7 +33,8 @@ namespace nonbloppy {
 /// would need to start farther out (c = 0.5, t = 2 would start 1.9 s out and merge fluid
 /// bodies 4 s apart) get the threshold of that limit and end inside the true surface.
 /// The result depends only on r_e/s, c, t and the cap. Cost: about 10⁵ kernel evaluations
-/// (2 ms at r_e = 2.1 s).
+/// (2 ms at r_e = 2.1 s), growing as (r_e/s)³ and with t, up to the step where a sample
+/// vertex stops moving.
 /// Thread-safety: reentrant.
 /// @param effectiveRadiusOverSpacing  r_e / s, > 0.5
 /// @param blend           c in [0,1]
@@ -45,8 +46,8 @@ namespace nonbloppy {
 ///                        steps as the mesh will: a start 1.4 s out (r_e = 2 s, c = 0.4,
 ///                        t = 2) needs steps longer than the default cap of s/2, and
 ///                        calibrating for uncapped ones left the box's faces 0.09 s off.
-/// @throw ParameterError if @a effectiveRadiusOverSpacing ≤ 0.5, c outside [0,1], t < 0 or
-///        @a maxStepOverSpacing < 0.
+/// @throw ParameterError if @a effectiveRadiusOverSpacing ≤ 0.5 or above
+///        kMaxCalibratedRadiusOverSpacing, c outside [0,1], t < 0 or @a maxStepOverSpacing < 0.
 NONBLOPPY_API double calibrateRelaxedThreshold(double effectiveRadiusOverSpacing, double blend,
                                                int iterations, bool* reachesSurface = nullptr,
                                                double maxStepOverSpacing = 0.0);
