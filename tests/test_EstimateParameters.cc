@@ -40,6 +40,19 @@ TEST(EstimateParameters, SpacingOfASheetIsTheNearestNeighbourDistance)
     EXPECT_LT(spacing, 0.095);
 }
 
+TEST(EstimateParameters, SpacingOfAFlatSheetAndOfALineIsTheirStep)
+{
+    // Exactly flat (or straight): the bounding box has no volume (or area), so the first
+    // guess comes from the area (or length) per particle.
+    std::vector<openvdb::Vec3f> sheet, line;
+    for (int i = 0; i < 60; ++i) {
+        for (int j = 0; j < 60; ++j) sheet.emplace_back(0.05f * float(i), 0.05f * float(j), 1.0f);
+        line.emplace_back(2.0f, 0.05f * float(i), 1.0f);
+    }
+    EXPECT_NEAR(estimateSpacing(sheet), 0.05, 1e-6);
+    EXPECT_NEAR(estimateSpacing(line), 0.05, 1e-6);
+}
+
 TEST(EstimateParameters, SpacingOfSplishSplashFramesIsTheirVolumePerParticle)
 {
     // SPlisHSPlasH gives each particle of radius r the volume 0.8·(2r)³: s = 0.0464 for
