@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "Cancellation.h"
 #include "ParticleIndexImpl.h"
+#include "SurfaceStages.h"
 
 #include <nonbloppy/CorrectSurface.h>
 #include <nonbloppy/Error.h>
@@ -220,7 +221,9 @@ double estimateSpacingWith(const std::vector<openvdb::Vec3f>& positions, const P
     if (shared) return estimateSpacingOf(*shared, guess, maxSamples, poll);
     ParticleIndex index;
     try {
-        index = ParticleIndex::build(positions, guess, interrupter);
+        // Cells no smaller than OpenVDB allows: the estimate still works (on wider cells),
+        // and the caller then names the voxel size it implies.
+        index = ParticleIndex::build(positions, std::max(guess, kMinCellSize), interrupter);
     } catch (const CancelledError&) {
         throw CancelledError(std::string("interrupted during ") + poll.stage());  // this stage's name
     }
@@ -322,6 +325,10 @@ ResolvedParameters resolveParametersWith(const SurfaceParameters& params, const 
     out.effectiveRadius = params.effectiveRadius ? *params.effectiveRadius
                                                  : kDefaultRadiusOverSpacing * out.spacing;
     out.voxelSize = params.voxelSize ? *params.voxelSize : kDefaultVoxelOverSpacing * out.spacing;
+    // OpenVDB's smallest voxel, and index cell (kCellOverRadius·r_e).
+    using surface_stages_internal::requireOpenVdbScale;
+    requireOpenVdbScale(out.voxelSize, kMinCellSize, "--voxel-size");
+    requireOpenVdbScale(out.effectiveRadius, kMinCellSize / surface_stages_internal::kCellOverRadius, "--radius");
     // The grid holds (2 r_e / h)³ voxels per particle: refuse sizes that would exhaust memory,
     // before the threshold's calibration, whose cost grows as (r_e/s)³.
     constexpr double kMaxVoxelsPerRadius = 32.0;

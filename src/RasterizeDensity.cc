@@ -369,6 +369,12 @@ openvdb::FloatGrid::Ptr instruction_set_internal::rasterizeDensity(const Particl
             msg << "--voxel-size must be > 0, got " << settings.voxelSize;
             throw ParameterError(msg.str());
         }
+        if (settings.voxelSize < kMinCellSize) {
+            std::ostringstream msg;
+            msg << "--voxel-size " << settings.voxelSize << " is below " << kMinCellSize
+                << ", the smallest OpenVDB accepts: give the positions in a smaller unit";
+            throw ParameterError(msg.str());
+        }
         transform = openvdb::math::Transform::createLinearTransform(settings.voxelSize);
     } else if (transform->baseMap()->type() != openvdb::math::UniformScaleMap::mapType()) {
         throw ParameterError("rasterizeDensity needs a uniform-scale transform without translation or rotation");

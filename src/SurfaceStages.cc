@@ -16,6 +16,7 @@
 #include <nonbloppy/Version.h>
 
 #include <cmath>
+#include <sstream>
 #include <string>
 
 namespace nonbloppy {
@@ -24,6 +25,16 @@ namespace surface_stages_internal {
 void checkCancelled(openvdb::util::NullInterrupter* interrupter, const char* stage)
 {
     cancellation_internal::CancelPoll(interrupter, stage).throwIfStopped();
+}
+
+void requireOpenVdbScale(double value, double least, const char* name)
+{
+    if (value < least) {
+        std::ostringstream msg;
+        msg << name << " " << value << " is below " << least
+            << ", the smallest OpenVDB accepts: give the positions in a smaller unit";
+        throw ParameterError(msg.str());
+    }
 }
 
 void resolveAndIndex(const SurfaceParameters& params, const ResolvedParameters* kept,
@@ -39,7 +50,10 @@ void resolveAndIndex(const SurfaceParameters& params, const ResolvedParameters* 
     };
     const bool indexFirst = !kept && params.effectiveRadius && *params.effectiveRadius > 0.0
                             && std::isfinite(*params.effectiveRadius);
-    if (indexFirst) indexParticles(*params.effectiveRadius);
+    if (indexFirst) {
+        requireOpenVdbScale(*params.effectiveRadius, kMinCellSize / kCellOverRadius, "--radius");
+        indexParticles(*params.effectiveRadius);
+    }
     {
         StageScope scope(result.timings, interrupter, "estimate parameters");
         result.parameters = kept ? *kept

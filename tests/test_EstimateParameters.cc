@@ -53,6 +53,14 @@ TEST(EstimateParameters, SpacingOfAFlatSheetAndOfALineIsTheirStep)
     EXPECT_NEAR(estimateSpacing(line), 0.05, 1e-6);
 }
 
+TEST(EstimateParameters, SpacingOfMicrometreParticlesIsEstimatedOnCellsOpenVdbAccepts)
+{
+    // A lattice spaced 1 µm, in metres: its first guess (1e-6) is below OpenVDB's smallest
+    // cell, so the estimate's index uses that smallest cell; the spacing is still found.
+    const auto box = latticeParticles(1e-6, 1e-5, [](const openvdb::Vec3d&) { return true; });
+    EXPECT_NEAR(estimateSpacing(box), 1e-6, 0.005 * 1e-6);  // the smooth count: within 0.5% on lattices
+}
+
 TEST(EstimateParameters, SpacingOfSplishSplashFramesIsTheirVolumePerParticle)
 {
     // SPlisHSPlasH gives each particle of radius r the volume 0.8·(2r)³: s = 0.0464 for
@@ -206,6 +214,15 @@ TEST(EstimateParameters, ResolveReportsWhatWasGivenAndChecksRanges)
                        "spacings; give --threshold");
     bad.threshold = 1.0;  // given: nothing to calibrate, any width
     EXPECT_DOUBLE_EQ(resolveParameters(bad, ball).threshold, 1.0);
+    // Below OpenVDB's smallest voxel and index cell (positions in metres, spacing 1 µm).
+    bad = SurfaceParameters();
+    bad.spacing = 1e-6;
+    expectMessage(bad, "--voxel-size 5e-07 is below 1.5e-05, the smallest OpenVDB accepts: give the positions "
+                       "in a smaller unit");
+    bad.voxelSize = 2e-5;
+    bad.effectiveRadius = 2e-5;
+    expectMessage(bad, "--radius 2e-05 is below 3e-05, the smallest OpenVDB accepts: give the positions in a "
+                       "smaller unit");
     try {
         resolveParameters(SurfaceParameters(), {});
         ADD_FAILURE() << "no particles accepted";

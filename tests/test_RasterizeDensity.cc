@@ -143,6 +143,24 @@ TEST(RasterizeDensity, RejectsBadSettings)
     } catch (const ParameterError& e) {
         EXPECT_STREQ(e.what(), "--voxel-size must be > 0, got -0.5");
     }
+    // OpenVDB's transforms refuse such a scale with "Non-zero scale values required".
+    settings.voxelSize = 1e-6;
+    try {
+        rasterizeDensity(index, settings);
+        FAIL() << "h below OpenVDB's smallest accepted";
+    } catch (const ParameterError& e) {
+        EXPECT_STREQ(e.what(),
+                     "--voxel-size 1e-06 is below 1.5e-05, the smallest OpenVDB accepts: give the positions in a "
+                     "smaller unit");
+    }
+    try {
+        ParticleIndex::build({openvdb::Vec3f(0.0f)}, 1e-6);
+        FAIL() << "cell below OpenVDB's smallest accepted";
+    } catch (const ParameterError& e) {
+        EXPECT_STREQ(e.what(),
+                     "particle index cell size 1e-06 is below 1.5e-05, the smallest OpenVDB accepts: give the "
+                     "positions in a smaller unit");
+    }
 }
 
 TEST(ParticleIndex, KeepsEveryParticleOnceAndMapsBackToTheOriginal)

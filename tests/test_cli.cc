@@ -265,6 +265,9 @@ TEST_F(CliTest, BadParameters)
     expectFailure(base + "--spacing 0.05 --radius 50 --voxel-size 2",
                   "--radius must be at most 32 particle spacings to calibrate --threshold, got 1000 spacings; "
                   "give --threshold");
+    expectFailure(base + "--spacing 1e-6",
+                  "--voxel-size 5e-07 is below 1.5e-05, the smallest OpenVDB accepts: give the positions in a "
+                  "smaller unit");
 }
 
 TEST_F(CliTest, NegativeValuesWithSpace)

@@ -27,6 +27,11 @@
 
 namespace nonbloppy {
 
+/// Smallest index cell and density voxel, world units: OpenVDB's linear transforms refuse a
+/// scale whose cube is below 3e-15 ("Non-zero scale values required"). Positions in metres
+/// of particles spaced a micrometre apart need a smaller unit (millimetres) to be meshed.
+constexpr double kMinCellSize = 1.5e-5;
+
 /// Particles bucketed into cubic cells of a PointIndexGrid.
 /// Memory: 16 bytes per particle (float position + uint32 original index) plus the grid.
 /// Thread-safe for concurrent reading once built.
@@ -46,7 +51,7 @@ public:
     /// Bucket @a positions (world units, taken over and reordered) into cells of
     /// @a cellSize world units. Cost: O(N) time (parallel radix partitioning by OpenVDB).
     /// @param positions    world units; taken over (reordered into the index's own array)
-    /// @param cellSize     cell edge, world units, > 0
+    /// @param cellSize     cell edge, world units, ≥ kMinCellSize
     /// @param interrupter  optional; asked every 4096 particles of the checks and once per
     ///                     index leaf while slots are assigned, not during OpenVDB's
     ///                     partitioning (createPointIndexGrid takes no interrupter, and
@@ -54,7 +59,7 @@ public:
     ///                     partial counts); no start()/end() (buildSurface() announces
     ///                     "index particles")
     /// Thread-safety: reentrant.
-    /// @throw ParameterError if cellSize ≤ 0 or a position is not finite;
+    /// @throw ParameterError if cellSize < kMinCellSize or a position is not finite;
     ///        CancelledError("interrupted during index particles") when @a interrupter says stop.
     static ParticleIndex build(std::vector<openvdb::Vec3f> positions, double cellSize,
                                openvdb::util::NullInterrupter* interrupter = nullptr);
