@@ -362,6 +362,11 @@ ResolvedParameters resolveParametersWith(const SurfaceParameters& params, const 
         if ((out.preserveVolume || out.smoothSurface) && !(out.spacing > 0.0)) {
             out.spacing = estimateSpacingWith(positions, shared, kSpacingSamples, poll, interrupter);
         }
+        const double volume = double(positions.size()) * out.spacing * out.spacing * out.spacing;
+        if (out.preserveVolume && !std::isfinite(volume)) {
+            throw ParameterError("--spacing " + formatNumber(out.spacing) + " is too large: the fluid's volume N s^3 (N = " +
+                                 std::to_string(positions.size()) + ") is not a finite number");
+        }
     }
 
     poll.throwIfStopped();

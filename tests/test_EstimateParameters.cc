@@ -214,6 +214,10 @@ TEST(EstimateParameters, ResolveReportsWhatWasGivenAndChecksRanges)
                        "spacings; give --threshold");
     bad.threshold = 1.0;  // given: nothing to calibrate, any width
     EXPECT_DOUBLE_EQ(resolveParameters(bad, ball).threshold, 1.0);
+    // The volume correction's target N·s³ overflows.
+    bad = SurfaceParameters();
+    bad.spacing = 1e300;
+    expectMessage(bad, "--spacing 1e+300 is too large: the fluid's volume N s^3 (N = 485) is not a finite number");
     // Below OpenVDB's smallest voxel and index cell (positions in metres, spacing 1 µm).
     bad = SurfaceParameters();
     bad.spacing = 1e-6;
