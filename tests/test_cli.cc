@@ -321,6 +321,19 @@ TEST_F(CliTest, InspectUnknownExtension)
                            "or .json\n");
 }
 
+TEST_F(CliTest, InspectBrokenMeshIsNotCalledAParticleFile)
+{
+    // Its vertices alone would read as three particles.
+    const std::string path = in("broken.ply");
+    writeText(path, "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+                    "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n"
+                    "0 0 0\n1 0 0\n0 1 0\n3 0 1 7\n");
+    const RunResult r = run("inspect " + quote(path));
+    EXPECT_EQ(r.exitCode, 1);
+    EXPECT_EQ(r.err, "nonbloppy: polygon 0 references vertex 7 but the file has 3 vertices (" + path + ")\n");
+    EXPECT_EQ(r.out, "");
+}
+
 TEST_F(CliTest, UsageErrorsAreOneLine)
 {
     for (const std::string& args : {std::string(""), std::string("mesh"),

@@ -462,8 +462,11 @@ int runInspect(const std::string& path, bool json)
         try {
             nonbloppy::SurfaceMesh mesh = nonbloppy::readMesh(path);
             if (mesh.polygonCount() > 0) return inspectMesh(path, mesh, json);
-        } catch (const nonbloppy::FileError&) {
+        } catch (const nonbloppy::FileError& e) {
             // Not a mesh (e.g. UNSTRUCTURED_GRID): read it as particles, whose error counts.
+            // A polygon list that is there but broken, though, makes a broken mesh, not a
+            // particle file (its vertices would read as particles).
+            if (std::strncmp(e.what(), "polygon ", 8) == 0) throw;
         }
     }
     if (nonbloppy::isParticleFile(path)) {
