@@ -49,9 +49,9 @@ NONBLOPPY_API double estimateSpacing(const std::vector<openvdb::Vec3f>& position
 
 /// Widest kernel, in particle spacings (r_e/s), for which calibrateThreshold() and
 /// calibrateRelaxedThreshold() compute r_0: their lattice sums grow as (r_e/s)³, to 1.5 s
-/// at this limit for the default t = 2 on the benchmark machine; a wider kernel, which
-/// reaches across tens of thousands of particles, needs r_0 given (--threshold). With the default voxel size h = s/2, the limit
-/// of 32 voxels per radius already stops r_e at 16 s.
+/// at this limit for the default t = 2 on the benchmark machine. A wider kernel, which
+/// reaches across tens of thousands of particles, needs r_0 given (--threshold). With the
+/// default voxel size h = s/2, the limit of 32 voxels per radius already stops r_e at 16 s.
 constexpr double kMaxCalibratedRadiusOverSpacing = 32.0;
 
 /// The iso-value r_0 for which a flat, uniform half-space of particles on a cubic lattice of
