@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "Cancellation.h"
+#include "OpenVdbScale.h"
 #include "ParticleIndexImpl.h"
 #include "SurfaceStages.h"
 
@@ -326,7 +327,7 @@ ResolvedParameters resolveParametersWith(const SurfaceParameters& params, const 
                                                  : kDefaultRadiusOverSpacing * out.spacing;
     out.voxelSize = params.voxelSize ? *params.voxelSize : kDefaultVoxelOverSpacing * out.spacing;
     // OpenVDB's smallest voxel, and index cell (kCellOverRadius·r_e).
-    using surface_stages_internal::requireOpenVdbScale;
+    using openvdb_scale_internal::requireOpenVdbScale;
     requireOpenVdbScale(out.voxelSize, kMinCellSize, "--voxel-size");
     requireOpenVdbScale(out.effectiveRadius, kMinCellSize / surface_stages_internal::kCellOverRadius, "--radius");
     // The grid holds (2 r_e / h)³ voxels per particle: refuse sizes that would exhaust memory,

@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "Cancellation.h"
+#include "OpenVdbScale.h"
 #include "ParticleIndexImpl.h"
 
 #include <nonbloppy/Error.h>
@@ -65,12 +66,7 @@ ParticleIndex ParticleIndex::build(std::vector<openvdb::Vec3f> positions, double
         msg << "particle index cell size must be > 0, got " << cellSize;
         throw ParameterError(msg.str());
     }
-    if (cellSize < kMinCellSize) {
-        std::ostringstream msg;
-        msg << "particle index cell size " << cellSize << " is below " << kMinCellSize
-            << ", the smallest OpenVDB accepts: give the positions in a smaller unit";
-        throw ParameterError(msg.str());
-    }
+    openvdb_scale_internal::requireOpenVdbScale(cellSize, kMinCellSize, "particle index cell size");
     if (positions.size() > size_t(std::numeric_limits<uint32_t>::max())) {
         throw ParameterError("too many particles: at most 4294967295 are supported");
     }

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "Cancellation.h"
 #include "InstructionSet.h"
+#include "OpenVdbScale.h"
 #include "ParticleIndexImpl.h"
 
 #include <nonbloppy/Error.h>
@@ -369,12 +370,7 @@ openvdb::FloatGrid::Ptr instruction_set_internal::rasterizeDensity(const Particl
             msg << "--voxel-size must be > 0, got " << settings.voxelSize;
             throw ParameterError(msg.str());
         }
-        if (settings.voxelSize < kMinCellSize) {
-            std::ostringstream msg;
-            msg << "--voxel-size " << settings.voxelSize << " is below " << kMinCellSize
-                << ", the smallest OpenVDB accepts: give the positions in a smaller unit";
-            throw ParameterError(msg.str());
-        }
+        openvdb_scale_internal::requireOpenVdbScale(settings.voxelSize, kMinCellSize, "--voxel-size");
         transform = openvdb::math::Transform::createLinearTransform(settings.voxelSize);
     } else if (transform->baseMap()->type() != openvdb::math::UniformScaleMap::mapType()) {
         throw ParameterError("rasterizeDensity needs a uniform-scale transform without translation or rotation");

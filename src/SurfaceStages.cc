@@ -5,6 +5,7 @@
 #include "SurfaceStages.h"
 
 #include "Cancellation.h"
+#include "OpenVdbScale.h"
 
 #include <nonbloppy/ComputeNormals.h>
 #include <nonbloppy/CorrectSurface.h>
@@ -16,7 +17,6 @@
 #include <nonbloppy/Version.h>
 
 #include <cmath>
-#include <sstream>
 #include <string>
 
 namespace nonbloppy {
@@ -25,16 +25,6 @@ namespace surface_stages_internal {
 void checkCancelled(openvdb::util::NullInterrupter* interrupter, const char* stage)
 {
     cancellation_internal::CancelPoll(interrupter, stage).throwIfStopped();
-}
-
-void requireOpenVdbScale(double value, double least, const char* name)
-{
-    if (value < least) {
-        std::ostringstream msg;
-        msg << name << " " << value << " is below " << least
-            << ", the smallest OpenVDB accepts: give the positions in a smaller unit";
-        throw ParameterError(msg.str());
-    }
 }
 
 void resolveAndIndex(const SurfaceParameters& params, const ResolvedParameters* kept,
@@ -51,7 +41,7 @@ void resolveAndIndex(const SurfaceParameters& params, const ResolvedParameters* 
     const bool indexFirst = !kept && params.effectiveRadius && *params.effectiveRadius > 0.0
                             && std::isfinite(*params.effectiveRadius);
     if (indexFirst) {
-        requireOpenVdbScale(*params.effectiveRadius, kMinCellSize / kCellOverRadius, "--radius");
+        openvdb_scale_internal::requireOpenVdbScale(*params.effectiveRadius, kMinCellSize / kCellOverRadius, "--radius");
         indexParticles(*params.effectiveRadius);
     }
     {

@@ -24,11 +24,6 @@ namespace surface_stages_internal {
 /// cells of r_e (three per axis, 27 r_e³ visited for a 4.2 r_e³ sphere).
 constexpr double kCellOverRadius = 0.5;
 
-/// Throw ParameterError("<name> <value> is below <least>, the smallest OpenVDB accepts: ...")
-/// if @a value < @a least: for the voxel size (least kMinCellSize) and r_e (least
-/// kMinCellSize / kCellOverRadius, for the index's cells), before any grid is made.
-void requireOpenVdbScale(double value, double least, const char* name);
-
 /// Throw CancelledError("interrupted during <stage>") if @a interrupter (may be null) asks to
 /// stop. Cost: one wasInterrupted() call. Thread-safety: as the interrupter's.
 void checkCancelled(openvdb::util::NullInterrupter* interrupter, const char* stage);

@@ -1,0 +1,33 @@
+// SPDX-License-Identifier: Apache-2.0
+/// @file OpenVdbScale.h
+/// @brief Private: the one check, and the one message, for lengths below the smallest voxel
+///        or cell OpenVDB's linear transforms accept (kMinCellSize). Only src/ includes it.
+
+#ifndef NONBLOPPY_OPENVDB_SCALE_H
+#define NONBLOPPY_OPENVDB_SCALE_H
+
+#include <nonbloppy/Error.h>
+
+#include <sstream>
+
+namespace nonbloppy {
+namespace openvdb_scale_internal {
+
+/// Throw ParameterError("<name> <value> is below <least>, the smallest OpenVDB accepts: give
+/// the positions in a smaller unit") if @a value < @a least. Called before any grid is made:
+/// for the voxel size and the index's cells (least kMinCellSize), and for r_e when it sets
+/// the index's cells (least kMinCellSize / kCellOverRadius).
+inline void requireOpenVdbScale(double value, double least, const char* name)
+{
+    if (value < least) {
+        std::ostringstream msg;
+        msg << name << " " << value << " is below " << least
+            << ", the smallest OpenVDB accepts: give the positions in a smaller unit";
+        throw ParameterError(msg.str());
+    }
+}
+
+} // namespace openvdb_scale_internal
+} // namespace nonbloppy
+
+#endif // NONBLOPPY_OPENVDB_SCALE_H
