@@ -29,6 +29,9 @@ constexpr size_t kLanes = 8;
 /// Vertex groups of a task between two polls: each group gathers its candidate particles
 /// and sums over them for every vertex, so a task of many groups runs for milliseconds.
 constexpr size_t kGroupsPerPoll = 16;
+/// Steps of one group between two polls: with a large t one group takes many, each of them
+/// one candidate gather and one sum per vertex.
+constexpr int kStepsPerPoll = 16;
 /// Edge of the cells vertices are grouped by, in particle-index cells. Larger groups share one
 /// gather among more vertices but give each a longer candidate list. 64x benchmark input,
 /// relax stage (t = 2), groups bounded by their vertices' box, one thread / two: 2 cells
@@ -154,8 +157,7 @@ struct RelaxGroupsOp
             next.resize(end - begin);
             for (size_t n = begin; n < end; ++n) current[n - begin] = points[vertexOrder[n]];
             for (int iteration = 0; iteration < iterations; ++iteration) {
-                // A large t keeps one group busy for long: poll within it too.
-                if (iteration > 0 && iteration % kGroupsPerPoll == 0 && poll.stopped()) return;
+                if (iteration > 0 && iteration % kStepsPerPoll == 0 && poll.stopped()) return;
                 step(current, next, positions, accessor, cellSize, radius, minDistance2, candidates);
                 current.swap(next);
             }
