@@ -599,6 +599,10 @@ public:
                 havePoints = true;
             } else if (key == "CELLS" || key == "VERTICES" || key == "LINES" ||
                        key == "POLYGONS" || key == "TRIANGLE_STRIPS") {
+                uint64_t cells = 0;
+                if (key == "POLYGONS" && words.size() == 3 && parseCount(words[1], cells) && cells > 0) {
+                    mSawPolygons = true;
+                }
                 readCells(key, words);
             } else if (key == "CELL_TYPES") {
                 requireWords(words, 2);
@@ -904,6 +908,14 @@ private:
     bool mInCellData = false;
     uint64_t mTupleCount = 0;
     VtkData mData;
+
+public:
+    /// Whether parse() reached a POLYGONS section header declaring at least one polygon
+    /// (true even if the section's data then failed to decode).
+    bool sawPolygons() const { return mSawPolygons; }
+
+private:
+    bool mSawPolygons = false;
 };
 
 } // namespace
@@ -919,6 +931,19 @@ parseVtk(const char* data, size_t size, const std::string& path, bool wantPolygo
 {
     Cursor cursor(data, size);
     return parseVtk(cursor, path, wantPolygons);
+}
+
+bool
+vtkDeclaresPolygons(const char* data, size_t size, const std::string& path)
+{
+    Cursor cursor(data, size);
+    VtkParser parser(cursor, path, /*wantPolygons=*/false);
+    try {
+        parser.parse();
+    } catch (const FileError&) {
+        // Broken before or after its POLYGONS header: what was seen until then decides.
+    }
+    return parser.sawPolygons();
 }
 
 // ------------------------------------------------------------------------------------------
@@ -1182,6 +1207,37 @@ parsePly(const char* data, size_t size, const std::string& path, bool wantFaces)
 {
     Cursor cursor(data, size);
     return PlyParser(cursor, path, wantFaces).parse();
+}
+
+namespace {
+
+/// Reads a PLY header and nothing else.
+class PlyHeaderReader : public PlyReaderBase
+{
+public:
+    PlyHeaderReader(ByteInput& input, const std::string& path) : PlyReaderBase(input, path) {}
+
+    bool declaresFaces()
+    {
+        readHeader();
+        for (const PlyElement& element : mElements) {
+            if (element.name == "face" && element.count > 0) return true;
+        }
+        return false;
+    }
+};
+
+} // namespace
+
+bool
+plyDeclaresFaces(const char* data, size_t size, const std::string& path)
+{
+    Cursor cursor(data, size);
+    try {
+        return PlyHeaderReader(cursor, path).declaresFaces();
+    } catch (const FileError&) {
+        return false;  // no readable header: not a mesh by declaration
+    }
 }
 
 } // namespace io_internal

@@ -246,6 +246,10 @@ VtkData parseVtk(const char* data, size_t size, const std::string& path, bool wa
 /// parseVtk() reading from @a input (readParticles() passes a file stream).
 VtkData parseVtk(ByteInput& input, const std::string& path, bool wantPolygons);
 
+/// Whether a legacy VTK file has a POLYGONS section header declaring at least one polygon,
+/// however broken the file is after it (false when it breaks before).
+bool vtkDeclaresPolygons(const char* data, size_t size, const std::string& path);
+
 /// What parsePly() found in a PLY file.
 struct PlyData
 {
@@ -297,6 +301,10 @@ protected:
 /// List properties of the vertex element, and every other element, are skipped, except
 /// the face element's vertex_indices (or vertex_index) list when @a wantFaces.
 PlyData parsePly(const char* data, size_t size, const std::string& path, bool wantFaces);
+
+/// Whether a PLY header declares a face element of at least one face (false when the
+/// header cannot be read); reads the header only.
+bool plyDeclaresFaces(const char* data, size_t size, const std::string& path);
 
 /// The values of a 1- or 3-component array as floats (for positions and normals).
 std::vector<float> toFloats(const NumericArray& array);

@@ -285,4 +285,15 @@ readMesh(const std::string& path)
     return readVtkMesh(file, path);
 }
 
+bool
+declaresPolygons(const std::string& path)
+{
+    const std::string ext = lowerExtension(path);
+    if (ext == ".obj") return true;
+    if (ext != ".ply" && ext != ".vtk") return false;
+    const std::vector<char> file = loadFile(path);
+    return ext == ".ply" ? plyDeclaresFaces(file.data(), file.size(), path)
+                         : vtkDeclaresPolygons(file.data(), file.size(), path);
+}
+
 } // namespace nonbloppy

@@ -38,6 +38,7 @@ using nonbloppy_test::messageOf;
 using nonbloppy_test::readBytes;
 using nonbloppy_test::writeBytes;
 
+using nonbloppy::declaresPolygons;
 using nonbloppy::FileError;
 using nonbloppy::MeshWriteSettings;
 using nonbloppy::SurfaceMesh;
@@ -526,6 +527,41 @@ TEST_F(WriteMeshTest, TruncatedMeshFilesAreFileErrors)
         // Only cuts at the very end of the faces / before POINT_DATA can still parse.
         EXPECT_GT(failures, bytes.size() - 10) << ext;
     }
+}
+
+TEST_F(WriteMeshTest, MeshFilesDeclareTheirPolygonsHoweverBrokenTheRestIs)
+{
+    const SurfaceMesh mesh = mixedMesh();
+    for (const char* ext : {".ply", ".vtk"}) {
+        const std::string full = path(std::string("full") + ext);
+        writeMesh(mesh, full);
+        EXPECT_TRUE(declaresPolygons(full)) << ext;
+        const std::string bytes = readBytes(full);
+        // The declaration is the PLY header's last line, or the VTK POLYGONS header line:
+        // cut before it, the file is not a mesh; cut after it (its newline may go), it is,
+        // however little of the rest is there. Cuts inside the line go either way.
+        const std::string marker = std::string(ext) == ".ply" ? "end_header\n" : "POLYGONS ";
+        const size_t lineStart = bytes.find(marker);
+        ASSERT_NE(lineStart, std::string::npos) << ext;
+        const size_t lineEnd = bytes.find('\n', lineStart);
+        const std::string cut = path(std::string("cut") + ext);
+        for (size_t k = 0; k < bytes.size(); k += (k < lineEnd + 64 ? 1 : 97)) {
+            if (k > lineStart && k < lineEnd) continue;
+            writeBytes(cut, bytes.substr(0, k));
+            EXPECT_EQ(declaresPolygons(cut), k >= lineEnd) << ext << " cut at " << k << " of " << bytes.size();
+        }
+    }
+    EXPECT_TRUE(declaresPolygons(path("full.ply")));
+    writeMesh(mesh, path("m.obj"));
+    EXPECT_TRUE(declaresPolygons(path("m.obj")));
+    // Particle files of the same formats, and a PLY whose face element is empty.
+    EXPECT_FALSE(declaresPolygons(dataPath("cube_8_particles.vtk")));
+    EXPECT_FALSE(declaresPolygons(dataPath("cube_8_particles.vtu")));
+    writeBytes(path("noFaces.ply"), "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\n"
+                                    "property float z\nelement face 0\nproperty list uchar int vertex_indices\n"
+                                    "end_header\n0 0 0\n");
+    EXPECT_FALSE(declaresPolygons(path("noFaces.ply")));
+    EXPECT_EQ(messageOf<FileError>([&] { declaresPolygons(path("missing.ply")); }).rfind("cannot open ", 0), 0u);
 }
 
 TEST_F(WriteMeshTest, MeasuresSurviveARoundTrip)

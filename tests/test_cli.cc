@@ -334,6 +334,20 @@ TEST_F(CliTest, InspectBrokenMeshIsNotCalledAParticleFile)
     EXPECT_EQ(r.out, "");
 }
 
+TEST_F(CliTest, InspectTruncatedMeshIsNotCalledAParticleFile)
+{
+    // Cut inside its face list: the vertices are whole and would read as particles.
+    const std::string mesh = out("cube.ply");
+    ASSERT_EQ(run("mesh " + quote(kCube) + " -q -o " + quote(mesh)).exitCode, 0);
+    const std::string bytes = readText(mesh);
+    const std::string path = in("cut.ply");
+    writeText(path, bytes.substr(0, bytes.size() - 100));
+    const RunResult r = run("inspect " + quote(path));
+    EXPECT_EQ(r.exitCode, 1);
+    EXPECT_EQ(r.err, "nonbloppy: truncated PLY face element (" + path + ")\n");
+    EXPECT_EQ(r.out, "");
+}
+
 TEST_F(CliTest, UsageErrorsAreOneLine)
 {
     for (const std::string& args : {std::string(""), std::string("mesh"),

@@ -457,17 +457,10 @@ int runInspect(const std::string& path, bool json)
     const std::string ext = lowerExtension(path);
     if (ext == ".vdb") return inspectVdb(path, json);
     if (ext == ".obj") return inspectMesh(path, nonbloppy::readMesh(path), json);
-    if (ext == ".ply" || ext == ".vtk") {
-        // Both formats hold either particles or polygons: a file with faces is a mesh.
-        try {
-            nonbloppy::SurfaceMesh mesh = nonbloppy::readMesh(path);
-            if (mesh.polygonCount() > 0) return inspectMesh(path, mesh, json);
-        } catch (const nonbloppy::FileError& e) {
-            // Not a mesh (e.g. UNSTRUCTURED_GRID): read it as particles, whose error counts.
-            // A polygon list that is there but broken, though, makes a broken mesh, not a
-            // particle file (its vertices would read as particles).
-            if (std::strncmp(e.what(), "polygon ", 8) == 0) throw;
-        }
+    // Both formats hold either particles or polygons: a file that declares polygons is a
+    // mesh, whose errors are reported as such (its vertices would read as particles).
+    if ((ext == ".ply" || ext == ".vtk") && nonbloppy::declaresPolygons(path)) {
+        return inspectMesh(path, nonbloppy::readMesh(path), json);
     }
     if (nonbloppy::isParticleFile(path)) {
         return inspectParticles(path, nonbloppy::readParticles(path), json);
