@@ -11,6 +11,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <streambuf>
 #include <vector>
@@ -224,10 +225,32 @@ directIoSuitable(const std::string& path)
 #endif
 }
 
-AtomicFile::AtomicFile(const std::string& path)
-    : mPath(path)
+namespace {
+
+/// @a path with symbolic links followed to the file they name (which need not exist yet),
+/// as a shell redirection or cp writes through a link. Replacing the link itself would
+/// silently detach whatever it was meant to update.
+/// @throw FileError naming @a path after 40 links (a loop), as open() would fail.
+std::string followSymlinks(const std::string& path)
 {
-    std::string pattern = path + ".tmp-XXXXXX";
+    namespace fs = std::filesystem;
+    fs::path target = path;
+    for (int links = 0;; ++links) {
+        std::error_code error;
+        if (!fs::is_symlink(fs::symlink_status(target, error))) return target.string();
+        if (links == 40) throwWriteError(path, ELOOP);
+        const fs::path next = fs::read_symlink(target, error);
+        if (error) throwWriteError(path, error.value());
+        target = next.is_absolute() ? next : target.parent_path() / next;
+    }
+}
+
+} // namespace
+
+AtomicFile::AtomicFile(const std::string& path)
+    : mPath(path), mTarget(followSymlinks(path))
+{
+    std::string pattern = mTarget + ".tmp-XXXXXX";
     std::vector<char> name(pattern.begin(), pattern.end());
     name.push_back('\0');
     const int fd = ::mkstemp(name.data());
@@ -245,8 +268,8 @@ void
 AtomicFile::commit()
 {
     if (mCommitted) return;
-    if (::chmod(mTempPath.c_str(), newFileMode(mPath)) != 0 ||
-        ::rename(mTempPath.c_str(), mPath.c_str()) != 0)
+    if (::chmod(mTempPath.c_str(), newFileMode(mTarget)) != 0 ||
+        ::rename(mTempPath.c_str(), mTarget.c_str()) != 0)
     {
         const int errorNumber = errno;
         ::unlink(mTempPath.c_str());

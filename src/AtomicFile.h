@@ -32,8 +32,10 @@ namespace nonbloppy {
 class AtomicFile
 {
 public:
-    /// Create an empty temporary file `path + ".tmp-XXXXXX"` in the target's directory
-    /// (same file system, so the final rename is atomic).
+    /// Create an empty temporary file `target + ".tmp-XXXXXX"` in the target's directory
+    /// (same file system, so the final rename is atomic). The target is @a path, or the
+    /// file it names when it is a symbolic link (followed, as `>` in a shell does): the
+    /// link stays a link to the new contents.
     /// @throw FileError "cannot write <path>: <reason>" if it cannot be created.
     explicit AtomicFile(const std::string& path);
     /// Removes the temporary file unless commit() succeeded.
@@ -42,8 +44,10 @@ public:
     AtomicFile(const AtomicFile&) = delete;
     AtomicFile& operator=(const AtomicFile&) = delete;
 
-    /// The final file name.
+    /// The final file name, as given (errors name it).
     const std::string& path() const { return mPath; }
+    /// The file commit() replaces: path() with symbolic links followed.
+    const std::string& target() const { return mTarget; }
     /// Where to write the contents until commit().
     const std::string& tempPath() const { return mTempPath; }
     /// True once commit() has succeeded.
@@ -56,6 +60,7 @@ public:
 
 private:
     std::string mPath;
+    std::string mTarget;
     std::string mTempPath;
     bool mCommitted = false;
 };

@@ -369,6 +369,37 @@ TEST_F(WriteMeshTest, AtomicFileRemovesItsTemporaryUnlessCommitted)
     EXPECT_EQ(readBytes(target), "newest");
 }
 
+TEST_F(WriteMeshTest, WritingThroughASymlinkUpdatesItsTargetAndKeepsTheLink)
+{
+    namespace fs = std::filesystem;
+    fs::create_directory(path("frames"));
+    writeBytes(path("frames/0042.ply"), "old");
+    // A chain: latest.ply -> current.ply -> frames/0042.ply, both relative.
+    fs::create_symlink("frames/0042.ply", path("current.ply"));
+    fs::create_symlink("current.ply", path("latest.ply"));
+    const SurfaceMesh mesh = mixedMesh();
+    writeMesh(mesh, path("latest.ply"));
+    EXPECT_TRUE(fs::is_symlink(path("latest.ply")));
+    EXPECT_TRUE(fs::is_symlink(path("current.ply")));
+    EXPECT_EQ(fs::read_symlink(path("latest.ply")), "current.ply");
+    writeMesh(mesh, path("direct.ply"));
+    EXPECT_EQ(readBytes(path("frames/0042.ply")), readBytes(path("direct.ply")));
+    EXPECT_EQ(listDirectory(path("frames")), std::set<std::string>{"0042.ply"});  // no temporary left
+
+    // A dangling link gets its target created, as a shell's > would.
+    fs::create_symlink("frames/0043.ply", path("next.ply"));
+    writeMesh(mesh, path("next.ply"));
+    EXPECT_TRUE(fs::is_symlink(path("next.ply")));
+    EXPECT_EQ(readBytes(path("frames/0043.ply")), readBytes(path("direct.ply")));
+
+    // A loop is an error naming the path given, and writes nothing.
+    fs::create_symlink("loopB.ply", path("loopA.ply"));
+    fs::create_symlink("loopA.ply", path("loopB.ply"));
+    EXPECT_EQ(messageOf<FileError>([&] { writeMesh(mesh, path("loopA.ply")); }),
+              "cannot write " + path("loopA.ply") + ": Too many levels of symbolic links");
+    EXPECT_TRUE(fs::is_symlink(path("loopA.ply")));
+}
+
 TEST_F(WriteMeshTest, LargeFilesGoPastThePageCacheWithTheSameBytes)
 {
     // Sizes around the direct writer's edges: exactly the threshold, whole 4 KiB blocks past
