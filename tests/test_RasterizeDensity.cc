@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
 
+#include <limits>
 #include <random>
 
 using namespace nonbloppy;
@@ -190,4 +191,23 @@ TEST(ParticleIndex, RejectsNonFinitePositions)
     } catch (const ParameterError& e) {
         EXPECT_STREQ(e.what(), "non-finite position of particle 7");
     }
+    // The first of several, wherever the parallel scan's pieces start.
+    std::vector<openvdb::Vec3f> many(200000, openvdb::Vec3f(0.0f));
+    for (size_t n : {size_t(199999), size_t(150000), size_t(64123), size_t(100001)}) {
+        many[n][2] = std::numeric_limits<float>::infinity();
+    }
+    EXPECT_EQ(nonbloppy_test::messageOf<ParameterError>([&] { ParticleIndex::build(many, 0.1); }),
+              "non-finite position of particle 64123");
+}
+
+TEST(ParticleIndex, RejectsCoordinatesBeyondThe32BitIndexSpace)
+{
+    // 2.5e8 / 0.1 is 2.5e9 cells from the origin, past what an int32 coordinate holds.
+    std::vector<openvdb::Vec3f> positions(100000, openvdb::Vec3f(1.0f));
+    positions[54321] = openvdb::Vec3f(0.0f, -2.5e8f, 0.0f);
+    EXPECT_EQ(nonbloppy_test::messageOf<ParameterError>([&] { ParticleIndex::build(positions, 0.1); }),
+              "particle coordinates up to 2.5e+08 are too far from the origin for a cell size of 0.1 "
+              "(32-bit index space)");
+    // The same particle with cells of 1 is 2.5e8 cells away: accepted.
+    EXPECT_EQ(ParticleIndex::build(positions, 1.0).size(), positions.size());
 }
