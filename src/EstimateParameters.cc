@@ -48,7 +48,7 @@ void forEachSampleNeighbourhood(const ParticleIndex& index, const std::vector<si
                 if ((i - range.begin()) % 16 == 0 && poll.stopped()) return;
                 const openvdb::Vec3d x = positions[samples[i]];
                 const auto forNeighbours = [&](double radius, auto&& visit) {
-                    forEachRunInBox(accessor, index.cellSize(), x - openvdb::Vec3d(radius),
+                    forEachRunInBox(index.impl(), accessor, x - openvdb::Vec3d(radius),
                         x + openvdb::Vec3d(radius), [&](uint32_t first, uint32_t end) {
                             for (uint32_t k = first; k < end; ++k) visit(k, openvdb::Vec3d(positions[k]) - x);
                         });

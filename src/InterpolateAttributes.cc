@@ -76,7 +76,7 @@ struct InterpolateOp
             const openvdb::Vec3f v = mesh.points[i];
             std::fill(sums.begin(), sums.end(), 0.0);
             double weightSum = 0.0;
-            particle_index_internal::forEachRunInBox(accessor, index.cellSize,
+            particle_index_internal::forEachRunInBox(index, accessor,
                 openvdb::Vec3d(v) - openvdb::Vec3d(r), openvdb::Vec3d(v) + openvdb::Vec3d(r),
                 [&](uint32_t first, uint32_t end) {
                     for (uint32_t k = first; k < end; ++k) {

@@ -120,6 +120,7 @@ ParticleIndex ParticleIndex::build(std::vector<openvdb::Vec3f> positions, double
             impl.originalIndex.resize(positions.size());
         });
     poll.throwIfStopped();
+    impl.grid->tree().evalLeafBoundingBox(impl.leafBounds);  // stays empty without particles
 
     // Give every particle a sorted slot: leaves in tree order, then voxels in offset order,
     // then (sorted here, so the result never depends on the partitioner's threading)

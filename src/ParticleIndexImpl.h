@@ -21,6 +21,10 @@ struct ParticleIndex::Impl
     std::vector<uint32_t> originalIndex;
     double cellSize = 0.0;
     openvdb::tools::PointIndexGrid::Ptr grid;  ///< indices refer to sorted slots
+    /// The index-space box of the grid's leaves: every particle's cell lies inside, so
+    /// queries are clipped to it (a query box far wider than the particles, e.g. a voxel
+    /// hundreds of times r_e, would otherwise walk billions of empty cells).
+    openvdb::CoordBBox leafBounds;
 };
 
 namespace particle_index_internal {
@@ -41,12 +45,20 @@ inline openvdb::Coord cellOf(const openvdb::Vec3d& x, double cellSize)
 /// the world box [minCorner, maxCorner]. Cells along z inside one leaf hold consecutive
 /// slots, so each (x, y) column of a leaf is one run. Visiting order is fixed (x, y, z
 /// ascending), which keeps every sum built from the runs independent of threading.
+/// Cost: one probe per (x, y) cell column and leaf of the box clipped to @a index's leaves.
 template<typename AccessorT, typename VisitorT>
-inline void forEachRunInBox(AccessorT& accessor, double cellSize,
+inline void forEachRunInBox(const ParticleIndex::Impl& index, AccessorT& accessor,
                             const openvdb::Vec3d& minCorner, const openvdb::Vec3d& maxCorner,
                             VisitorT&& visit)
 {
-    const openvdb::Coord lo = cellOf(minCorner, cellSize), hi = cellOf(maxCorner, cellSize);
+    // Clipped in world units first: a corner too far out for an int cell number (a huge
+    // query radius) must not overflow the conversion.
+    if (index.leafBounds.empty()) return;
+    const double cellSize = index.cellSize;
+    const openvdb::Vec3d boundsMin = (index.leafBounds.min().asVec3d() - 0.5) * cellSize;
+    const openvdb::Vec3d boundsMax = (index.leafBounds.max().asVec3d() + 0.5) * cellSize;
+    const openvdb::Coord lo = cellOf(openvdb::math::maxComponent(minCorner, boundsMin), cellSize);
+    const openvdb::Coord hi = cellOf(openvdb::math::minComponent(maxCorner, boundsMax), cellSize);
     constexpr int kLeafMask = int(IndexLeaf::DIM) - 1;
     openvdb::Coord ijk;
     for (ijk[0] = lo[0]; ijk[0] <= hi[0]; ++ijk[0]) {

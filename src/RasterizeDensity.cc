@@ -273,7 +273,7 @@ struct RasterizeColumnOp
             // The runs are listed first and walked here rather than in a visitor lambda:
             // a lambda is compiled for the baseline, so the AVX2 row code would not inline.
             runs.clear();
-            particle_index_internal::forEachRunInBox(accessor, particles.cellSize(),
+            particle_index_internal::forEachRunInBox(particles.impl(), accessor,
                 columnMin - openvdb::Vec3d(effectiveRadius), columnMax + openvdb::Vec3d(effectiveRadius),
                 [&](uint32_t first, uint32_t end) { runs.emplace_back(first, end); });
             for (const auto& [first, end] : runs) {

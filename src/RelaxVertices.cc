@@ -185,7 +185,7 @@ struct RelaxGroupsOp
         const openvdb::Vec3f boxMin = vertexMin - openvdb::Vec3f(slack);
         const openvdb::Vec3f boxMax = vertexMax + openvdb::Vec3f(slack);
         candidates.clear();
-        particle_index_internal::forEachRunInBox(accessor, cellSize,
+        particle_index_internal::forEachRunInBox(particles.impl(), accessor,
             openvdb::Vec3d(boxMin) - openvdb::Vec3d(radius), openvdb::Vec3d(boxMax) + openvdb::Vec3d(radius),
             [&](uint32_t first, uint32_t last) {
                 candidates.gather(positions, first, last, boxMin, boxMax, radius * radius);

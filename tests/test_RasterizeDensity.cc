@@ -94,6 +94,19 @@ TEST(RasterizeDensity, WideSupportsAndGappedColumnsMatchTheBruteForceSum)
     EXPECT_FALSE(grid->tree().isValueOn(openvdb::Coord(0, 0, 30)));  // the gap stays empty
 }
 
+TEST(RasterizeDensity, VoxelsFarWiderThanTheSupportMatchTheBruteForceSum)
+{
+    // h = 64 r_e: a leaf column spans 512 h, some 650,000 index cells per axis around 300
+    // particles. The cell walk is clipped to the index's leaves; unclipped it took minutes.
+    // Only voxel centres within r_e of a particle are active.
+    const double radius = 0.1, voxelSize = 6.4;
+    std::vector<openvdb::Vec3f> positions = randomParticles(300, 5);
+    positions.push_back(openvdb::Vec3f(6.4f, 0.0f, -6.4f));  // on a voxel centre
+    const openvdb::FloatGrid::Ptr grid = rasterize(positions, radius, voxelSize);
+    EXPECT_TRUE(grid->tree().isValueOn(openvdb::Coord(1, 0, -1)));
+    expectBruteForceValues(*grid, positions, radius, openvdb::CoordBBox(openvdb::Coord(-2), openvdb::Coord(2)));
+}
+
 TEST(RasterizeDensity, VoxelOnTopOfAParticleStaysFinite)
 {
     const std::vector<openvdb::Vec3f> one{openvdb::Vec3f(0.2f, 0.0f, -0.4f)};
