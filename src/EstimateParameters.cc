@@ -337,6 +337,13 @@ ResolvedParameters resolveParametersWith(const SurfaceParameters& params, const 
         throw ParameterError("--voxel-size " + formatNumber(out.voxelSize) + " is too small for --radius " +
                              formatNumber(out.effectiveRadius) + ": at most 32 voxels per radius");
     }
+    // A voxel wider than r_e leaves particles whose support holds no voxel centre: the mesh
+    // would lose them (with h = 64 r_e, every one: an empty mesh and exit 0). At h ≤ r_e the
+    // nearest centre is at most (√3/2) h < r_e away.
+    if (out.voxelSize > out.effectiveRadius) {
+        throw ParameterError("--voxel-size " + formatNumber(out.voxelSize) + " is too large for --radius " +
+                             formatNumber(out.effectiveRadius) + ": at most one voxel per radius");
+    }
     out.method = params.method;
     const bool faithful = params.method == Method::Faithful;
     if (faithful) {

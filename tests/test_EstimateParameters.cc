@@ -205,6 +205,13 @@ TEST(EstimateParameters, ResolveReportsWhatWasGivenAndChecksRanges)
     bad.spacing = 0.05;
     bad.effectiveRadius = 50.0;
     expectMessage(bad, "--voxel-size 0.025 is too small for --radius 50: at most 32 voxels per radius");
+    // Wider than r_e: particles between voxel centres would be lost (at 64 r_e, all of them).
+    SurfaceParameters wide;
+    wide.spacing = 0.05;
+    wide.voxelSize = 6.4;
+    expectMessage(wide, "--voxel-size 6.4 is too large for --radius 0.1: at most one voxel per radius");
+    wide.voxelSize = 0.1;  // one voxel per radius: accepted
+    EXPECT_NO_THROW(resolveParameters(wide, ball));
     bad.voxelSize = 2.0;
     expectMessage(bad, "--radius must be at most 32 particle spacings to calibrate --threshold, got 1000 "
                        "spacings; give --threshold");
