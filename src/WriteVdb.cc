@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: Apache-2.0
 /// @file WriteVdb.cc
-/// @brief Stage "write vdb": openvdb::io::File into a temporary file, a deterministic file
-///        UUID patched into its header, then a rename into place
-///        (AtomicFile).
+/// @brief Stage "write vdb": the grids as io::File writes them, into a temporary file through
+///        a stream whose errors are checked, a deterministic file UUID patched into its
+///        header, then a rename into place (AtomicFile).
 
 #include <nonbloppy/WriteVdb.h>
 
@@ -10,7 +10,7 @@
 
 #include "AtomicFile.h"
 
-#include <openvdb/io/File.h>
+#include <openvdb/io/Archive.h>
 
 #include <array>
 #include <cerrno>
@@ -22,6 +22,18 @@
 namespace nonbloppy {
 
 namespace write_vdb_internal {
+
+/// io::File::write() as it is (io::Archive::write() to a std::ofstream, seekable), but onto
+/// a stream the caller owns: io::File never checks its stream, so a full disk gave a
+/// truncated .vdb and no error.
+class StreamArchive : public openvdb::io::Archive
+{
+public:
+    void writeSeekable(std::ostream& os, const openvdb::GridCPtrVec& grids, const openvdb::MetaMap& metadata) const
+    {
+        openvdb::io::Archive::write(os, grids, /*seekable=*/true, metadata);
+    }
+};
 
 /// Layout of the VDB file header as io::Archive::writeHeader() writes it (file format ≥ 220):
 /// int64 magic, uint32 file version, uint32 library major, uint32 library minor,
@@ -129,9 +141,14 @@ void writeVdb(const openvdb::GridCPtrVec& grids, const std::string& path,
     AtomicFile temp(path);
 
     try {
-        openvdb::io::File file(temp.tempPath());
-        file.write(grids, fileMetadata);
-        file.close();
+        std::ofstream os;
+        os.open(temp.tempPath(), std::ios_base::out | std::ios_base::binary | std::ios_base::trunc);
+        errno = 0;
+        if (os) StreamArchive().writeSeekable(os, grids, fileMetadata);
+        if (os) os.close();
+        if (!os) throw FileError("cannot write " + path + ": " + std::strerror(errno ? errno : EIO));
+    } catch (const Error&) {
+        throw;
     } catch (const openvdb::Exception& e) {
         throw FileError("cannot write " + path + ": " + e.what());
     } catch (const std::exception& e) {

@@ -251,3 +251,27 @@ TEST_F(CliFormatsTest, VdbSurfaceAndPointsGrids)
 }
 
 } // namespace
+
+TEST_F(CliFormatsTest, FullDiskWhileWritingVdbIsAnErrorAndLeavesNothing)
+{
+    // A file-size limit (32 blocks: 16 KB in dash, 32 KB in bash; the mesh is 8 KB, the grids
+    // 23 and 90 KB) stands in for a full disk: writes past it fail (EFBIG) once SIGXFSZ
+    // is ignored. io::File never checked its stream: the .vdb came out truncated, exit 0.
+    const std::string outDir = path("out");
+    const auto runLimited = [&](const std::string& args) {
+        const std::string command = "trap '' XFSZ; ulimit -f 32; exec " + quote(kCli) + " " + args + " >"
+                                    + quote(path("stdout.txt")) + " 2>" + quote(path("stderr.txt")) + " </dev/null";
+        const int status = std::system(command.c_str());
+        return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+    };
+    const std::string vdb = outDir + "/fluid.vdb";
+    EXPECT_EQ(runLimited("convert " + quote(kData + "/fluid_250_particles.vtu") + " " + quote(vdb)), 1);
+    EXPECT_EQ(readText(path("stderr.txt")), "nonbloppy: cannot write " + vdb + ": File too large\n");
+    EXPECT_TRUE(listDir(outDir).empty()) << "output files left behind";
+
+    const std::string grids = outDir + "/cube.vdb";
+    EXPECT_EQ(runLimited("mesh " + quote(kData + "/cube_8_particles.vtk") + " -q -o " + quote(outDir + "/cube.ply")
+                         + " --vdb " + quote(grids) + " --vdb-points --vdb-surface"), 1);
+    EXPECT_EQ(readText(path("stderr.txt")), "nonbloppy: cannot write " + grids + ": File too large\n");
+    EXPECT_TRUE(listDir(outDir).empty()) << "output files left behind";
+}
