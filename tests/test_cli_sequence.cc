@@ -102,6 +102,22 @@ TEST_F(CliSequenceTest, OutputWithoutPlaceholderIsAnError)
     }
 }
 
+TEST_F(CliSequenceTest, LogNamingAnInputFrameOrAnOutputIsRefusedBeforeAnyWork)
+{
+    makeFrames({kFree, kFree});
+    const std::string frame2 = in("fluid_0002.vtk");
+    const std::string before = readText(frame2);
+    // Written first, the log would have replaced frame 2 with JSON.
+    expectFailure("mesh " + quote(in("fluid_{}.vtk")) + " -o " + quote(out("mesh_{}.obj")) + " --log "
+                      + quote(frame2),
+                  "cannot write " + frame2 + ": --log names the input of frame 2");
+    EXPECT_EQ(readText(frame2), before);
+    // Frame 1's rename would have replaced the log.
+    expectFailure("mesh " + quote(in("fluid_{}.vtk")) + " -o " + quote(out("mesh_{}.obj")) + " --vdb "
+                      + quote(out("density_{}.vdb")) + " --log " + quote(out("density_0001.vdb")),
+                  "cannot write " + out("density_0001.vdb") + ": --log names an output of frame 1");
+}
+
 TEST_F(CliSequenceTest, SequenceOptionsNeedASequence)
 {
     const RunResult r = run("mesh " + quote(kFree) + " -o " + quote(out("m.obj")) + " --frames 1-3");

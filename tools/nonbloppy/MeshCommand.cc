@@ -543,6 +543,28 @@ void requirePlaceholder(const std::string& path, const std::string& option, cons
     }
 }
 
+/// Refuse a --log that names an input frame (it would be overwritten with JSON before the
+/// frame is read) or a frame's output (whose rename would replace the log).
+void requireLogApart(const std::string& logPath, const std::vector<BatchJob>& jobs)
+{
+    const auto same = [&](const std::string& path) {
+        std::error_code ec;
+        return logPath == path || fs::equivalent(logPath, path, ec);
+    };
+    for (const BatchJob& job : jobs) {
+        if (same(job.frame.input)) {
+            throw nonbloppy::FileError("cannot write " + logPath + ": --log names the input of frame "
+                                       + std::to_string(job.frame.number));
+        }
+        for (const std::string& output : job.outputs) {
+            if (same(output)) {
+                throw nonbloppy::FileError("cannot write " + logPath + ": --log names an output of frame "
+                                           + std::to_string(job.frame.number));
+            }
+        }
+    }
+}
+
 int runSequence(const MeshOptions& o)
 {
     validateParameters(o);
@@ -571,6 +593,7 @@ int runSequence(const MeshOptions& o)
     }
     // Output extensions and directories, before any work.
     validatePaths(optionsForFrame(o, plan.frames.front()));
+    if (!o.logPath.empty()) requireLogApart(o.logPath, jobs);
 
     std::unique_ptr<tbb::global_control> threadLimit;
     if (o.threadsOpt->count() > 0) {
