@@ -74,6 +74,18 @@ TEST_F(CliSequenceTest, MeshesEveryFrameFoundWithOneLinePerFrame)
         << outLines[3];
     // The same frame gives the same mesh.
     EXPECT_EQ(readText(out("mesh_0001.obj")), readText(out("mesh_0003.obj")));
+    // The faces counted are the faces written (triangles: quads are split); it said the quads.
+    size_t faces = 0;
+    for (const std::string& line : lines(readText(out("mesh_0002.obj")))) faces += line.rfind("f ", 0) == 0;
+    EXPECT_GT(faces, 0u);
+    EXPECT_NE(outLines[1].find(" vertices, " + std::to_string(faces) + " faces, "), std::string::npos) << outLines[1];
+    const RunResult quads = run("mesh " + quote(in("fluid_{}.vtk")) + " -o " + quote(out("quads_{}.obj"))
+                                + " --frames 2 --quads");
+    ASSERT_EQ(quads.exitCode, 0) << quads.err;
+    size_t polygons = 0;
+    for (const std::string& line : lines(readText(out("quads_0002.obj")))) polygons += line.rfind("f ", 0) == 0;
+    EXPECT_LT(polygons, faces);
+    EXPECT_NE(quads.out.find(" vertices, " + std::to_string(polygons) + " faces, "), std::string::npos) << quads.out;
 }
 
 TEST_F(CliSequenceTest, HashAndPrintfPatterns)

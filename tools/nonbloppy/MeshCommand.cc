@@ -627,7 +627,8 @@ int runSequence(const MeshOptions& o)
         const nonbloppy::ResolvedParameters& p = result.parameters;
         report.particles = result.particleCount;
         report.vertices = result.mesh.points.size();
-        report.faces = result.mesh.polygonCount();
+        // As written: quads are split into two triangles unless --quads keeps them.
+        report.faces = f.quads ? result.mesh.polygonCount() : result.mesh.triangleCount();
         report.timings = outcome.timings;
         report.parameters = {{"spacing", p.spacing}, {"effective_radius", p.effectiveRadius},
                              {"threshold", p.threshold}, {"voxel_size", p.voxelSize},
