@@ -245,12 +245,27 @@ std::string followSymlinks(const std::string& path)
     }
 }
 
+/// mkstemp() pattern of the temporary file for @a target: `target.tmp-XXXXXX`, or, when
+/// that name would be longer than the directory allows (a legal name of 245 or more bytes),
+/// `.tmp-XXXXXX` in the same directory. Both match the `*.tmp-*` of the cleanup advice.
+std::string temporaryPattern(const std::string& target)
+{
+    constexpr const char* kSuffix = ".tmp-XXXXXX";
+    const size_t slash = target.rfind('/');
+    const std::string directory = slash == std::string::npos ? "." : target.substr(0, slash + 1);
+    const size_t nameLength = target.size() - (slash == std::string::npos ? 0 : slash + 1);
+    const long maxName = ::pathconf(directory.c_str(), _PC_NAME_MAX);
+    const size_t limit = maxName > 0 ? size_t(maxName) : 255;
+    if (nameLength + std::strlen(kSuffix) <= limit) return target + kSuffix;
+    return (slash == std::string::npos ? std::string() : target.substr(0, slash + 1)) + kSuffix;
+}
+
 } // namespace
 
 AtomicFile::AtomicFile(const std::string& path)
     : mPath(path), mTarget(followSymlinks(path))
 {
-    std::string pattern = mTarget + ".tmp-XXXXXX";
+    std::string pattern = temporaryPattern(mTarget);
     std::vector<char> name(pattern.begin(), pattern.end());
     name.push_back('\0');
     const int fd = ::mkstemp(name.data());

@@ -400,6 +400,27 @@ TEST_F(WriteMeshTest, WritingThroughASymlinkUpdatesItsTargetAndKeepsTheLink)
     EXPECT_TRUE(fs::is_symlink(path("loopA.ply")));
 }
 
+TEST_F(WriteMeshTest, NamesUpToTheFileSystemLimitCanBeWritten)
+{
+    // 255 bytes is ext4's and tmpfs's limit; "name.tmp-XXXXXX" would exceed it from 245 on.
+    const SurfaceMesh mesh = mixedMesh();
+    writeMesh(mesh, path("short.ply"));
+    for (size_t length : {size_t(244), size_t(245), size_t(255)}) {
+        const std::string name = std::string(length - 4, 'm') + ".ply";
+        writeMesh(mesh, path(name));
+        EXPECT_EQ(readBytes(path(name)), readBytes(path("short.ply"))) << length;
+        EXPECT_EQ(listDirectory(dir()).count(name), 1u);
+        std::filesystem::remove(path(name));
+        {
+            nonbloppy::AtomicFile file(path(name));  // the temporary file's name, not committed
+            const std::string temp = file.tempPath().substr(dir().size() + 1);
+            EXPECT_LE(temp.size(), 255u);
+            EXPECT_NE(temp.find(".tmp-"), std::string::npos) << temp;  // found by the *.tmp-* cleanup
+        }
+    }
+    EXPECT_EQ(listDirectory(dir()), std::set<std::string>{"short.ply"});
+}
+
 TEST_F(WriteMeshTest, LargeFilesGoPastThePageCacheWithTheSameBytes)
 {
     // Sizes around the direct writer's edges: exactly the threshold, whole 4 KiB blocks past
