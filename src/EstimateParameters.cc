@@ -219,7 +219,13 @@ double estimateSpacingWith(const std::vector<openvdb::Vec3f>& positions, const P
                            size_t maxSamples, CancelPoll& poll, openvdb::util::NullInterrupter* interrupter)
 {
     const double guess = spacingGuess(positions, poll);
-    if (shared) return estimateSpacingOf(*shared, guess, maxSamples, poll);
+    // The caller's index (cells of r_e/2) serves unless its cells are far finer than the
+    // spacing: each search then walks (guess/cell)³ cells, 40 s for --radius 0.001 on a
+    // cube of spacing 0.05, before the error that r_e is too small.
+    constexpr double kMinSharedCellOverGuess = 0.25;
+    if (shared && shared->cellSize() >= kMinSharedCellOverGuess * guess) {
+        return estimateSpacingOf(*shared, guess, maxSamples, poll);
+    }
     ParticleIndex index;
     try {
         // Cells no smaller than OpenVDB allows: the estimate still works (on wider cells),
@@ -341,8 +347,14 @@ ResolvedParameters resolveParametersWith(const SurfaceParameters& params, const 
     // would lose them (with h = 64 r_e, every one: an empty mesh and exit 0). At h ≤ r_e the
     // nearest centre is at most (√3/2) h < r_e away.
     if (out.voxelSize > out.effectiveRadius) {
+        // Name what the user gave: a derived voxel size (s/2) is not theirs to fix.
+        if (!out.voxelSizeGiven) {
+            throw ParameterError("--radius " + formatNumber(out.effectiveRadius) + " is smaller than the voxel size " +
+                                 formatNumber(out.voxelSize) + " (derived: half the particle spacing): at least one "
+                                 "voxel per radius");
+        }
         throw ParameterError("--voxel-size " + formatNumber(out.voxelSize) + " is too large for --radius " +
-                             formatNumber(out.effectiveRadius) + ": at most one voxel per radius");
+                             formatNumber(out.effectiveRadius) + ": at least one voxel per radius");
     }
     out.method = params.method;
     const bool faithful = params.method == Method::Faithful;

@@ -209,7 +209,13 @@ TEST(EstimateParameters, ResolveReportsWhatWasGivenAndChecksRanges)
     SurfaceParameters wide;
     wide.spacing = 0.05;
     wide.voxelSize = 6.4;
-    expectMessage(wide, "--voxel-size 6.4 is too large for --radius 0.1: at most one voxel per radius");
+    expectMessage(wide, "--voxel-size 6.4 is too large for --radius 0.1: at least one voxel per radius");
+    // The voxel size derived (s/2), the radius given: the radius is named.
+    SurfaceParameters narrow;
+    narrow.spacing = 0.05;
+    narrow.effectiveRadius = 0.001;
+    expectMessage(narrow, "--radius 0.001 is smaller than the voxel size 0.025 (derived: half the particle spacing): "
+                          "at least one voxel per radius");
     wide.voxelSize = 0.1;  // one voxel per radius: accepted
     EXPECT_NO_THROW(resolveParameters(wide, ball));
     bad.voxelSize = 2.0;

@@ -265,6 +265,12 @@ TEST_F(CliTest, BadParameters)
     expectFailure(base + "--spacing 0.05 --radius 50 --voxel-size 2",
                   "--radius must be at most 32 particle spacings to calibrate --threshold, got 1000 spacings; "
                   "give --threshold");
+    // The spacing estimated (0.0498) through an index of cells r_e/2 = 0.0005 took 40 s.
+    expectFailure(base + "--radius 0.001",
+                  "--radius 0.001 is smaller than the voxel size 0.0249191 (derived: half the particle spacing): "
+                  "at least one voxel per radius");
+    expectFailure(base + "--voxel-size 64",
+                  "--voxel-size 64 is too large for --radius 0.0996763: at least one voxel per radius");
     expectFailure(base + "--spacing 1e-6",
                   "--voxel-size 5e-07 is below 1.5e-05, the smallest OpenVDB accepts: give the positions in a "
                   "smaller unit");
