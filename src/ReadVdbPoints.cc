@@ -436,13 +436,15 @@ public:
     }
 
     /// A GridDescriptor (GridDescriptor::read): unique name, type, instance parent, offsets.
-    void gridDescriptor(uint32_t version)
+    /// A GridDescriptor; returns the grid's name.
+    std::string gridDescriptor(uint32_t version)
     {
         const std::string name = string("grid name");
         const std::string grid = "grid '" + printable(name) + "'";
         string("type name of " + grid);
         if (version >= openvdb::OPENVDB_FILE_VERSION_GRID_INSTANCING) string("instance parent of " + grid);
         skip(3 * 8, grid + " descriptor");
+        return name;
     }
 
     bool hasGridOffsets() const { return mHasGridOffsets; }
@@ -1061,11 +1063,16 @@ private:
                 continue;
             }
             // A Blosc chunk starts with a 16-byte header whose bytes 4..7 hold the
-            // uncompressed size (little-endian).
+            // uncompressed size (little-endian). OpenVDB's bloscCompress() pads arrays
+            // shorter than 128 bytes to 128 before compressing them.
             if (compressed < 16 || compressed > left()) corrupt("bad compressed array in " + item);
             uint32_t uncompressed;
             std::memcpy(&uncompressed, here(16) + 4, 4);
-            if (uncompressed != uint64_t(count) * width) corrupt("bad compressed array in " + item);
+            constexpr uint64_t kBloscPadBytes = 128;
+            const uint64_t arrayBytes = uint64_t(count) * width;
+            if (uncompressed != arrayBytes && !(arrayBytes < kBloscPadBytes && uncompressed == kBloscPadBytes)) {
+                corrupt("bad compressed array in " + item);
+            }
             mPos += compressed;
         }
     }
@@ -1171,6 +1178,44 @@ public:
     }
 };
 
+/// checkVdbLayout() of @a source.
+void checkLayout(const VdbSource& source, const std::string& path)
+{
+    VdbSizeCheck check(source, path);
+    const uint64_t size = source.size();
+    const uint32_t version = check.header();
+    check.metaMap("the file");
+    const uint32_t gridCount = check.load<uint32_t>("grid count");
+    if (gridCount > check.left() / 36) {
+        check.corrupt("grid count " + std::to_string(int32_t(gridCount)) + " does not fit in the file");
+    }
+    for (uint32_t i = 0; i < gridCount; ++i) {
+        const std::string name = check.gridDescriptor(version);
+        const size_t gridStart = check.pos();
+        // The descriptor ends with three offsets: grid, blocks, end of the grid.
+        check.seek(gridStart - 8);
+        const int64_t end = check.load<int64_t>("grid descriptor");
+        if (!check.hasGridOffsets()) {
+            // Written to a stream: the next grid starts where this one's tree ends, which
+            // only reading the tree finds.
+            check.grid(name, /*pointDataGrid=*/false, version);
+            return;
+        }
+        if (end < int64_t(gridStart)) {
+            // io::File patches the offsets in once a grid is written: a cut-off write leaves 0.
+            check.corrupt("truncated or corrupt grid '" + printable(name) + "' (its end offset " + std::to_string(end) +
+                          " lies before its start " + std::to_string(gridStart) + ")");
+        }
+        if (uint64_t(end) > size) {
+            check.corrupt("truncated grid '" + printable(name) + "' (it ends at byte " + std::to_string(end) +
+                          ", the file has " + std::to_string(size) + ")");
+        }
+        check.grid(name, /*pointDataGrid=*/false, version);
+        if (check.pos() > uint64_t(end)) check.corrupt("grid '" + printable(name) + "' overruns its end offset");
+        check.seek(size_t(end));
+    }
+}
+
 /// The first PointDataGrid of @a source, converted.
 ParticleSet
 readVdbPoints(const VdbSource& source, const std::string& path)
@@ -1214,6 +1259,19 @@ ParticleSet
 readVdbPointsParticles(const char* data, size_t size, const std::string& path)
 {
     return readVdbPoints(VdbSource(data, size, path), path);
+}
+
+void
+checkVdbLayout(const std::string& path)
+{
+    const OpenFile file = openFile(path);
+    if (!file.regular) {
+        const std::vector<char> data = readToEndAndClose(file.fd, path, 0);
+        checkLayout(VdbSource(data.data(), data.size(), path), path);
+        return;
+    }
+    struct FdCloser { int fd; ~FdCloser() { ::close(fd); } } closer{file.fd};
+    checkLayout(VdbSource(file.fd, file.size, path), path);
 }
 
 ParticleSet

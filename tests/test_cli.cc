@@ -354,6 +354,24 @@ TEST_F(CliTest, InspectTruncatedMeshIsNotCalledAParticleFile)
     EXPECT_EQ(r.out, "");
 }
 
+TEST_F(CliTest, InspectTruncatedVdbIsOneLineQuickly)
+{
+    // Cut in its second grid: io::File took a minute and 8.5 GB on such a file and printed a
+    // 1.4 GB line; cut in its header, it reported "0 grids", exit 0.
+    ASSERT_EQ(meshCube("cube", "-q").exitCode, 0);
+    const std::string bytes = readText(out("cube.vdb"));
+    for (size_t size : {size_t(4), size_t(64), bytes.size() / 2}) {
+        const std::string path = in("cut.vdb");
+        writeText(path, bytes.substr(0, size));
+        const RunResult r = run("inspect " + quote(path));
+        EXPECT_EQ(r.exitCode, 1) << size;
+        EXPECT_EQ(r.err.rfind("nonbloppy: cannot read .vdb file: ", 0), 0u) << r.err;
+        EXPECT_EQ(lines(r.err).size(), 1u) << r.err;
+        EXPECT_NE(r.err.find(" (" + path + ")\n"), std::string::npos) << r.err;
+        EXPECT_EQ(r.out, "");
+    }
+}
+
 TEST_F(CliTest, UsageErrorsAreOneLine)
 {
     for (const std::string& args : {std::string(""), std::string("mesh"),

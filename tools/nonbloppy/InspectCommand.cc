@@ -13,6 +13,7 @@
 #include <nonbloppy/Particles.h>
 #include <nonbloppy/ReadMesh.h>
 #include <nonbloppy/ReadParticles.h>
+#include <nonbloppy/ReadVdb.h>
 
 #include <openvdb/Exceptions.h>
 #include <openvdb/io/File.h>
@@ -339,27 +340,10 @@ void printMetadata(const openvdb::MetaMap& metadata, const char* indent)
 
 int inspectVdb(const std::string& path, bool json)
 {
-    openvdb::initialize();
-    openvdb::GridPtrVecPtr grids;
-    openvdb::MetaMap::Ptr fileMetadata;
-    std::string fileVersion;
-    try {
-        openvdb::io::File file(path);
-        file.open(/*delayLoad=*/false);
-        fileVersion = file.version();
-        fileMetadata = file.getMetadata();
-        // Names, classes and metadata first, then the trees (this is where a truncated
-        // file fails).
-        file.readAllGridMetadata();
-        grids = file.getGrids();
-        file.close();
-    } catch (const openvdb::Exception& e) {
-        throw nonbloppy::FileError("cannot read " + path + ": " + e.what());
-    } catch (const std::exception& e) {
-        throw nonbloppy::FileError("cannot read " + path + ": " + e.what());
-    }
-    if (!grids) grids = std::make_shared<openvdb::GridPtrVec>();
-    if (!fileMetadata) fileMetadata = std::make_shared<openvdb::MetaMap>();
+    nonbloppy::VdbFileContents contents = nonbloppy::readVdbFile(path);
+    const std::string& fileVersion = contents.formatVersion;
+    const openvdb::MetaMap* fileMetadata = &contents.metadata;
+    const openvdb::GridPtrVec* grids = &contents.grids;
 
     if (json) {
         JsonWriter w;
