@@ -16,9 +16,12 @@
 #include <openvdb/points/PointDataGrid.h>
 #pragma GCC visibility pop
 
+#include <cctype>
 #include <charconv>
 #include <cstring>
+#include <functional>
 #include <ostream>
+#include <set>
 
 namespace nonbloppy {
 
@@ -38,6 +41,96 @@ headerWord(const std::string& name)
         }
     }
     return word;
+}
+
+/// An attribute name in OpenVDB's alphabet (letters, digits, '_', '|', ':'), which
+/// appendAttribute() enforces by throwing.
+std::string
+vdbWord(const std::string& name)
+{
+    std::string word = name.empty() ? std::string("attribute") : name;
+    for (char& ch : word) {
+        if (!std::isalnum(static_cast<unsigned char>(ch)) && ch != '_' && ch != '|' && ch != ':') ch = '_';
+    }
+    return word;
+}
+
+/// The columns (or arrays) an attribute called @a base is written as, in one format.
+using ColumnsOf = std::function<std::vector<std::string>(const std::string& base, int components)>;
+
+/// The names the attributes are written under: @a word of each name (the format's
+/// alphabet), then, if any column it gives is taken (by the positions' x, y, z or P, or
+/// by another attribute), the first of word_2, word_3, ... whose columns are all free.
+/// Names the format takes as they are claim theirs first, in order; renamed ones follow.
+/// Renaming "a b" to "a_b" beside an attribute "a_b" gave two columns of one name, which
+/// nonbloppy's own readers then refused ("duplicate column").
+std::vector<std::string>
+uniqueNames(const ParticleSet& particles, std::string (*word)(const std::string&), const ColumnsOf& columnsOf)
+{
+    std::set<std::string> taken{"x", "y", "z", "P"};
+    std::vector<std::string> names(particles.attributes.size());
+    for (const bool renamed : {false, true}) {
+        for (size_t i = 0; i < particles.attributes.size(); ++i) {
+            const ParticleAttribute& a = particles.attributes[i];
+            const std::string base = word(a.name);
+            if ((base != a.name) != renamed) continue;
+            std::string name = base;
+            for (int suffix = 2;; ++suffix) {
+                const std::vector<std::string> columns = columnsOf(name, a.components);
+                if (std::none_of(columns.begin(), columns.end(), [&](const std::string& c) { return taken.count(c); })) {
+                    taken.insert(columns.begin(), columns.end());
+                    break;
+                }
+                name = base + "_" + std::to_string(suffix);
+            }
+            names[i] = name;
+        }
+    }
+    return names;
+}
+
+/// One column per attribute (VTK and VTU arrays hold all components).
+std::vector<std::string>
+wholeColumn(const std::string& base, int)
+{
+    return {base};
+}
+
+/// PLY properties: name, name_x/_y/_z, or name_<c>.
+std::string
+componentName(const std::string& base, int components, int c)
+{
+    if (components == 1) return base;
+    if (components == 3) return base + "_" + "xyz"[c];
+    return base + "_" + std::to_string(c);
+}
+
+std::vector<std::string>
+plyColumns(const std::string& base, int components)
+{
+    std::vector<std::string> columns;
+    for (int c = 0; c < components; ++c) columns.push_back(componentName(base, components, c));
+    return columns;
+}
+
+/// CSV columns: name, or name:<c> as ParaView writes them.
+std::vector<std::string>
+csvColumns(const std::string& base, int components)
+{
+    if (components == 1) return {base};
+    std::vector<std::string> columns;
+    for (int c = 0; c < components; ++c) columns.push_back(base + ":" + std::to_string(c));
+    return columns;
+}
+
+/// PointDataGrid attributes: one for 1 or 3 components, else name_<c> each.
+std::vector<std::string>
+vdbColumns(const std::string& base, int components)
+{
+    if (components == 1 || components == 3) return {base};
+    std::vector<std::string> columns;
+    for (int c = 0; c < components; ++c) columns.push_back(base + "_" + std::to_string(c));
+    return columns;
 }
 
 void
@@ -99,24 +192,17 @@ plyTypeName(ScalarType type)
     }
 }
 
-std::string
-componentName(const ParticleAttribute& a, int c)
-{
-    const std::string base = headerWord(a.name);
-    if (a.components == 1) return base;
-    if (a.components == 3) return base + "_" + "xyz"[c];
-    return base + "_" + std::to_string(c);
-}
-
 void
 writePly(const ParticleSet& particles, std::ostream& os)
 {
     std::string header = "ply\nformat binary_little_endian 1.0\ncomment written by nonbloppy\n";
     header += "element vertex " + std::to_string(particles.size()) + "\n";
     header += "property float x\nproperty float y\nproperty float z\n";
-    for (const ParticleAttribute& a : particles.attributes) {
+    const std::vector<std::string> names = uniqueNames(particles, headerWord, plyColumns);
+    for (size_t i = 0; i < particles.attributes.size(); ++i) {
+        const ParticleAttribute& a = particles.attributes[i];
         for (int c = 0; c < a.components; ++c) {
-            header += std::string("property ") + plyTypeName(a.type) + " " + componentName(a, c) + "\n";
+            header += std::string("property ") + plyTypeName(a.type) + " " + componentName(names[i], a.components, c) + "\n";
         }
     }
     header += "end_header\n";
@@ -178,8 +264,10 @@ writeVtk(const ParticleSet& particles, std::ostream& os)
     if (!particles.attributes.empty()) {
         out += "POINT_DATA " + std::to_string(n) + "\nFIELD FieldData " +
                std::to_string(particles.attributes.size()) + "\n";
-        for (const ParticleAttribute& a : particles.attributes) {
-            out += headerWord(a.name) + " " + std::to_string(a.components) + " " + std::to_string(n) +
+        const std::vector<std::string> names = uniqueNames(particles, headerWord, wholeColumn);
+        for (size_t i = 0; i < particles.attributes.size(); ++i) {
+            const ParticleAttribute& a = particles.attributes[i];
+            out += names[i] + " " + std::to_string(a.components) + " " + std::to_string(n) +
                    " " + vtkTypeName(a.type) + "\n";
             appendSwapped(out, a.bytes.data(), n * size_t(a.components), scalarSize(a.type), true);
             out += "\n";
@@ -235,10 +323,12 @@ writeVtu(const ParticleSet& particles, std::ostream& os)
     array("Int64", "offsets", 1, offsets);
     array("UInt8", "types", 1, types);
     xml += "      </Cells>\n      <PointData>\n";
-    for (const ParticleAttribute& a : particles.attributes) {
+    const std::vector<std::string> names = uniqueNames(particles, headerWord, wholeColumn);
+    for (size_t i = 0; i < particles.attributes.size(); ++i) {
+        const ParticleAttribute& a = particles.attributes[i];
         std::string bytes;
         appendSwapped(bytes, a.bytes.data(), n * size_t(a.components), scalarSize(a.type), false);
-        array(vtuTypeName(a.type), a.name, a.components, bytes);
+        array(vtuTypeName(a.type), names[i], a.components, bytes);
     }
     xml += "      </PointData>\n    </Piece>\n  </UnstructuredGrid>\n  <AppendedData encoding=\"raw\">\n   _";
     os.write(xml.data(), std::streamsize(xml.size()));
@@ -269,11 +359,9 @@ void
 writeCsv(const ParticleSet& particles, std::ostream& os)
 {
     std::string out = "x,y,z";
-    for (const ParticleAttribute& a : particles.attributes) {
-        for (int c = 0; c < a.components; ++c) {
-            out += "," + headerWord(a.name);
-            if (a.components > 1) out += ":" + std::to_string(c);
-        }
+    const std::vector<std::string> names = uniqueNames(particles, headerWord, csvColumns);
+    for (size_t i = 0; i < particles.attributes.size(); ++i) {
+        for (const std::string& column : csvColumns(names[i], particles.attributes[i].components)) out += "," + column;
     }
     out += "\n";
     char buffer[64];
@@ -325,7 +413,8 @@ addScalarAttribute(PointDataGrid& grid, const PointIndexGrid& index, const Parti
 
 template<typename VecT>
 void
-addVectorAttribute(PointDataGrid& grid, const PointIndexGrid& index, const ParticleAttribute& a)
+addVectorAttribute(PointDataGrid& grid, const PointIndexGrid& index, const ParticleAttribute& a,
+                   const std::string& name)
 {
     using ScalarT = typename VecT::value_type;
     std::vector<VecT> values(a.size());
@@ -333,7 +422,7 @@ addVectorAttribute(PointDataGrid& grid, const PointIndexGrid& index, const Parti
         values[n] = VecT(static_cast<ScalarT>(a.asDouble(n, 0)), static_cast<ScalarT>(a.asDouble(n, 1)),
                          static_cast<ScalarT>(a.asDouble(n, 2)));
     }
-    addVdbAttribute(grid, index, a.name, values);
+    addVdbAttribute(grid, index, name, values);
 }
 
 } // namespace
@@ -352,16 +441,18 @@ makePointDataGrid(const ParticleSet& particles, double voxelSize)
     auto grid = openvdb::points::createPointDataGrid<openvdb::points::NullCodec, PointDataGrid>(
         *index, wrapper, *transform);
     grid->setName("points");
-    for (const ParticleAttribute& a : particles.attributes) {
-        if (a.name == "P" || a.size() != particles.size()) continue;
+    const std::vector<std::string> names = uniqueNames(particles, vdbWord, vdbColumns);
+    for (size_t i = 0; i < particles.attributes.size(); ++i) {
+        const ParticleAttribute& a = particles.attributes[i];
+        if (a.name == "P" || a.size() != particles.size()) continue;  // P is the positions
         if (a.components == 3) {
-            if (a.type == ScalarType::Float32) addVectorAttribute<openvdb::Vec3f>(*grid, *index, a);
-            else if (a.type == ScalarType::Float64) addVectorAttribute<openvdb::Vec3d>(*grid, *index, a);
-            else addVectorAttribute<openvdb::Vec3i>(*grid, *index, a);
+            if (a.type == ScalarType::Float32) addVectorAttribute<openvdb::Vec3f>(*grid, *index, a, names[i]);
+            else if (a.type == ScalarType::Float64) addVectorAttribute<openvdb::Vec3d>(*grid, *index, a, names[i]);
+            else addVectorAttribute<openvdb::Vec3i>(*grid, *index, a, names[i]);
             continue;
         }
         for (int c = 0; c < a.components; ++c) {
-            const std::string name = a.components == 1 ? a.name : a.name + "_" + std::to_string(c);
+            const std::string name = vdbColumns(names[i], a.components)[size_t(c)];
             switch (a.type) {
             case ScalarType::Int8: addScalarAttribute<int8_t>(*grid, *index, a, c, name); break;
             case ScalarType::UInt8:

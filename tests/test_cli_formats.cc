@@ -17,6 +17,7 @@
 #include "CliTestUtil.h"
 
 #include <cmath>
+#include <cstring>
 #include <map>
 #include <string>
 #include <vector>
@@ -274,4 +275,50 @@ TEST_F(CliFormatsTest, FullDiskWhileWritingVdbIsAnErrorAndLeavesNothing)
                          + " --vdb " + quote(grids) + " --vdb-points --vdb-surface"), 1);
     EXPECT_EQ(readText(path("stderr.txt")), "nonbloppy: cannot write " + grids + ": File too large\n");
     EXPECT_TRUE(listDir(outDir).empty()) << "output files left behind";
+}
+
+TEST_F(CliFormatsTest, RenamedAttributesStayDistinctAndReadBack)
+{
+    // "a b" becomes a_b beside an a_b; an attribute x meets the positions; "my attr" cannot
+    // be an OpenVDB name. Before, the CSV had two a_b columns, which nonbloppy itself then
+    // refused ("duplicate column"), and .vdb failed with OpenVDB's "invalid characters".
+    ParticleSet particles;
+    particles.positions = {{0.0f, 0.0f, 0.0f}, {1.0f, 0.0f, 0.0f}};
+    const auto add = [&](const std::string& name, int components, float first) {
+        ParticleAttribute a;
+        a.name = name;
+        a.type = nonbloppy::ScalarType::Float32;
+        a.components = components;
+        std::vector<float> values;
+        for (int k = 0; k < 2 * components; ++k) values.push_back(first + float(k));
+        a.bytes.resize(values.size() * sizeof(float));
+        std::memcpy(a.bytes.data(), values.data(), a.bytes.size());
+        particles.attributes.push_back(a);
+    };
+    add("a b", 1, 10.0f);
+    add("a_b", 1, 20.0f);
+    add("x", 1, 50.0f);
+    add("my attr", 1, 60.0f);
+    // The name each attribute reads back under, per format; an unchanged name keeps its own.
+    const std::map<std::string, std::vector<std::string>> expected{
+        {".csv", {"a_b_2", "a_b", "x_2", "my_attr"}},
+        {".ply", {"a_b_2", "a_b", "x_2", "my_attr"}},
+        {".vtk", {"a_b_2", "a_b", "x_2", "my_attr"}},
+        {".vtu", {"a_b_2", "a_b", "x_2", "my_attr"}},
+        {".vdb", {"a_b_2", "a_b", "x_2", "my_attr"}}};
+    for (const auto& [ext, names] : expected) {
+        const std::string file = path("renamed" + ext);
+        nonbloppy::writeParticles(particles, file);
+        const ParticleSet back = nonbloppy::readParticles(file);
+        for (size_t i = 0; i < names.size(); ++i) {
+            const ParticleAttribute* a = back.findAttribute(names[i]);
+            ASSERT_NE(a, nullptr) << ext << " " << names[i];
+            EXPECT_EQ(a->components, particles.attributes[i].components) << ext << " " << names[i];
+            for (size_t n = 0; n < back.size(); ++n) {
+                // Match by position: a .vdb may reorder the particles.
+                const size_t original = back.positions[n][0] > 0.5f ? 1 : 0;
+                EXPECT_EQ(a->asDouble(n, 0), particles.attributes[i].asDouble(original, 0)) << ext << " " << names[i];
+            }
+        }
+    }
 }

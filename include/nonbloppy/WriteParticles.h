@@ -36,6 +36,10 @@ struct ParticleWriteSettings
 /// - `.csv`  header "x,y,z,<name>" (multi-component: "<name>:0,<name>:1,...", as ParaView),
 ///           shortest round-trip decimal text.
 /// - `.vdb`  one PointDataGrid named "points" (see makePointDataGrid()).
+/// Attribute names are written in the format's alphabet (spaces, commas, quotes, <, >, &
+/// and non-ASCII bytes become '_'; for `.vdb` all but letters, digits, '_', '|' and ':'),
+/// and kept distinct: a name that would repeat another column (or x, y, z, P) gets _2,
+/// _3, ...; names that need no change keep theirs ("a b" beside "a_b" is "a_b_2").
 /// Written through a temporary file renamed into place; same particles, same bytes (with
 /// or without direct I/O, see ParticleWriteSettings; `.vdb` goes through OpenVDB's own
 /// writer and always uses the page cache).
