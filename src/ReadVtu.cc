@@ -1149,7 +1149,9 @@ private:
         XML_SetCharacterDataHandler(mParser, &VtuReader::onText);
         const uint64_t shift = begin - std::min<uint64_t>(begin, prefix.size());
         auto errorText = [&] {
-            return "XML error at byte " + std::to_string(shift + uint64_t(XML_GetCurrentByteIndex(mParser))) +
+            // Expat gives -1 when it has no position (an empty document).
+            const XML_Index at = XML_GetCurrentByteIndex(mParser);
+            return "XML error at byte " + std::to_string(shift + uint64_t(std::max<XML_Index>(at, 0))) +
                    ": " + XML_ErrorString(XML_GetErrorCode(mParser)) + " (" + mPath + ")";
         };
         if (!prefix.empty()) {

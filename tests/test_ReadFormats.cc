@@ -370,6 +370,9 @@ TEST_F(ReadFormatsTest, VtuTruncatedCorruptAndHostile)
     EXPECT_EQ(fileErrorOf(half), "truncated AppendedData (no </AppendedData>) (" + half + ")");
     const std::string noXml = write("noxml.vtu", fluid.substr(0, 300));
     EXPECT_EQ(fileErrorOf(noXml).rfind("XML error at byte ", 0), 0u) << fileErrorOf(noXml);
+    // Expat has no position in an empty document (-1, printed as 18446744073709551615).
+    const std::string empty = write("empty.vtu", "");
+    EXPECT_EQ(fileErrorOf(empty), "XML error at byte 0: no element found (" + empty + ")");
 
     VtuVariant v;
     v.zlib = true;
