@@ -259,6 +259,9 @@ TEST_F(CliTest, BadParameters)
     expectFailure(base + "--adaptivity 1.5", "--adaptivity must lie in [0,1], got 1.5");
     expectFailure(base + "--region-leaves -1", "--region-leaves must be >= 0, got -1");
     expectFailure(base + "--threads 0", "--threads must be >= 1, got 0");
+    // An empty value was read as 0.
+    expectFailure(base + "--blend ''", "--blend needs a number, got ''");
+    expectFailure(base + "--adaptivity ''", "--adaptivity needs a number, got ''");
     // Refused before r_0 is calibrated over a kernel 1000 spacings wide (hours).
     expectFailure(base + "--spacing 0.05 --radius 50",
                   "--voxel-size 0.025 is too small for --radius 50: at most 32 voxels per radius");

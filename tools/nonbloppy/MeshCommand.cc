@@ -254,6 +254,17 @@ void requireWritableDirectory(const std::string& path)
 /// validateParameters() checks the numbers, validatePaths() the files of one frame.
 void validateParameters(const MeshOptions& o)
 {
+    // CLI11 reads an empty value ('--blend ""') as 0 without a word.
+    for (const CLI::Option* option : {o.spacingOpt, o.radiusOpt, o.thresholdOpt, o.voxelSizeOpt, o.blendOpt,
+                                      o.iterationsOpt, o.adaptivityOpt, o.regionLeavesOpt, o.threadsOpt,
+                                      o.frameJobsOpt}) {
+        if (!option) continue;
+        for (const std::string& value : option->results()) {
+            if (value.find_first_not_of(" \t") == std::string::npos) {
+                throw nonbloppy::ParameterError(option->get_name() + " needs a number, got ''");
+            }
+        }
+    }
     requirePositive(o.spacingOpt, o.spacing, "--spacing");
     requirePositive(o.radiusOpt, o.radius, "--radius");
     requirePositive(o.thresholdOpt, o.threshold, "--threshold");
