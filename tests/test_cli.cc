@@ -375,6 +375,18 @@ TEST_F(CliTest, InspectTruncatedVdbIsOneLineQuickly)
     }
 }
 
+TEST_F(CliTest, EmptyMeshIsWrittenWithAWarning)
+{
+    // A frame of spray may mesh to nothing; an out-of-scale --threshold did so without a word.
+    const RunResult r = run("mesh " + quote(kCube) + " -q -o " + quote(out("empty.obj")) + " --threshold 1e308");
+    EXPECT_EQ(r.exitCode, 0);
+    EXPECT_EQ(r.err, "nonbloppy: warning: " + out("empty.obj")
+                         + " is empty: the density of the 2366 particles nowhere reaches --threshold 1e+308\n");
+    EXPECT_TRUE(fs::exists(out("empty.obj")));
+    const RunResult normal = run("mesh " + quote(kCube) + " -q -o " + quote(out("cube.obj")));
+    EXPECT_EQ(normal.err, "");
+}
+
 TEST_F(CliTest, UsageErrorsAreOneLine)
 {
     for (const std::string& args : {std::string(""), std::string("mesh"),

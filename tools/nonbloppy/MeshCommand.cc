@@ -521,6 +521,16 @@ void warnIfFacesEndInside(const MeshOptions& o, const nonbloppy::ResolvedParamet
               << std::endl;
 }
 
+/// An empty mesh from particles is written (a frame of spray may have none), but said: an
+/// out-of-scale --threshold (1e308) gave 0 vertices and exit 0 without a word.
+void warnIfEmpty(const nonbloppy::SurfaceResult& result, const std::string& output)
+{
+    if (result.particleCount == 0 || !result.mesh.points.empty()) return;
+    std::cerr << "nonbloppy: warning: " << output << " is empty: the density of the "
+              << result.particleCount << " particles nowhere reaches --threshold "
+              << formatNumber(result.parameters.threshold) << std::endl;
+}
+
 // ---------------------------------------------------------------------------------------
 // Frame sequences
 
@@ -632,6 +642,7 @@ int runSequence(const MeshOptions& o)
         if (o.verbose) sampler = std::make_unique<ResidentSampler>();
         const FrameOutcome outcome = meshFrame(f, interrupter);
         warnIfFacesEndInside(o, outcome.result.parameters);
+        warnIfEmpty(outcome.result, f.output);
 
         FrameReport report;
         const nonbloppy::SurfaceResult& result = outcome.result;
@@ -684,6 +695,7 @@ int runMesh(const MeshOptions& o)
     try {
         const FrameOutcome outcome = meshFrame(o, interrupter);
         warnIfFacesEndInside(o, outcome.result.parameters);
+        warnIfEmpty(outcome.result, o.output);
         if (sampler) {
             sampler->stop();
             std::cerr << sampler->report(outcome.timings, outcome.result.particleCount);
