@@ -5,20 +5,10 @@
 #include "VectorArea.h"
 
 #include <tbb/parallel_for.h>
-#include <tbb/task_arena.h>
 
-#include <algorithm>
 #include <memory>
 
 namespace nonbloppy {
-
-namespace {
-
-/// Fewest vertices worth a range of their own in the normal sums (a range walks every
-/// polygon, so small meshes stay in one).
-constexpr size_t kMinVerticesPerRange = 65536;
-
-} // namespace
 
 namespace cancellation_internal {
 
@@ -38,42 +28,20 @@ void computeNormals(SurfaceMesh& mesh, CancelPoll& poll)
             }
         });
     poll.throwIfStopped();
-    // Each task takes one range of vertex numbers and walks every polygon in order, adding
-    // the normals of the corners in its range: every vertex still sums its polygons in
-    // polygon order, so the result has the same bits for any number of ranges. Extraction
-    // numbers vertices and polygons region by region, so most polygons have all their
-    // corners in one range and their normal is computed by one task only.
-    const size_t vertexCount = p.size();
-    const size_t ranges = std::clamp<size_t>(size_t(tbb::this_task_arena::max_concurrency()), 1,
-                                             vertexCount / kMinVerticesPerRange + 1);
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, ranges, 1), [&](const tbb::blocked_range<size_t>& range) {
-        for (size_t k = range.begin(); k < range.end(); ++k) {
-            const uint32_t first = uint32_t(k * vertexCount / ranges);
-            const uint32_t count = uint32_t((k + 1) * vertexCount / ranges) - first;
-            const auto mine = [&](uint32_t v) { return v - first < count; };  // first <= v < first + count
-            for (size_t n = 0; n < mesh.triangles.size(); ++n) {
-                if (poll.stoppedAt(n)) return;
-                const openvdb::Vec3I& t = mesh.triangles[n];
-                if (!(mine(t[0]) || mine(t[1]) || mine(t[2]))) continue;
-                const openvdb::Vec3d normal = twiceVectorArea(openvdb::Vec3d(p[t[0]]), openvdb::Vec3d(p[t[1]]),
-                                                              openvdb::Vec3d(p[t[2]]));
-                for (int c = 0; c < 3; ++c) {
-                    if (mine(t[c])) sums[t[c]] += normal;
-                }
-            }
-            for (size_t n = 0; n < mesh.quads.size(); ++n) {
-                if (poll.stoppedAt(n)) return;
-                const openvdb::Vec4I& q = mesh.quads[n];
-                if (!(mine(q[0]) || mine(q[1]) || mine(q[2]) || mine(q[3]))) continue;
-                const openvdb::Vec3d normal = twiceVectorArea(openvdb::Vec3d(p[q[0]]), openvdb::Vec3d(p[q[1]]),
-                                                              openvdb::Vec3d(p[q[2]]), openvdb::Vec3d(p[q[3]]));
-                for (int c = 0; c < 4; ++c) {
-                    if (mine(q[c])) sums[q[c]] += normal;
-                }
-            }
-        }
-    });
-    poll.throwIfStopped();
+    for (size_t n = 0; n < mesh.triangles.size(); ++n) {
+        if (poll.stoppedAt(n)) poll.throwIfStopped();
+        const openvdb::Vec3I& t = mesh.triangles[n];
+        const openvdb::Vec3d a(p[t[0]]), b(p[t[1]]), c(p[t[2]]);
+        const openvdb::Vec3d normal = twiceVectorArea(a, b, c);
+        sums[t[0]] += normal; sums[t[1]] += normal; sums[t[2]] += normal;
+    }
+    for (size_t n = 0; n < mesh.quads.size(); ++n) {
+        if (poll.stoppedAt(n)) poll.throwIfStopped();
+        const openvdb::Vec4I& q = mesh.quads[n];
+        const openvdb::Vec3d a(p[q[0]]), b(p[q[1]]), c(p[q[2]]), d(p[q[3]]);
+        const openvdb::Vec3d normal = twiceVectorArea(a, b, c, d);
+        sums[q[0]] += normal; sums[q[1]] += normal; sums[q[2]] += normal; sums[q[3]] += normal;
+    }
     mesh.normals.resize(p.size());
     tbb::parallel_for(tbb::blocked_range<size_t>(0, p.size()),
         [&](const tbb::blocked_range<size_t>& range) {
