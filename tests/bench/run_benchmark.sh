@@ -5,7 +5,8 @@
 #   bash tests/bench/run_benchmark.sh [--quick] [--runs N] [--out DIR]
 #
 #   --quick   skip the 512x input (12.5M particles) and the t/threads scans run once each
-#   --runs N  repetitions per tool and input, alternating the tools (default 3; the median is kept)
+#   --runs N  rounds over the inputs, each running both tools in turn on each input (default 3;
+#             the median is kept)
 #   --out DIR where the generated inputs, meshes and the report go (default /tmp/nonbloppy-bench)
 #
 # The peer is `vdb_tool` from Debian's libopenvdb-tools:
@@ -74,7 +75,7 @@ say ""
 say "Command: \`bash tests/bench/run_benchmark.sh$( ((quick)) && printf ' --quick')  --runs $runs\`, $(date -u +%Y-%m-%d), $(nproc) cores, $(awk '/MemTotal/ {printf "%.0f GiB", $2 / 1048576}' /proc/meminfo)."
 say "Input: \`tests/data/dam_break_frame_23_24389_particles.vtk\` tiled by \`nonbloppy_tile --copies N\` (binary PLY)."
 say "nonbloppy: \`mesh IN -o OUT.ply ${nb_args[*]}\`; vdb_tool: \`-points2ls voxel=0.025 radius=2 width=3 -ls2mesh adapt=0\`."
-say "Median of $runs runs each, the two tools alternating."
+say "Median of $runs runs each, in rounds over the inputs, the two tools alternating."
 say ""
 say "| input | particles | tool | wall s | CPU s | peak RSS MB | particles/s | wall ratio | RSS ratio |"
 say "| --- | --- | --- | --- | --- | --- | --- | --- | --- |"
@@ -83,15 +84,23 @@ declare -A nb_wall nb_cpu pair_ratios
 for size in "${sizes[@]}"; do
   input="$out/dam_break_x${size}.ply"
   [ -s "$input" ] || "$tile" "$frame" "$input" --copies "${copies_of[$size]}" > /dev/null
-  particles=$(( 24389 * size ))
   rm -f "$out/nb_$size" "$out/vt_$size" "$out/nb_$size.compute"
-  for ((r = 0; r < runs; ++r)); do
+done
+# Rounds over every size, rather than all runs of one size then the next: the machine's speed
+# drifts over minutes, and the linearity compares nonbloppy at 512x with itself at 64x, so
+# each round measures both sizes within a minute or two of each other.
+for ((r = 0; r < runs; ++r)); do
+  for size in "${sizes[@]}"; do
+    input="$out/dam_break_x${size}.ply"
     rm -f "$out/nb_x$size.ply" "$out/vt_x$size.ply"
     run_timed "$out/nb_$size" "$nonbloppy" mesh "$input" -o "$out/nb_x$size.ply" "${nb_args[@]}"
     compute_time "$out/nb_$size.out" >> "$out/nb_$size.compute"
     run_timed "$out/vt_$size" vdb_tool -read "$input" -points2ls voxel=0.025 radius=2 width=3 \
       -ls2mesh adapt=0 -write "$out/vt_x$size.ply"
   done
+done
+for size in "${sizes[@]}"; do
+  particles=$(( 24389 * size ))
   nbw=$(median 1 "$out/nb_$size"); nbc=$(median 2 "$out/nb_$size"); nbm=$(median 3 "$out/nb_$size")
   vtw=$(median 1 "$out/vt_$size"); vtc=$(median 2 "$out/vt_$size"); vtm=$(median 3 "$out/vt_$size")
   nb_wall[$size]=$nbw
@@ -118,6 +127,8 @@ say "Per-particle wall time, 512x relative to 64x (1.00 = linear): $(
     awk -v a="${nb_wall[512]}" -v b="${nb_wall[64]}" 'BEGIN {printf "%.2f", (a / 512) / (b / 64)}'
     printf '; per-particle CPU time (user + system): '
     awk -v a="${nb_cpu[512]}" -v b="${nb_cpu[64]}" 'BEGIN {printf "%.2f", (a / 512) / (b / 64)}'
+    printf '; each round (512x and 64x runs of one round): '
+    paste -d' ' "$out/nb_512" "$out/nb_64" | awk '{printf "%s%.2f", (NR > 1 ? " " : ""), ($1 / 512) / ($4 / 64)}'
   else echo "not measured (--quick)"; fi)"
 
 # Stages of the last 64x run, as nonbloppy prints them.
