@@ -46,8 +46,6 @@ public:
 
     /// The final file name, as given (errors name it).
     const std::string& path() const { return mPath; }
-    /// The file commit() replaces: path() with symbolic links followed.
-    const std::string& target() const { return mTarget; }
     /// Where to write the contents until commit().
     const std::string& tempPath() const { return mTempPath; }
     /// True once commit() has succeeded.
@@ -60,7 +58,7 @@ public:
 
 private:
     std::string mPath;
-    std::string mTarget;
+    std::string mTarget;  ///< the file commit() replaces: mPath with symbolic links followed
     std::string mTempPath;
     bool mCommitted = false;
 };

@@ -97,13 +97,13 @@ fail(const std::string& path, const std::string& what)
 }
 
 std::string
-printable(std::string_view text)
+printable(std::string_view text, size_t maxLength)
 {
     std::string result;
-    for (char ch : text.substr(0, 40)) {
+    for (char ch : text.substr(0, maxLength)) {
         result += (ch >= 32 && ch < 127) ? ch : '?';
     }
-    if (text.size() > 40) result += "...";
+    if (text.size() > maxLength) result += "...";
     return result;
 }
 
@@ -582,6 +582,10 @@ public:
     VtkParser(ByteInput& input, const std::string& path, bool wantPolygons)
         : mInput(input), mPath(path), mWantPolygons(wantPolygons) {}
 
+    /// Whether parse() reached a POLYGONS section header declaring at least one polygon
+    /// (true even if the section's data then failed to decode).
+    bool sawPolygons() const { return mSawPolygons; }
+
     VtkData parse()
     {
         readHeader();
@@ -908,13 +912,6 @@ private:
     bool mInCellData = false;
     uint64_t mTupleCount = 0;
     VtkData mData;
-
-public:
-    /// Whether parse() reached a POLYGONS section header declaring at least one polygon
-    /// (true even if the section's data then failed to decode).
-    bool sawPolygons() const { return mSawPolygons; }
-
-private:
     bool mSawPolygons = false;
 };
 

@@ -59,9 +59,9 @@ std::string lowerExtension(const std::string& path);
 /// Throw FileError("<what> (<path>)").
 [[noreturn]] void fail(const std::string& path, const std::string& what);
 
-/// @a text made safe for a one-line message: at most 40 characters, non-printable bytes
-/// replaced by '?'.
-std::string printable(std::string_view text);
+/// @a text made safe for a one-line message: at most @a maxLength characters (then "..."),
+/// non-printable bytes replaced by '?'.
+std::string printable(std::string_view text, size_t maxLength = 40);
 
 // ------------------------------------------------------------------------------------------
 // Text and value helpers shared by the in-memory parsers here and the streaming readers in

@@ -6,6 +6,7 @@
 
 #include <nonbloppy/Error.h>
 
+#include "FileFormats.h"
 #include "ReadVdbPoints.h"
 
 #include <openvdb/io/File.h>
@@ -13,21 +14,6 @@
 #include <new>
 
 namespace nonbloppy {
-
-namespace {
-
-/// An exception's text as one short printable line: OpenVDB quotes whatever bytes it read.
-std::string oneLine(const std::string& text)
-{
-    constexpr size_t kMaxLength = 200;
-    std::string line = text.substr(0, kMaxLength);
-    for (char& ch : line) {
-        if (static_cast<unsigned char>(ch) < 0x20 || static_cast<unsigned char>(ch) >= 0x7f) ch = '?';
-    }
-    return text.size() > kMaxLength ? line + "..." : line;
-}
-
-} // namespace
 
 VdbFileContents readVdbFile(const std::string& path)
 {
@@ -45,7 +31,10 @@ VdbFileContents readVdbFile(const std::string& path)
         throw FileError("cannot read .vdb file: it asks for more memory than there is (" + path + ")");
     } catch (const std::exception& e) {
         // The layout was sound, so this is damage inside a tree (compressed values, masks).
-        throw FileError("cannot read .vdb file: corrupt grid data (OpenVDB: " + oneLine(e.what()) + ") (" + path + ")");
+        // OpenVDB quotes whatever bytes it read: one printable line of at most 200 characters.
+        constexpr size_t kMaxQuoted = 200;
+        throw FileError("cannot read .vdb file: corrupt grid data (OpenVDB: " + io_internal::printable(e.what(), kMaxQuoted) +
+                        ") (" + path + ")");
     }
     return contents;
 }

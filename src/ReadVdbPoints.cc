@@ -400,6 +400,15 @@ public:
         return version;
     }
 
+    /// The grid count (io::Archive::readGridCount()), refused if that many grids cannot fit.
+    uint32_t gridCount()
+    {
+        const uint32_t count = load<uint32_t>("grid count");
+        // A grid takes at least its descriptor (three strings and three offsets).
+        if (count > left() / 36) corrupt("grid count " + std::to_string(int32_t(count)) + " does not fit in the file");
+        return count;
+    }
+
     /// A MetaMap (MetaMap::readMeta): count, then name, type name and value per item.
     /// @a owner is "the file" or "grid '<name>'".
     void metaMap(const std::string& owner)
@@ -436,7 +445,7 @@ public:
     }
 
     /// A GridDescriptor (GridDescriptor::read): unique name, type, instance parent, offsets.
-    /// A GridDescriptor; returns the grid's name.
+    /// Returns the grid's name.
     std::string gridDescriptor(uint32_t version)
     {
         const std::string name = string("grid name");
@@ -1134,11 +1143,7 @@ public:
         fileMetadata.readMeta(is);
         expectAt(check.pos(), "the file metadata");
 
-        const uint32_t gridCount = check.load<uint32_t>("grid count");
-        // A grid takes at least its descriptor (three strings and three offsets).
-        if (gridCount > check.left() / 36) {
-            check.corrupt("grid count " + std::to_string(int32_t(gridCount)) + " does not fit in the file");
-        }
+        const uint32_t gridCount = check.gridCount();
         readGridCount(is);
 
         openvdb::GridPtrVec grids;
@@ -1185,10 +1190,7 @@ void checkLayout(const VdbSource& source, const std::string& path)
     const uint64_t size = source.size();
     const uint32_t version = check.header();
     check.metaMap("the file");
-    const uint32_t gridCount = check.load<uint32_t>("grid count");
-    if (gridCount > check.left() / 36) {
-        check.corrupt("grid count " + std::to_string(int32_t(gridCount)) + " does not fit in the file");
-    }
+    const uint32_t gridCount = check.gridCount();
     for (uint32_t i = 0; i < gridCount; ++i) {
         const std::string name = check.gridDescriptor(version);
         const size_t gridStart = check.pos();
@@ -1216,6 +1218,20 @@ void checkLayout(const VdbSource& source, const std::string& path)
     }
 }
 
+/// @a read(VdbSource) over the file @a path: a regular file through pread(); anything else
+/// (a pipe, which cannot be read twice: walk, then OpenVDB) read whole first.
+template<typename ReadT>
+auto withVdbSource(const std::string& path, ReadT&& read)
+{
+    const OpenFile file = openFile(path);
+    if (!file.regular) {
+        const std::vector<char> data = readToEndAndClose(file.fd, path, 0);
+        return read(VdbSource(data.data(), data.size(), path));
+    }
+    struct FdCloser { int fd; ~FdCloser() { ::close(fd); } } closer{file.fd};
+    return read(VdbSource(file.fd, file.size, path));
+}
+
 /// The first PointDataGrid of @a source, converted.
 ParticleSet
 readVdbPoints(const VdbSource& source, const std::string& path)
@@ -1236,11 +1252,7 @@ readVdbPoints(const VdbSource& source, const std::string& path)
     } catch (const std::ios_base::failure&) {
         fail(path, "cannot read .vdb file: truncated stream");
     } catch (const std::exception& e) {
-        std::string message = e.what();
-        for (char& ch : message) {
-            if (static_cast<unsigned char>(ch) < 0x20 || static_cast<unsigned char>(ch) >= 0x7f) ch = '?';
-        }
-        fail(path, "cannot read .vdb file: " + message);
+        fail(path, "cannot read .vdb file: " + printable(e.what(), std::string::npos));
     }
     fail(path, "no PointDataGrid in this .vdb file (grids: " +
          [&] {
@@ -1264,27 +1276,13 @@ readVdbPointsParticles(const char* data, size_t size, const std::string& path)
 void
 checkVdbLayout(const std::string& path)
 {
-    const OpenFile file = openFile(path);
-    if (!file.regular) {
-        const std::vector<char> data = readToEndAndClose(file.fd, path, 0);
-        checkLayout(VdbSource(data.data(), data.size(), path), path);
-        return;
-    }
-    struct FdCloser { int fd; ~FdCloser() { ::close(fd); } } closer{file.fd};
-    checkLayout(VdbSource(file.fd, file.size, path), path);
+    withVdbSource(path, [&](const VdbSource& source) { checkLayout(source, path); });
 }
 
 ParticleSet
 readVdbPointsFile(const std::string& path)
 {
-    const OpenFile file = openFile(path);
-    if (!file.regular) {
-        // A pipe cannot be read twice (walk, then OpenVDB): read it whole.
-        const std::vector<char> data = readToEndAndClose(file.fd, path, 0);
-        return readVdbPointsParticles(data.data(), data.size(), path);
-    }
-    struct FdCloser { int fd; ~FdCloser() { ::close(fd); } } closer{file.fd};
-    return readVdbPoints(VdbSource(file.fd, file.size, path), path);
+    return withVdbSource(path, [&](const VdbSource& source) { return readVdbPoints(source, path); });
 }
 
 } // namespace io_internal

@@ -97,19 +97,14 @@ wholeColumn(const std::string& base, int)
 }
 
 /// PLY properties: name, name_x/_y/_z, or name_<c>.
-std::string
-componentName(const std::string& base, int components, int c)
-{
-    if (components == 1) return base;
-    if (components == 3) return base + "_" + "xyz"[c];
-    return base + "_" + std::to_string(c);
-}
-
 std::vector<std::string>
 plyColumns(const std::string& base, int components)
 {
+    if (components == 1) return {base};
     std::vector<std::string> columns;
-    for (int c = 0; c < components; ++c) columns.push_back(componentName(base, components, c));
+    for (int c = 0; c < components; ++c) {
+        columns.push_back(components == 3 ? base + "_" + "xyz"[c] : base + "_" + std::to_string(c));
+    }
     return columns;
 }
 
@@ -201,8 +196,8 @@ writePly(const ParticleSet& particles, std::ostream& os)
     const std::vector<std::string> names = uniqueNames(particles, headerWord, plyColumns);
     for (size_t i = 0; i < particles.attributes.size(); ++i) {
         const ParticleAttribute& a = particles.attributes[i];
-        for (int c = 0; c < a.components; ++c) {
-            header += std::string("property ") + plyTypeName(a.type) + " " + componentName(names[i], a.components, c) + "\n";
+        for (const std::string& column : plyColumns(names[i], a.components)) {
+            header += std::string("property ") + plyTypeName(a.type) + " " + column + "\n";
         }
     }
     header += "end_header\n";
@@ -451,8 +446,9 @@ makePointDataGrid(const ParticleSet& particles, double voxelSize)
             else addVectorAttribute<openvdb::Vec3i>(*grid, *index, a, names[i]);
             continue;
         }
+        const std::vector<std::string> columns = vdbColumns(names[i], a.components);
         for (int c = 0; c < a.components; ++c) {
-            const std::string name = vdbColumns(names[i], a.components)[size_t(c)];
+            const std::string& name = columns[size_t(c)];
             switch (a.type) {
             case ScalarType::Int8: addScalarAttribute<int8_t>(*grid, *index, a, c, name); break;
             case ScalarType::UInt8:

@@ -15,8 +15,6 @@
 #include <nonbloppy/ReadParticles.h>
 #include <nonbloppy/ReadVdb.h>
 
-#include <openvdb/Exceptions.h>
-#include <openvdb/io/File.h>
 #include <openvdb/openvdb.h>
 #include <openvdb/tools/Count.h>
 
@@ -340,10 +338,10 @@ void printMetadata(const openvdb::MetaMap& metadata, const char* indent)
 
 int inspectVdb(const std::string& path, bool json)
 {
-    nonbloppy::VdbFileContents contents = nonbloppy::readVdbFile(path);
+    const nonbloppy::VdbFileContents contents = nonbloppy::readVdbFile(path);
     const std::string& fileVersion = contents.formatVersion;
-    const openvdb::MetaMap* fileMetadata = &contents.metadata;
-    const openvdb::GridPtrVec* grids = &contents.grids;
+    const openvdb::MetaMap& fileMetadata = contents.metadata;
+    const openvdb::GridPtrVec& grids = contents.grids;
 
     if (json) {
         JsonWriter w;
@@ -351,9 +349,9 @@ int inspectVdb(const std::string& path, bool json)
         w.string("file", path);
         w.string("type", "vdb");
         w.string("format_version", fileVersion);
-        writeMetadataJson(w, "metadata", *fileMetadata);
+        writeMetadataJson(w, "metadata", fileMetadata);
         w.beginArray("grids");
-        for (const openvdb::GridBase::Ptr& grid : *grids) {
+        for (const openvdb::GridBase::Ptr& grid : grids) {
             if (!grid) continue;
             w.beginObject();
             w.string("name", grid->getName());
@@ -389,10 +387,10 @@ int inspectVdb(const std::string& path, bool json)
         return 0;
     }
 
-    std::cout << path << ": OpenVDB file version " << fileVersion << ", " << grids->size()
-              << (grids->size() == 1 ? " grid" : " grids") << "\n";
-    printMetadata(*fileMetadata, "  ");
-    for (const openvdb::GridBase::Ptr& grid : *grids) {
+    std::cout << path << ": OpenVDB file version " << fileVersion << ", " << grids.size()
+              << (grids.size() == 1 ? " grid" : " grids") << "\n";
+    printMetadata(fileMetadata, "  ");
+    for (const openvdb::GridBase::Ptr& grid : grids) {
         if (!grid) continue;
         // One line per grid, as vdb_print: name, type, class, voxel size, index bbox,
         // active voxels, leaves, memory, value range.
