@@ -234,6 +234,14 @@ std::string lowerExtension(const std::string& path)
 }
 
 /// Fail now, before any work, if @a path's directory does not exist or cannot be written.
+/// True if @a a and @a b name one file: the same name (which need not exist yet), or
+/// existing paths to one file (hard links, symbolic links, "./").
+bool sameFile(const std::string& a, const std::string& b)
+{
+    std::error_code ec;
+    return a == b || fs::equivalent(a, b, ec);
+}
+
 void requireWritableDirectory(const std::string& path)
 {
     fs::path dir = fs::path(path).parent_path();
@@ -308,17 +316,12 @@ void validatePaths(const MeshOptions& o)
     if (!o.vdbPath.empty()) outputs.push_back(o.vdbPath);
     for (const std::string& out : outputs) {
         requireWritableDirectory(out);
-        std::error_code ec;
-        if (fs::equivalent(o.input, out, ec)) {
+        if (sameFile(o.input, out)) {
             throw nonbloppy::FileError("cannot write " + out + ": it is the input file");
         }
     }
-    if (!o.vdbPath.empty()) {
-        std::error_code ec;
-        if (o.vdbPath == o.output || fs::equivalent(o.vdbPath, o.output, ec)) {
-            throw nonbloppy::FileError("cannot write " + o.vdbPath
-                                       + ": --vdb and --output name the same file");
-        }
+    if (!o.vdbPath.empty() && sameFile(o.vdbPath, o.output)) {
+        throw nonbloppy::FileError("cannot write " + o.vdbPath + ": --vdb and --output name the same file");
     }
 }
 
@@ -568,17 +571,13 @@ void requirePlaceholder(const std::string& path, const std::string& option, cons
 /// frame is read) or a frame's output (whose rename would replace the log).
 void requireLogApart(const std::string& logPath, const std::vector<BatchJob>& jobs)
 {
-    const auto same = [&](const std::string& path) {
-        std::error_code ec;
-        return logPath == path || fs::equivalent(logPath, path, ec);
-    };
     for (const BatchJob& job : jobs) {
-        if (same(job.frame.input)) {
+        if (sameFile(logPath, job.frame.input)) {
             throw nonbloppy::FileError("cannot write " + logPath + ": --log names the input of frame "
                                        + std::to_string(job.frame.number));
         }
         for (const std::string& output : job.outputs) {
-            if (same(output)) {
+            if (sameFile(logPath, output)) {
                 throw nonbloppy::FileError("cannot write " + logPath + ": --log names an output of frame "
                                            + std::to_string(job.frame.number));
             }
