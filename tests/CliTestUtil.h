@@ -128,18 +128,24 @@ protected:
         return result;
     }
 
-    /// The failure contract: non-zero exit, exactly one stderr line, equal to
-    /// "nonbloppy: " + @a message, and nothing (not even a temporary file) in out/.
-    void expectFailure(const std::string& args, const std::string& message) const
+    /// The failure contract: exit @a exitCode (1: an error, 2: a bad command line), exactly
+    /// one stderr line, equal to "nonbloppy: " + @a message, and nothing (not even a
+    /// temporary file) in out/.
+    void expectFailure(const std::string& args, const std::string& message, int exitCode = 1) const
     {
         SCOPED_TRACE(args);
         const RunResult r = run(args);
-        EXPECT_NE(r.exitCode, 0);
-        EXPECT_LT(r.exitCode, 128) << "crashed";
+        EXPECT_EQ(r.exitCode, exitCode);
         const std::vector<std::string> errLines = lines(r.err);
         ASSERT_EQ(errLines.size(), 1u) << r.err;
         EXPECT_EQ(errLines[0], "nonbloppy: " + message);
         EXPECT_TRUE(listDir(mDir + "/out").empty()) << "output files left behind";
+    }
+
+    /// expectFailure() for a bad command line: exit 2 (docs/farm.md), before any work.
+    void expectUsageError(const std::string& args, const std::string& message) const
+    {
+        expectFailure(args, message, 2);
     }
 
     /// Starts `nonbloppy ARGS` (unquoted arguments) with stdout to /dev/null and stderr to

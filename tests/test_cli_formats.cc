@@ -117,10 +117,11 @@ TEST_F(CliFormatsTest, ConvertToXyzWarnsAndErrorsAreOneLine)
     for (size_t n = 0; n < 250; ++n) EXPECT_EQ(xyz.positions[n], vtu.positions[n]);
 
     RunResult bad = run("convert " + quote(source) + " " + quote(path("p.obj")));
-    EXPECT_EQ(bad.exitCode, 1);
+    EXPECT_EQ(bad.exitCode, 2);
     EXPECT_EQ(bad.err, "nonbloppy: unknown particle output extension '.obj' (" + path("p.obj") +
                        "); expected .ply, .vtk, .vtu, .xyz, .csv or .vdb\n");
     bad = run("convert " + quote(source) + " " + quote(source));
+    EXPECT_EQ(bad.exitCode, 2);
     EXPECT_EQ(bad.err, "nonbloppy: cannot write " + source + ": it is the input file\n");
     const std::string density = path("density.vdb");
     ASSERT_EQ(run("mesh " + quote(source) + " -q -o " + quote(path("m.ply")) + " --vdb " + quote(density)).exitCode, 0);

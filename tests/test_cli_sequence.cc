@@ -105,7 +105,7 @@ TEST_F(CliSequenceTest, OutputWithoutPlaceholderIsAnError)
     for (const std::string& extra : {std::string(""), " --vdb " + quote(out("d.vdb"))}) {
         const std::string output = extra.empty() ? out("mesh.obj") : out("mesh_{}.obj");
         const RunResult r = run("mesh " + quote(in("fluid_{}.vtk")) + " -o " + quote(output) + extra);
-        EXPECT_EQ(r.exitCode, 1);
+        EXPECT_EQ(r.exitCode, 2);
         const std::string option = extra.empty() ? "--output" : "--vdb";
         const std::string path = extra.empty() ? output : out("d.vdb");
         EXPECT_EQ(r.err, "nonbloppy: " + option + ": no frame placeholder ({}, #### or %04d) in '"
@@ -120,12 +120,12 @@ TEST_F(CliSequenceTest, LogNamingAnInputFrameOrAnOutputIsRefusedBeforeAnyWork)
     const std::string frame2 = in("fluid_0002.vtk");
     const std::string before = readText(frame2);
     // Written first, the log would have replaced frame 2 with JSON.
-    expectFailure("mesh " + quote(in("fluid_{}.vtk")) + " -o " + quote(out("mesh_{}.obj")) + " --log "
+    expectUsageError("mesh " + quote(in("fluid_{}.vtk")) + " -o " + quote(out("mesh_{}.obj")) + " --log "
                       + quote(frame2),
                   "cannot write " + frame2 + ": --log names the input of frame 2");
     EXPECT_EQ(readText(frame2), before);
     // Frame 1's rename would have replaced the log.
-    expectFailure("mesh " + quote(in("fluid_{}.vtk")) + " -o " + quote(out("mesh_{}.obj")) + " --vdb "
+    expectUsageError("mesh " + quote(in("fluid_{}.vtk")) + " -o " + quote(out("mesh_{}.obj")) + " --vdb "
                       + quote(out("density_{}.vdb")) + " --log " + quote(out("density_0001.vdb")),
                   "cannot write " + out("density_0001.vdb") + ": --log names an output of frame 1");
 }
@@ -133,7 +133,7 @@ TEST_F(CliSequenceTest, LogNamingAnInputFrameOrAnOutputIsRefusedBeforeAnyWork)
 TEST_F(CliSequenceTest, SequenceOptionsNeedASequence)
 {
     const RunResult r = run("mesh " + quote(kFree) + " -o " + quote(out("m.obj")) + " --frames 1-3");
-    EXPECT_EQ(r.exitCode, 1);
+    EXPECT_EQ(r.exitCode, 2);
     EXPECT_EQ(r.err, "nonbloppy: --frames needs a frame sequence as IN (a name with {}, #### or "
                      "%04d), got '" + kFree + "'\n");
     EXPECT_TRUE(listDir(dir() + "/out").empty());
@@ -165,12 +165,15 @@ TEST_F(CliSequenceTest, BadFramesIsAOneLineError)
              {"1-9:0", "--frames: bad step in '1-9:0' (must be an integer >= 1)"},
              {"1,,2", "--frames: empty item in '1,,2'"}}) {
         const RunResult r = run(base + " --frames " + quote(frames));
-        EXPECT_EQ(r.exitCode, 1);
+        EXPECT_EQ(r.exitCode, 2);
         EXPECT_EQ(r.err, "nonbloppy: " + message + "\n");
     }
     const RunResult jobs = run(base + " --frame-jobs 0");
+    EXPECT_EQ(jobs.exitCode, 2);
     EXPECT_EQ(jobs.err, "nonbloppy: --frame-jobs must be >= 1, got 0\n");
+    // No file to mesh is not a bad command line: a frame failed to appear (exit 1).
     const RunResult noFiles = run("mesh " + quote(in("gas_{}.vtk")) + " -o " + quote(out("m_{}.obj")));
+    EXPECT_EQ(noFiles.exitCode, 1);
     EXPECT_EQ(noFiles.err, "nonbloppy: no file matches " + in("gas_{}.vtk") + "\n");
     EXPECT_TRUE(listDir(dir() + "/out").empty());
 }
@@ -200,8 +203,29 @@ TEST_F(CliSequenceTest, FirstBadFrameStopsTheRun)
     makeCorruptFrame(2);
     const RunResult r = meshSequence(dir() + "/out", "");
     EXPECT_EQ(r.exitCode, 1);
-    EXPECT_EQ(r.err, "nonbloppy: truncated POINTS section (" + in("fluid_0002.vtk") + ")\n");
+    EXPECT_EQ(r.err, "nonbloppy: frame 2: truncated POINTS section (" + in("fluid_0002.vtk") + ")\n");
     EXPECT_EQ(listDir(dir() + "/out"), (std::vector<std::string>{"density_0001.vdb", "mesh_0001.obj"}));
+    // Frame 3 never started; the summary still adds up to the 3 frames.
+    EXPECT_NE(r.out.find("3 frames: 1 done, 1 failed, 0 skipped, 0 missing, 1 not run in "), std::string::npos)
+        << r.out;
+}
+
+TEST_F(CliSequenceTest, ParametersThatDoNotSuitAFrameFailThatFrame)
+{
+    // A frame of one particle has no spacing to derive the parameters from: the library's
+    // ParameterError. In a sequence that is a failed frame (exit 1, named), not a bad
+    // command line (exit 2): the same command meshes the other frames.
+    makeFrames({kFree, kFree});
+    writeText(in("fluid_0002.vtk"), "# vtk DataFile Version 3.0\none\nASCII\nDATASET POLYDATA\n"
+                                   "POINTS 1 float\n0 0 0\n");
+    const std::string message = "cannot estimate the particle spacing from 1 particle(s); give --spacing or "
+                                "--radius, --threshold and --voxel-size";
+    const RunResult r = meshSequence(dir() + "/out", "-q");
+    EXPECT_EQ(r.exitCode, 1);
+    EXPECT_EQ(r.err, "nonbloppy: frame 2: " + message + "\n");
+    const RunResult single = run("mesh " + quote(in("fluid_0002.vtk")) + " -o " + quote(out("one.obj")));
+    EXPECT_EQ(single.exitCode, 1);
+    EXPECT_EQ(single.err, "nonbloppy: " + message + "\n");
 }
 
 TEST_F(CliSequenceTest, KeepGoingListsFailedFrames)

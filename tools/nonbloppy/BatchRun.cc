@@ -23,6 +23,7 @@
 #include <filesystem>
 #include <iostream>
 #include <memory>
+#include <new>
 
 #include <sys/resource.h>
 #include <unistd.h>
@@ -126,7 +127,7 @@ public:
         progress(index, job.frame.input + " -> " + job.outputs.front() + ": " + text);
     }
 
-    void failed(size_t index, const std::string& message, std::exception_ptr error)
+    void failed(size_t index, const std::string& message)
     {
         std::lock_guard<std::mutex> lock(mMutex);
         mStatus[index] = Status::Failed;
@@ -134,7 +135,9 @@ public:
         logLine("{\"frame\": " + std::to_string(job.frame.number) + ", \"status\": \"failed\", "
                 "\"input\": " + jsonString(job.frame.input) + ", \"output\": "
                 + jsonString(job.outputs.front()) + ", \"error\": " + jsonString(message) + "}");
-        if (!mFirstError) mFirstError = error;
+        // Named like --keep-going's lines: in a sequence, the message alone may not say which
+        // frame (e.g. "cannot estimate the particle spacing from 1 particle(s)").
+        if (mFirstError.empty()) mFirstError = "frame " + std::to_string(job.frame.number) + ": " + message;
         if (mSettings.keepGoing) {
             // Reported now, on one line; the run goes on and fails at the end.
             clearBar();
@@ -207,13 +210,16 @@ public:
         }
 
         if (!mSettings.quiet) {
+            // Frames a stop left unstarted are counted too, so that the parts add up.
+            const std::string notRunPart =
+                notRun.empty() ? std::string() : ", " + std::to_string(notRun.size()) + " not run";
             char line[256];
             std::snprintf(line, sizeof(line),
-                          "%zu frames: %zu done, %zu failed, %zu skipped, %zu missing in %.2f s "
+                          "%zu frames: %zu done, %zu failed, %zu skipped, %zu missing%s in %.2f s "
                           "(%s particles/s)",
                           mJobs.size() + mSettings.missing.size(), doneFrames.size(),
                           failedFrames.size(), skippedFrames.size(), mSettings.missing.size(),
-                          total, formatCount(uint64_t(rate)).c_str());
+                          notRunPart.c_str(), total, formatCount(uint64_t(rate)).c_str());
             std::cout << line << std::endl;
         }
 
@@ -225,7 +231,7 @@ public:
             return kExitInterrupted;
         }
         if (!failedFrames.empty()) {
-            if (!mSettings.keepGoing && mFirstError) std::rethrow_exception(mFirstError);
+            if (!mSettings.keepGoing) throw nonbloppy::Error(mFirstError);
             throw nonbloppy::Error(std::to_string(failedFrames.size()) + " of "
                                    + std::to_string(mJobs.size()) + " frames failed: "
                                    + formatFrameList(failedFrames));
@@ -293,7 +299,7 @@ private:
     const bool mTerminal;
     const Clock::time_point mStart;
     std::FILE* mLog = nullptr;
-    std::exception_ptr mFirstError;
+    std::string mFirstError;  ///< "frame N: message" of the first frame that failed
     size_t mFinished = 0;
     uint64_t mParticles = 0;
     double mBusySeconds = 0.0;
@@ -333,11 +339,14 @@ void work(BatchState& state, const std::vector<BatchJob>& jobs, const BatchSetti
         } catch (const nonbloppy::CancelledError&) {
             state.interrupted(index);
             state.stop = true;
+        } catch (const std::bad_alloc&) {
+            state.failed(index, "out of memory");
+            if (!settings.keepGoing) state.stop = true;
         } catch (const std::exception& e) {
-            state.failed(index, e.what(), std::current_exception());
+            state.failed(index, e.what());
             if (!settings.keepGoing) state.stop = true;
         } catch (...) {
-            state.failed(index, "unknown error", std::current_exception());
+            state.failed(index, "unknown error");
             if (!settings.keepGoing) state.stop = true;
         }
     }

@@ -4,10 +4,13 @@
 ///        set-up function that declares a command's options, one function that runs it).
 ///
 /// Every run function returns the process exit code and reports failures by throwing:
-/// main() prints what() as the single line "nonbloppy: <message>" and exits with 1.
+/// main() prints what() as the single line "nonbloppy: <message>" and exits with 2 for a
+/// UsageError, 1 for any other error.
 
 #ifndef NONBLOPPY_TOOL_COMMANDS_H
 #define NONBLOPPY_TOOL_COMMANDS_H
+
+#include "UsageError.h"
 
 #include <CLI/CLI.hpp>
 
@@ -27,6 +30,7 @@ constexpr const char* kGroupDebug = "Debug";
 
 /// Exit status after SIGINT/SIGTERM (128 + SIGINT, as shells report it).
 constexpr int kExitInterrupted = 130;
+
 
 /// One subcommand: its CLI11 sub-app (options, help) and what runs it after parsing.
 struct Command

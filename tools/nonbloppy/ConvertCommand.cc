@@ -40,14 +40,14 @@ int runConvert(const ConvertOptions& o)
     // overwriting the input.
     if (!nonbloppy::isParticleOutputFile(o.output)) {
         const std::string ext = lowerExtensionOf(o.output);
-        throw nonbloppy::FileError(
+        throw UsageError(
             (ext.empty() ? "particle file name has no extension ("
                          : "unknown particle output extension '" + ext + "' (")
             + o.output + "); expected .ply, .vtk, .vtu, .xyz, .csv or .vdb");
     }
     std::error_code ec;
     if (o.input == o.output || std::filesystem::equivalent(o.input, o.output, ec)) {
-        throw nonbloppy::FileError("cannot write " + o.output + ": it is the input file");
+        throw UsageError("cannot write " + o.output + ": it is the input file");
     }
 
     const nonbloppy::ParticleSet particles = nonbloppy::readParticles(o.input);

@@ -3,6 +3,7 @@
 /// @brief Frame-number placeholders, `--frames` lists and the plan of a sequence run.
 
 #include "FrameSequence.h"
+#include "UsageError.h"
 
 #include <nonbloppy/Error.h>
 
@@ -108,7 +109,7 @@ FramePattern parseFramePattern(const std::string& text, const std::string& what)
     pattern.mText = text;
     const std::vector<Placeholder> found = findPlaceholders(text);
     if (found.size() > 1) {
-        throw nonbloppy::ParameterError(what + ": more than one frame placeholder in '" + text
+        throw UsageError(what + ": more than one frame placeholder in '" + text
                                         + "'");
     }
     if (found.empty()) return pattern;
@@ -163,7 +164,7 @@ std::optional<std::string> FramePattern::matchFileName(const std::string& fileNa
 
 std::vector<int> parseFrameList(const std::string& text, const std::string& what)
 {
-    if (trim(text).empty()) throw nonbloppy::ParameterError(what + ": empty frame list");
+    if (trim(text).empty()) throw UsageError(what + ": empty frame list");
     std::vector<int> frames;
     long long listed = 0;
     size_t start = 0;
@@ -172,7 +173,7 @@ std::vector<int> parseFrameList(const std::string& text, const std::string& what
         const std::string item = trim(text.substr(start, comma == std::string::npos
                                                              ? std::string::npos : comma - start));
         if (item.empty()) {
-            throw nonbloppy::ParameterError(what + ": empty item in '" + text + "'");
+            throw UsageError(what + ": empty item in '" + text + "'");
         }
 
         // item = A | A-B | A-B:S
@@ -184,32 +185,32 @@ std::vector<int> parseFrameList(const std::string& text, const std::string& what
         }
         const size_t dash = range.find('-');
         if (dash == std::string::npos && colon != std::string::npos) {
-            throw nonbloppy::ParameterError(what + ": a step needs a range, as in 1-10:2, got '"
+            throw UsageError(what + ": a step needs a range, as in 1-10:2, got '"
                                             + item + "'");
         }
         const std::optional<int> first = parseNumber(trim(range.substr(0, dash)));
         const std::optional<int> last =
             dash == std::string::npos ? first : parseNumber(trim(range.substr(dash + 1)));
         if (!first || !last) {
-            throw nonbloppy::ParameterError(what + ": bad " + std::string(dash == std::string::npos
+            throw UsageError(what + ": bad " + std::string(dash == std::string::npos
                                             ? "frame number '" : "range '") + item
                                             + "' (expected N, A-B or A-B:STEP with A, B >= 0)");
         }
         if (*last < *first) {
-            throw nonbloppy::ParameterError(what + ": bad range '" + item + "' (end before start)");
+            throw UsageError(what + ": bad range '" + item + "' (end before start)");
         }
         int step = 1;
         if (colon != std::string::npos) {
             const std::optional<int> s = parseNumber(stepText);
             if (!s || *s < 1) {
-                throw nonbloppy::ParameterError(what + ": bad step in '" + item
+                throw UsageError(what + ": bad step in '" + item
                                                 + "' (must be an integer >= 1)");
             }
             step = *s;
         }
         listed += (static_cast<long long>(*last) - *first) / step + 1;
         if (listed > kMaxListedFrames) {
-            throw nonbloppy::ParameterError(what + ": more than "
+            throw UsageError(what + ": more than "
                                             + std::to_string(kMaxListedFrames) + " frames in '"
                                             + text + "'");
         }
@@ -243,7 +244,7 @@ std::vector<Frame> findFrames(const FramePattern& input)
 {
     const std::string dir = input.directory();
     if (!input.placeholderInFileName()) {
-        throw nonbloppy::ParameterError("IN: the frame placeholder must be in the file name, "
+        throw UsageError("IN: the frame placeholder must be in the file name, "
                                         "not in a directory ('" + input.text() + "')");
     }
     std::error_code ec;

@@ -212,7 +212,7 @@ std::optional<double> ifGiven(const CLI::Option* option, double value)
 void requirePositive(const CLI::Option* option, double value, const char* name)
 {
     if (option->count() > 0 && !(value > 0.0 && std::isfinite(value))) {
-        throw nonbloppy::ParameterError(std::string(name) + " must be > 0, got "
+        throw UsageError(std::string(name) + " must be > 0, got "
                                         + formatNumber(value));
     }
 }
@@ -220,7 +220,7 @@ void requirePositive(const CLI::Option* option, double value, const char* name)
 void requireUnitInterval(double value, const char* name)
 {
     if (!(value >= 0.0 && value <= 1.0)) {
-        throw nonbloppy::ParameterError(std::string(name) + " must lie in [0,1], got "
+        throw UsageError(std::string(name) + " must lie in [0,1], got "
                                         + formatNumber(value));
     }
 }
@@ -269,7 +269,7 @@ void validateParameters(const MeshOptions& o)
         if (!option) continue;
         for (const std::string& value : option->results()) {
             if (value.find_first_not_of(" \t") == std::string::npos) {
-                throw nonbloppy::ParameterError(option->get_name() + " needs a number, got ''");
+                throw UsageError(option->get_name() + " needs a number, got ''");
             }
         }
     }
@@ -279,16 +279,16 @@ void validateParameters(const MeshOptions& o)
     requirePositive(o.voxelSizeOpt, o.voxelSize, "--voxel-size");
     requireUnitInterval(o.blend, "--blend");
     if (o.iterations < 0) {
-        throw nonbloppy::ParameterError("--iterations must be >= 0, got "
+        throw UsageError("--iterations must be >= 0, got "
                                         + std::to_string(o.iterations));
     }
     requireUnitInterval(o.adaptivity, "--adaptivity");
     if (o.regionLeaves < 0) {
-        throw nonbloppy::ParameterError("--region-leaves must be >= 0, got "
+        throw UsageError("--region-leaves must be >= 0, got "
                                         + std::to_string(o.regionLeaves));
     }
     if (o.threadsOpt->count() > 0 && o.threads < 1) {
-        throw nonbloppy::ParameterError("--threads must be >= 1, got " + std::to_string(o.threads));
+        throw UsageError("--threads must be >= 1, got " + std::to_string(o.threads));
     }
 }
 
@@ -297,13 +297,13 @@ void validatePaths(const MeshOptions& o)
     // Spelled as writeMesh() spells it, which would say the same after all the work.
     if (!nonbloppy::isMeshFile(o.output)) {
         const std::string ext = lowerExtension(o.output);
-        throw nonbloppy::FileError(
+        throw UsageError(
             (ext.empty() ? "mesh file name has no extension ("
                          : "unknown mesh file extension '" + ext + "' (")
             + o.output + "); expected .obj, .ply or .vtk");
     }
     if (!o.vdbPath.empty() && lowerExtension(o.vdbPath) != ".vdb") {
-        throw nonbloppy::FileError("--vdb file name must end in .vdb (" + o.vdbPath + ")");
+        throw UsageError("--vdb file name must end in .vdb (" + o.vdbPath + ")");
     }
 
     struct stat info;
@@ -317,11 +317,11 @@ void validatePaths(const MeshOptions& o)
     for (const std::string& out : outputs) {
         requireWritableDirectory(out);
         if (sameFile(o.input, out)) {
-            throw nonbloppy::FileError("cannot write " + out + ": it is the input file");
+            throw UsageError("cannot write " + out + ": it is the input file");
         }
     }
     if (!o.vdbPath.empty() && sameFile(o.vdbPath, o.output)) {
-        throw nonbloppy::FileError("cannot write " + o.vdbPath + ": --vdb and --output name the same file");
+        throw UsageError("cannot write " + o.vdbPath + ": --vdb and --output name the same file");
     }
 }
 
@@ -562,7 +562,7 @@ MeshOptions optionsForFrame(const MeshOptions& o, const Frame& frame)
 void requirePlaceholder(const std::string& path, const std::string& option, const MeshOptions& o)
 {
     if (!parseFramePattern(path, option).hasPlaceholder()) {
-        throw nonbloppy::ParameterError(option + ": no frame placeholder ({}, #### or %04d) in '"
+        throw UsageError(option + ": no frame placeholder ({}, #### or %04d) in '"
                                         + path + "', but IN is the sequence '" + o.input + "'");
     }
 }
@@ -573,12 +573,12 @@ void requireLogApart(const std::string& logPath, const std::vector<BatchJob>& jo
 {
     for (const BatchJob& job : jobs) {
         if (sameFile(logPath, job.frame.input)) {
-            throw nonbloppy::FileError("cannot write " + logPath + ": --log names the input of frame "
+            throw UsageError("cannot write " + logPath + ": --log names the input of frame "
                                        + std::to_string(job.frame.number));
         }
         for (const std::string& output : job.outputs) {
             if (sameFile(logPath, output)) {
-                throw nonbloppy::FileError("cannot write " + logPath + ": --log names an output of frame "
+                throw UsageError("cannot write " + logPath + ": --log names an output of frame "
                                            + std::to_string(job.frame.number));
             }
         }
@@ -589,7 +589,7 @@ int runSequence(const MeshOptions& o)
 {
     validateParameters(o);
     if (o.frameJobs < 1) {
-        throw nonbloppy::ParameterError("--frame-jobs must be >= 1, got "
+        throw UsageError("--frame-jobs must be >= 1, got "
                                         + std::to_string(o.frameJobs));
     }
     const FramePattern input = parseFramePattern(o.input, "IN");
@@ -672,7 +672,7 @@ int runMesh(const MeshOptions& o)
     for (const CLI::Option* option : {o.framesOpt, o.frameJobsOpt, o.skipExistingOpt,
                                       o.keepGoingOpt, o.logOpt}) {
         if (option->count() > 0) {
-            throw nonbloppy::ParameterError(option->get_name() + " needs a frame sequence as IN "
+            throw UsageError(option->get_name() + " needs a frame sequence as IN "
                                             "(a name with {}, #### or %04d), got '" + o.input + "'");
         }
     }

@@ -60,7 +60,7 @@ void addSurfaceAttributes(nonbloppy::SurfaceResult& result, const nonbloppy::Par
 {
     if (o.attributes.empty()) return;
     const std::vector<std::string> names = splitNames(o.attributes);
-    if (names.empty()) throw nonbloppy::ParameterError("--attributes names no attribute");
+    if (names.empty()) throw UsageError("--attributes names no attribute");
     nonbloppy::interpolateAttributes(result.mesh, particles, names,
                                      result.parameters.effectiveRadius, interrupter);
     std::string ext = std::filesystem::path(meshPath).extension().string();

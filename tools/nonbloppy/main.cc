@@ -57,6 +57,26 @@ int fail(const std::string& message, int exitCode)
     return exitCode;
 }
 
+/// CLI11's "Could not convert: --threads = abc" in the words of the tool's own checks:
+/// "--threads needs an integer, got 'abc'". Other messages (and any other spelling a later
+/// CLI11 may use) are returned as they are.
+std::string conversionMessage(const CLI::App& app, const std::string& message)
+{
+    const std::string prefix = "Could not convert: ";
+    const size_t equals = message.find(" = ", prefix.size());
+    if (message.compare(0, prefix.size(), prefix) != 0 || equals == std::string::npos) return message;
+    const std::string name = message.substr(prefix.size(), equals - prefix.size());
+    const std::string value = message.substr(equals + 3);
+    const CLI::Option* option = nullptr;
+    for (const CLI::App* command : app.get_subcommands({})) {  // all of them
+        if (command->parsed() && (option = command->get_option_no_throw(name))) break;
+    }
+    if (!option) return message;
+    const std::string type = option->get_type_name();
+    const bool integer = type == "INT" || type == "UINT";
+    return name + " needs " + (integer ? "an integer" : "a number") + ", got '" + value + "'";
+}
+
 int run(int argc, char** argv)
 {
     using namespace nonbloppy_tool;
@@ -95,6 +115,8 @@ int run(int argc, char** argv)
         app.parse(argc, argv);
     } catch (const CLI::Success& e) {
         return app.exit(e); // --help or --version: printed on stdout, exit 0
+    } catch (const CLI::ConversionError& e) {
+        return fail(conversionMessage(app, e.what()), kExitUsage);
     } catch (const CLI::ParseError& e) {
         return fail(e.what(), kExitUsage);
     }
@@ -125,6 +147,8 @@ int main(int argc, char** argv)
         return run(argc, argv);
     } catch (const nonbloppy::CancelledError&) {
         return fail("interrupted", nonbloppy_tool::kExitInterrupted);
+    } catch (const nonbloppy_tool::UsageError& e) {
+        return fail(e.what(), kExitUsage);
     } catch (const nonbloppy::Error& e) {
         return fail(e.what(), kExitError);
     } catch (const openvdb::Exception& e) {
