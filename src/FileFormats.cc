@@ -96,6 +96,36 @@ fail(const std::string& path, const std::string& what)
     throw FileError(what + " (" + path + ")");
 }
 
+std::vector<ColumnGroup>
+groupColumns(const std::vector<AttributeColumn>& columns)
+{
+    std::vector<ColumnGroup> runs;  // each run's base in name until it is settled
+    for (size_t i = 0; i < columns.size(); ++i) {
+        const AttributeColumn& column = columns[i];
+        if (column.component > 0 && !runs.empty()) {
+            ColumnGroup& previous = runs.back();
+            const AttributeColumn& last = columns[previous.columns.back()];
+            if (last.index + 1 == column.index && last.kind == column.kind && last.component >= 0
+                && previous.name == column.base && int(previous.columns.size()) == column.component) {
+                previous.columns.push_back(i);
+                continue;
+            }
+        }
+        runs.push_back(ColumnGroup{column.component == 0 ? column.base : column.name, {i}});
+    }
+    std::vector<ColumnGroup> groups;
+    for (ColumnGroup& run : runs) {
+        bool baseTaken = false;
+        for (const AttributeColumn& other : columns) baseTaken = baseTaken || other.name == run.name;
+        if (run.columns.size() >= 2 && !baseTaken) {
+            groups.push_back(std::move(run));
+        } else {
+            for (size_t i : run.columns) groups.push_back(ColumnGroup{columns[i].name, {i}});
+        }
+    }
+    return groups;
+}
+
 std::string
 printable(std::string_view text, size_t maxLength)
 {

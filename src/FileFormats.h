@@ -63,6 +63,33 @@ std::string lowerExtension(const std::string& path);
 /// non-printable bytes replaced by '?'.
 std::string printable(std::string_view text, size_t maxLength = 40);
 
+/// An attribute column of a record (CSV) or a vertex property (PLY), as groupColumns()
+/// sees it.
+struct AttributeColumn
+{
+    size_t index;        ///< position in the record; a run needs consecutive ones
+    std::string name;    ///< as written
+    std::string base;    ///< the name without its component spelling ("v" of "v_y")
+    int component = -1;  ///< the component that spelling names (1 for "v_y"), or -1
+    int kind = 0;        ///< columns of another kind never join (PLY: the value type)
+};
+
+/// One attribute made of columns: @a columns index into groupColumns()' argument, in
+/// component order.
+struct ColumnGroup
+{
+    std::string name;
+    std::vector<size_t> columns;
+};
+
+/// The attributes that @a columns form, in order. A run of consecutive columns of one kind
+/// that spell components 0, 1, 2, ... of one base is one attribute named by the base; a
+/// run of one keeps its column's own name ("speed_x" alone is no vector), as does every
+/// column of a run whose base is another column's name ("v" beside "v_x,v_y,v_z"), so that
+/// columns a writer spelled apart read back apart. Cost: O(n²) name comparisons for n
+/// columns (a header's worth).
+std::vector<ColumnGroup> groupColumns(const std::vector<AttributeColumn>& columns);
+
 // ------------------------------------------------------------------------------------------
 // Text and value helpers shared by the in-memory parsers here and the streaming readers in
 // ReadParticles.cc (so that both accept the same text and say the same words).

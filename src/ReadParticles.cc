@@ -305,16 +305,46 @@ readVtkParticles(const std::string& path)
 // ------------------------------------------------------------------------------------------
 // PLY
 
-/// Where one vertex property goes: a position axis, an attribute, or nowhere (lists).
+/// Where one vertex property goes: a position axis, a component of an attribute, or
+/// nowhere (lists).
 struct PlyColumn
 {
     int axis = -1;                      ///< 0, 1, 2 for x, y, z
     ParticleAttribute* attribute = nullptr;
+    size_t component = 0;               ///< of attribute
     size_t width = 0;                   ///< bytes per value
+
+    /// Where vertex @a i's value goes.
+    unsigned char* destination(size_t i) const
+    {
+        return attribute->bytes.data() + (i * size_t(attribute->components) + component) * width;
+    }
 };
 
+/// The component a PLY property name spells as nonbloppy's writer writes vectors:
+/// "<base>_x/_y/_z" (3 components) or "<base>_<c>" (any other count); -1 otherwise.
+int plyComponentOf(const std::string& name, std::string& base)
+{
+    const size_t underscore = name.rfind('_');
+    if (underscore == std::string::npos || underscore == 0 || underscore + 1 == name.size()) return -1;
+    const std::string suffix = name.substr(underscore + 1);
+    int component = -1;
+    if (suffix.size() == 1 && suffix[0] >= 'x' && suffix[0] <= 'z') {
+        component = suffix[0] - 'x';
+    } else if (suffix.size() <= 2 && std::all_of(suffix.begin(), suffix.end(), [](char c) { return c >= '0' && c <= '9'; })
+               && (suffix.size() == 1 || suffix[0] != '0')) {
+        component = std::stoi(suffix);
+    } else {
+        return -1;
+    }
+    base = name.substr(0, underscore);
+    return component;
+}
+
 /// The vertex element of a PLY file, read straight into a ParticleSet: x, y, z as
-/// positions, every other scalar property as a 1-component attribute.
+/// positions, every other scalar property an attribute, those spelling the components of
+/// a vector (<name>_x,_y,_z or <name>_0,_1,..., as writeParticles() writes them, of one
+/// type) one attribute of that many components (groupColumns()).
 class PlyReader : public PlyReaderBase
 {
 public:
@@ -342,35 +372,41 @@ private:
         requireRoom(element, section);
         const size_t count = size_t(element.count);
 
-        // Lay out the destinations first: positions and one attribute per other scalar.
-        size_t attributeCount = 0;
-        for (const PlyProperty& property : element.properties) {
-            if (property.isList) continue;
-            const int axis = axisOf(property.name);
-            if (axis < 0) {
-                ++attributeCount;
-            } else if (property.type != ScalarType::Float32 &&
-                       property.type != ScalarType::Float64) {
-                fail(mPath, "PLY property '" + property.name + "' must be float or double");
-            }
-        }
-        mData.positions.resize(count);
-        mData.attributes.reserve(attributeCount);  // the columns point into it
+        // Lay out the destinations first: positions, and the attributes the other scalar
+        // properties form.
         std::vector<PlyColumn> columns(element.properties.size());
+        std::vector<AttributeColumn> attributeColumns;
         for (size_t p = 0; p < element.properties.size(); ++p) {
             const PlyProperty& property = element.properties[p];
             if (property.isList) continue;
             PlyColumn& column = columns[p];
             column.width = scalarSize(property.type);
             column.axis = axisOf(property.name);
-            if (column.axis >= 0) continue;
+            if (column.axis < 0) {
+                AttributeColumn attributeColumn{p, property.name, std::string(), -1, int(property.type)};
+                attributeColumn.component = plyComponentOf(property.name, attributeColumn.base);
+                attributeColumns.push_back(std::move(attributeColumn));
+            } else if (property.type != ScalarType::Float32 &&
+                       property.type != ScalarType::Float64) {
+                fail(mPath, "PLY property '" + property.name + "' must be float or double");
+            }
+        }
+        mData.positions.resize(count);
+        const std::vector<ColumnGroup> groups = groupColumns(attributeColumns);
+        mData.attributes.reserve(groups.size());  // the columns point into it
+        for (const ColumnGroup& group : groups) {
+            const PlyProperty& first = element.properties[attributeColumns[group.columns[0]].index];
             ParticleAttribute attribute;
-            attribute.name = property.name;
-            attribute.type = property.type;
-            attribute.components = 1;
-            attribute.bytes.resize(count * column.width);
+            attribute.name = group.name;
+            attribute.type = first.type;
+            attribute.components = int(group.columns.size());
+            attribute.bytes.resize(count * group.columns.size() * scalarSize(first.type));
             mData.attributes.push_back(std::move(attribute));
-            column.attribute = &mData.attributes.back();
+            for (size_t c = 0; c < group.columns.size(); ++c) {
+                PlyColumn& column = columns[attributeColumns[group.columns[c]].index];
+                column.attribute = &mData.attributes.back();
+                column.component = c;
+            }
         }
 
         bool hasList = false;
@@ -423,8 +459,7 @@ private:
                         mData.positions[i][column.axis] =
                             floatValue(value, element.properties[p].type);
                     } else {
-                        std::memcpy(column.attribute->bytes.data() + i * column.width, value,
-                                    column.width);
+                        std::memcpy(column.destination(i), value, column.width);
                     }
                     record += column.width;
                 }
@@ -449,8 +484,7 @@ private:
                     mReader->readInto(1, property.type, section, value);
                     mData.positions[i][column.axis] = floatValue(value, property.type);
                 } else {
-                    mReader->readInto(1, property.type, section,
-                        column.attribute->bytes.data() + i * column.width);
+                    mReader->readInto(1, property.type, section, column.destination(i));
                 }
             }
         }

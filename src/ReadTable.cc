@@ -6,9 +6,11 @@
 /// names the columns, separated by ',' or ';' or tabs or spaces (the first of these found
 /// in the header is the separator), names optionally quoted. Positions are the columns
 /// x, y, z (any case), or ParaView's `Points:0..2`, or `<name>_x/_y/_z` with name
-/// position, pos or p. Every other column is an attribute; consecutive columns
-/// `<name>:0,:1,:2` (ParaView), `<name>_x,_y,_z`, `<name>[0..2]` form one 3-component
-/// attribute `<name>`. An attribute whose values are all integers is Int64, else Float64.
+/// position, pos or p. Every other column is an attribute; two or three consecutive columns
+/// `<name>:0,:1,:2` (ParaView), `<name>_x,_y,_z`, `<name>[0..2]` or `<name>.x,.y,.z` form
+/// one attribute `<name>` of that many components, unless another column is called `<name>`;
+/// a lone `<name>_x` is a scalar of that name. An attribute whose values are all integers
+/// is Int64, else Float64.
 ///
 /// Both are read through a StreamReader (a bounded buffer) straight into the final arrays:
 /// table rows line by line, attribute values stored as float64 and turned into int64 in
@@ -174,10 +176,9 @@ parseTable(StreamReader& in, const std::string& path)
     std::vector<std::string_view> fields;
     splitLine(header, separator, fields);
 
-    // Map the columns to positions and attributes.
+    // Map the columns to positions and attributes (vectors as groupColumns() forms them).
     std::vector<Column> columns(fields.size());
-    std::vector<std::string> names;
-    std::vector<int> componentCounts;
+    std::vector<AttributeColumn> attributeColumns;
     int axisColumn[3] = {-1, -1, -1};
     for (size_t i = 0; i < fields.size(); ++i) {
         const std::string name(trimmed(fields[i]));
@@ -193,24 +194,22 @@ parseTable(StreamReader& in, const std::string& path)
             columns[i] = {-1, axis};
             continue;
         }
-        // Continue the previous column's vector if this is its next component.
-        if (component > 0 && i > 0 && columns[i - 1].attribute >= 0
-            && names[size_t(columns[i - 1].attribute)] == base
-            && columns[i - 1].component == component - 1) {
-            columns[i] = {columns[i - 1].attribute, component};
-            componentCounts[size_t(columns[i - 1].attribute)] = component + 1;
-            continue;
-        }
-        const std::string attributeName = component == 0 ? base : name;
-        if (std::find(names.begin(), names.end(), attributeName) != names.end()) {
-            fail(path, "duplicate column '" + printable(attributeName) + "'");
-        }
-        columns[i] = {int(names.size()), 0};
-        names.push_back(attributeName);
-        componentCounts.push_back(1);
+        attributeColumns.push_back(AttributeColumn{i, name, base, component});
     }
     if (axisColumn[0] < 0 || axisColumn[1] < 0 || axisColumn[2] < 0) {
         fail(path, "the header must name columns x, y and z, got '" + printable(header) + "'");
+    }
+    std::vector<std::string> names;
+    std::vector<int> componentCounts;
+    for (const ColumnGroup& group : groupColumns(attributeColumns)) {
+        if (std::find(names.begin(), names.end(), group.name) != names.end()) {
+            fail(path, "duplicate column '" + printable(group.name) + "'");
+        }
+        for (size_t c = 0; c < group.columns.size(); ++c) {
+            columns[attributeColumns[group.columns[c]].index] = {int(names.size()), int(c)};
+        }
+        names.push_back(group.name);
+        componentCounts.push_back(int(group.columns.size()));
     }
 
     // Values go straight into the attribute arrays as float64; an attribute whose values

@@ -441,6 +441,56 @@ TEST_F(ReadFormatsTest, CsvWithVectorAndScalarColumns)
     EXPECT_EQ(attribute(particles, "density").asDouble(0), 1000.5);
 }
 
+TEST_F(ReadFormatsTest, CsvComponentSpellingsFormVectorsOnlyWhenTheyAreOne)
+{
+    // speed_x alone is a scalar of that name (it was read as a 1-component "speed", so a
+    // scalar so named did not survive a CSV round trip); w beside w_x,w_y,w_z keeps the
+    // three as columns of their own (they were a duplicate "w"); a_x,a_y is 2 components.
+    const std::string file = write("c.csv", "x,y,z,speed_x,w,w_x,w_y,w_z,a_x,a_y,b[1],n.x\n"
+                                            "1,2,3,4,5,6,7,8,9,10,11,12\n");
+    const ParticleSet particles = readParticles(file);
+    ASSERT_EQ(particles.size(), 1u);
+    std::vector<std::string> names;
+    for (const ParticleAttribute& a : particles.attributes) names.push_back(a.name + "/" + std::to_string(a.components));
+    EXPECT_EQ(names, (std::vector<std::string>{"speed_x/1", "w/1", "w_x/1", "w_y/1", "w_z/1", "a/2", "b[1]/1",
+                                               "n.x/1"}));
+    EXPECT_EQ(attribute(particles, "w_z").asDouble(0), 8.0);
+    EXPECT_EQ(attribute(particles, "a").asDouble(0, 1), 10.0);
+    EXPECT_EQ(attribute(particles, "n.x").asDouble(0), 12.0);
+    // A column named twice is still an error.
+    const std::string twice = write("twice.csv", "x,y,z,m,m\n1,2,3,4,5\n");
+    EXPECT_EQ(fileErrorOf(twice), "duplicate column 'm' (" + twice + ")");
+}
+
+TEST_F(ReadFormatsTest, PlyVectorPropertiesAreOneAttribute)
+{
+    // As writeParticles() spells vectors: v_x,v_y,v_z and c_0..c_3, each of one type. A
+    // lone speed_x, and w_x,w_y of two types, stay properties of their own.
+    const std::string file = write("v.ply",
+        "ply\nformat ascii 1.0\nelement vertex 2\n"
+        "property float x\nproperty float y\nproperty float z\n"
+        "property float speed_x\nproperty float v_x\nproperty float v_y\nproperty float v_z\n"
+        "property float w_x\nproperty int w_y\n"
+        "property uchar c_0\nproperty uchar c_1\nproperty uchar c_2\nproperty uchar c_3\nend_header\n"
+        "1 2 3 4 5 6 7 8 9 10 11 12 13\n"
+        "-1 -2 -3 -4 -5 -6 -7 -8 -9 20 21 22 23\n");
+    const ParticleSet particles = readParticles(file);
+    ASSERT_EQ(particles.size(), 2u);
+    EXPECT_EQ(particles.positions[1], openvdb::Vec3f(-1, -2, -3));
+    std::vector<std::string> names;
+    for (const ParticleAttribute& a : particles.attributes) names.push_back(a.name + "/" + std::to_string(a.components));
+    EXPECT_EQ(names, (std::vector<std::string>{"speed_x/1", "v/3", "w_x/1", "w_y/1", "c/4"}));
+    const ParticleAttribute& v = attribute(particles, "v");
+    EXPECT_EQ(v.type, ScalarType::Float32);
+    EXPECT_EQ(v.asDouble(0, 0), 5.0);
+    EXPECT_EQ(v.asDouble(1, 2), -7.0);
+    EXPECT_EQ(attribute(particles, "w_y").type, ScalarType::Int32);
+    const ParticleAttribute& c = attribute(particles, "c");
+    EXPECT_EQ(c.type, ScalarType::UInt8);
+    EXPECT_EQ(c.asDouble(1, 3), 23.0);
+    EXPECT_EQ(c.asDouble(0, 1), 11.0);
+}
+
 TEST_F(ReadFormatsTest, TxtWithSpacesAndAnyColumnOrder)
 {
     const std::string file = write("p.txt", "id  Z y X\n1 3 2 1\n2\t6 5 4\n");

@@ -12,8 +12,10 @@
 ///           and `vtkIdType` as 32-bit, as VTK's legacy writer stores them. Names written
 ///           with %XX escapes (VTK 5) are decoded.
 /// - `.ply`  PLY (ascii, binary_little_endian, binary_big_endian); vertex x y z (float or
-///           double) plus every other scalar vertex property as a 1-component attribute;
-///           list properties and other elements are skipped.
+///           double) plus every other scalar vertex property as an attribute in its type;
+///           consecutive properties `name_x/_y/_z` or `name_0, name_1, ...` of one type form
+///           one vector `name` (as writeParticles() writes vectors), unless a property is
+///           itself called `name`; list properties and other elements are skipped.
 /// - `.xyz`  raw little-endian float32 triples, no header.
 /// - `.bgeo` Houdini classic binary geometry (`BgeoV` version 5, as Partio and SPlisHSPlasH
 ///           write it), gzip-compressed or not; float, int, vector and index point
@@ -25,7 +27,9 @@
 ///           numeric and vector attribute (group and string attributes are skipped); a .vdb
 ///           without one (e.g. a density cache) is an error.
 /// - `.csv`, `.txt`  a header row naming the columns (x, y, z or ParaView's Points:0..2,
-///           plus any others; `name:0..2`, `name_x/_y/_z` and `name[0..2]` form 3-vectors),
+///           plus any others; two or three consecutive `name:0..2`, `name_x/_y/_z`,
+///           `name[0..2]` or `name.x/.y/.z` form a vector `name` unless a column is itself
+///           called `name`; a lone `name_x` keeps its name),
 ///           separated by ',', ';', tabs or spaces; attributes are int64 if every value is
 ///           an integer, else float64.
 /// - `.json` `[[x, y, z], ...]` (positions only).
