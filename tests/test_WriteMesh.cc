@@ -14,6 +14,9 @@
 
 #include <gtest/gtest.h>
 
+#include <csignal>
+#include <sys/resource.h>
+
 #include <tbb/global_control.h>
 
 #include <dirent.h>
@@ -448,6 +451,36 @@ TEST_F(WriteMeshTest, LargeFilesGoPastThePageCacheWithTheSameBytes)
     EXPECT_EQ(readBytes(path("small.bin")), "x");
     // Only the targets remain: no temporary files.
     EXPECT_EQ(listDirectory(dir()).size(), 6u);
+}
+
+TEST_F(WriteMeshTest, ADirectWriteThatFailsInTheWriterThreadFailsTheFile)
+{
+    if (!nonbloppy::directIoSuitable(dir())) GTEST_SKIP() << "no direct I/O on " << dir();
+    // A 6 MB file-size limit stands in for a full disk: the second 4 MiB buffer, written by
+    // the writer thread while the caller fills the third, fails with EFBIG (SIGXFSZ
+    // ignored). The error must reach the caller, and nothing may be left.
+    struct rlimit saved;
+    ASSERT_EQ(getrlimit(RLIMIT_FSIZE, &saved), 0);
+    const auto oldHandler = std::signal(SIGXFSZ, SIG_IGN);
+    struct rlimit limited = saved;
+    limited.rlim_cur = 6u << 20;
+    ASSERT_EQ(setrlimit(RLIMIT_FSIZE, &limited), 0);
+    const std::string target = path("full.bin");
+    const std::string bytes((size_t(13) << 20) + 5, 'x');
+    std::string message;
+    try {
+        nonbloppy::writeFileAtomically(target, [&](std::ostream& os) {
+            for (size_t at = 0; at < bytes.size(); at += 100000) {
+                os.write(bytes.data() + at, std::streamsize(std::min<size_t>(100000, bytes.size() - at)));
+            }
+        }, bytes.size());
+    } catch (const nonbloppy::FileError& e) {
+        message = e.what();
+    }
+    setrlimit(RLIMIT_FSIZE, &saved);
+    std::signal(SIGXFSZ, oldHandler);
+    EXPECT_EQ(message, "cannot write " + target + ": File too large");
+    EXPECT_TRUE(listDirectory(dir()).empty());
 }
 
 TEST_F(WriteMeshTest, DirectIoSettingDoesNotChangeTheFile)
