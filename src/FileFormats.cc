@@ -57,6 +57,34 @@ loadFile(const std::string& path)
 }
 
 std::vector<char>
+loadFileThrough(const std::string& path, std::string_view marker)
+{
+    const OpenFile file = openFile(path);
+    struct FdCloser { int fd; ~FdCloser() { ::close(fd); } } closer{file.fd};
+    constexpr size_t kPiece = 65536;
+    std::vector<char> data;
+    size_t used = 0;
+    size_t searchFrom = 0;
+    for (;;) {
+        data.resize(used + kPiece);
+        const ssize_t n = ::read(file.fd, data.data() + used, kPiece);
+        if (n < 0) {
+            if (errno == EINTR) continue;
+            failRead(path, errno);
+        }
+        if (n == 0) break;
+        used += size_t(n);
+        const std::string_view seen(data.data(), used);
+        const size_t at = seen.find(marker, searchFrom);
+        if (at != std::string_view::npos && seen.find('\n', at) != std::string_view::npos) break;
+        // A marker may straddle two pieces.
+        searchFrom = used >= marker.size() ? used - marker.size() : 0;
+    }
+    data.resize(used);
+    return data;
+}
+
+std::vector<char>
 readToEndAndClose(int fd, const std::string& path, size_t sizeHint)
 {
     struct FdCloser { int fd; ~FdCloser() { ::close(fd); } } closer{fd};

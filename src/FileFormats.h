@@ -46,6 +46,12 @@ OpenFile openFile(const std::string& path);
 /// @throw FileError "cannot open <path>: <reason>" or "cannot read <path>: <reason>".
 std::vector<char> loadFile(const std::string& path);
 
+/// The start of @a path: read in 64 KiB pieces until a piece holds @a marker with the
+/// line it ends complete (then what was read), or to the end of the file. For a header
+/// whose last line is @a marker (PLY's "end_header"), without reading the data after it.
+/// @throw FileError "cannot open <path>: <reason>" or "cannot read <path>: <reason>".
+std::vector<char> loadFileThrough(const std::string& path, std::string_view marker);
+
 /// Everything left to read from the open descriptor @a fd (named @a path in errors), in a
 /// buffer first sized for @a sizeHint bytes (0: unknown, as for a pipe); closes @a fd
 /// whatever happens. Readers use it for pipes, which have no size and must not be opened

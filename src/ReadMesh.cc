@@ -291,7 +291,8 @@ declaresPolygons(const std::string& path)
     const std::string ext = lowerExtension(path);
     if (ext == ".obj") return true;
     if (ext != ".ply" && ext != ".vtk") return false;
-    const std::vector<char> file = loadFile(path);
+    // A PLY header says it all: the vertex data after it (gigabytes, maybe) is not read.
+    const std::vector<char> file = ext == ".ply" ? loadFileThrough(path, "end_header") : loadFile(path);
     return ext == ".ply" ? plyDeclaresFaces(file.data(), file.size(), path)
                          : vtkDeclaresPolygons(file.data(), file.size(), path);
 }
