@@ -59,7 +59,14 @@ PositionScan scanPositions(const std::vector<openvdb::Vec3f>& positions, cancell
 
 } // namespace
 
-ParticleIndex::ParticleIndex() : mImpl(new Impl) {}
+ParticleIndex::ParticleIndex() : mImpl(new Impl)
+{
+    // An empty grid of unit cells, not none: every function that takes an index (e.g.
+    // SurfaceReconstructor::particleIndex() before its first frame) then works on it as on
+    // build() of no particles, instead of dereferencing a null grid.
+    mImpl->cellSize = 1.0;
+    mImpl->grid = openvdb::tools::PointIndexGrid::create();
+}
 ParticleIndex::~ParticleIndex() = default;
 ParticleIndex::ParticleIndex(ParticleIndex&&) noexcept = default;
 ParticleIndex& ParticleIndex::operator=(ParticleIndex&&) noexcept = default;

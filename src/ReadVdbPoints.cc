@@ -1195,7 +1195,9 @@ void checkLayout(const VdbSource& source, const std::string& path)
         const std::string name = check.gridDescriptor(version);
         const size_t gridStart = check.pos();
         // The descriptor ends with three offsets: grid, blocks, end of the grid.
-        check.seek(gridStart - 8);
+        check.seek(gridStart - 24);
+        const int64_t gridPosition = check.load<int64_t>("grid descriptor");
+        const int64_t blockPosition = check.load<int64_t>("grid descriptor");
         const int64_t end = check.load<int64_t>("grid descriptor");
         if (!check.hasGridOffsets()) {
             // Written to a stream: the next grid starts where this one's tree ends, which
@@ -1211,6 +1213,15 @@ void checkLayout(const VdbSource& source, const std::string& path)
         if (uint64_t(end) > size) {
             check.corrupt("truncated grid '" + printable(name) + "' (it ends at byte " + std::to_string(end) +
                           ", the file has " + std::to_string(size) + ")");
+        }
+        // io::File reads the grid from its grid offset (where the walk below starts, right
+        // after the descriptor) and seeks to its block offset: one pointing elsewhere made
+        // it read past the end of the file into uninitialised lengths (gigabytes, minutes).
+        if (gridPosition != int64_t(gridStart) || blockPosition < int64_t(gridStart) || blockPosition > end) {
+            check.corrupt("corrupt grid '" + printable(name) + "' (its grid and block offsets " +
+                          std::to_string(gridPosition) + " and " + std::to_string(blockPosition) +
+                          " do not lie between its start " + std::to_string(gridStart) + " and end " +
+                          std::to_string(end) + ")");
         }
         check.grid(name, /*pointDataGrid=*/false, version);
         if (check.pos() > uint64_t(end)) check.corrupt("grid '" + printable(name) + "' overruns its end offset");

@@ -44,16 +44,19 @@ SurfaceReconstructor::reconstructBuffered(openvdb::util::NullInterrupter* interr
     result.timings = StageTimings();
     result.density.reset();
     result.particleCount = mPositions.size();
-    // Parameters kept from an earlier frame, or resolved for this one and kept from then on.
+    // Parameters kept from an earlier frame, or resolved for this one and kept from then on,
+    // once the frame is done: a frame that throws or is stopped after resolving them must
+    // leave the next frame as a fresh object would (the header's promise).
     const bool reuse = mKeepParameters && mHaveKeptParameters;
     surface_stages_internal::resolveAndIndex(mParams, reuse ? &mKeptParameters : nullptr, mPositions, mIndex,
-                                             result, interrupter, [&](const ResolvedParameters& resolved) {
-                                                 mKeptParameters = resolved;
-                                                 mHaveKeptParameters = true;
-                                             });
+                                             result, interrupter);
     surface_stages_internal::runSurfaceStages(mIndex, mParams.keepDensity, result, mUnrelaxed,
                                               surface_stages_internal::UnrelaxedBuffer::Keep,
                                               interrupter);
+    if (!reuse) {
+        mKeptParameters = result.parameters;
+        mHaveKeptParameters = true;
+    }
     ++mFrames;
     return result;
 }

@@ -29,8 +29,7 @@ void checkCancelled(openvdb::util::NullInterrupter* interrupter, const char* sta
 
 void resolveAndIndex(const SurfaceParameters& params, const ResolvedParameters* kept,
                      std::vector<openvdb::Vec3f>& positions, ParticleIndex& index, SurfaceResult& result,
-                     openvdb::util::NullInterrupter* interrupter,
-                     const std::function<void(const ResolvedParameters&)>& onResolved)
+                     openvdb::util::NullInterrupter* interrupter)
 {
     const auto indexParticles = [&](double effectiveRadius) {
         StageScope scope(result.timings, interrupter, "index particles");
@@ -51,7 +50,6 @@ void resolveAndIndex(const SurfaceParameters& params, const ResolvedParameters* 
                                        : resolveParameters(params, positions, interrupter);
         checkCancelled(interrupter, "estimate parameters");
     }
-    if (onResolved) onResolved(result.parameters);
     if (!indexFirst) indexParticles(result.parameters.effectiveRadius);
 }
 

@@ -13,7 +13,6 @@
 #include <openvdb/openvdb.h>
 #include <openvdb/util/NullInterrupter.h>
 
-#include <functional>
 #include <vector>
 
 namespace nonbloppy {
@@ -58,13 +57,10 @@ private:
 /// searches that index (resolveParametersIndexed()); otherwise the estimate comes first, as
 /// r_e, hence the cells, may depend on it (a bad r_e is left for resolveParameters() to
 /// refuse with its own message). @a positions is moved into the index and left empty.
-/// @a onResolved, when given, is called with result.parameters as soon as the estimate stage
-/// has ended, whether or not the index is built yet.
 /// @throw ParameterError, CancelledError as buildSurface().
 void resolveAndIndex(const SurfaceParameters& params, const ResolvedParameters* kept,
                      std::vector<openvdb::Vec3f>& positions, ParticleIndex& index, SurfaceResult& result,
-                     openvdb::util::NullInterrupter* interrupter,
-                     const std::function<void(const ResolvedParameters&)>& onResolved = {});
+                     openvdb::util::NullInterrupter* interrupter);
 
 /// What runSurfaceStages() does with the unrelaxed-vertex buffer after fold repair.
 enum class UnrelaxedBuffer

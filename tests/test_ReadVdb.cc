@@ -77,3 +77,30 @@ TEST_F(ReadVdbTest, EveryTruncationIsAOneLineErrorNamingTheFile)
     EXPECT_EQ(nonbloppy_test::messageOf<FileError>([&] { readVdbFile(cut); }),
               "cannot read .vdb file: not a VDB file (" + cut + ")");
 }
+
+TEST_F(ReadVdbTest, GridAndBlockOffsetsMustLieInTheirGrid)
+{
+    // One byte changed in a grid's offset made io::File read past the end of the file into
+    // uninitialised string lengths: some runs allocated 4-10 GB for a minute (valgrind:
+    // reads of uninitialised values in Transform::read).
+    const std::string bytes = nonbloppy_test::readBytes(writeTwoGrids());
+    // The second grid's descriptor ends with its grid, block and end offsets; the end is
+    // the file's size.
+    const int64_t fileSize = int64_t(bytes.size());
+    size_t endAt = std::string::npos;
+    for (size_t k = 0; k + 8 <= bytes.size(); ++k) {
+        if (std::memcmp(bytes.data() + k, &fileSize, 8) == 0) endAt = k;
+    }
+    ASSERT_NE(endAt, std::string::npos);
+    ASSERT_GE(endAt, 16u);
+    const std::string bad = path("bad.vdb");
+    for (const size_t at : {endAt - 16 + 7, endAt - 8 + 7, endAt - 16}) {
+        std::string changed = bytes;
+        changed[at] = char(changed[at] ^ 0x35);
+        nonbloppy_test::writeBytes(bad, changed);
+        const std::string message = nonbloppy_test::messageOf<FileError>([&] { readVdbFile(bad); });
+        EXPECT_EQ(message.rfind("cannot read .vdb file: corrupt grid 'surface' (its grid and block offsets ", 0), 0u)
+            << message;
+        EXPECT_NE(message.find("(" + bad + ")"), std::string::npos) << message;
+    }
+}

@@ -79,6 +79,23 @@ TEST(RelaxVertices, VertexWithNoParticleInReachStaysPut)
     EXPECT_EQ(one.mesh.points.back(), kCentre + openvdb::Vec3s(3.0f, 0.0f, 0.0f));
 }
 
+TEST(RelaxVertices, AnEmptyIndexLeavesEveryVertexPut)
+{
+    // A default-constructed index (also SurfaceReconstructor::particleIndex() before its
+    // first frame) segfaulted here and in rasterizeDensity(): it had no grid.
+    OneParticle one;
+    const std::vector<openvdb::Vec3s> before = one.mesh.points;
+    for (const ParticleIndex& empty : {ParticleIndex(), ParticleIndex::build({}, 0.5)}) {
+        EXPECT_EQ(empty.size(), 0u);
+        relaxVertices(one.mesh, empty, relaxSettings(0.5, 2));
+        EXPECT_EQ(one.mesh.points, before);
+        DensitySettings settings;
+        settings.effectiveRadius = 1.0;
+        settings.voxelSize = 0.05;
+        EXPECT_EQ(rasterizeDensity(empty, settings)->activeVoxelCount(), 0u);
+    }
+}
+
 TEST(RelaxVertices, MovesTowardsTheWeightedMeanOfTwoParticles)
 {
     // Vertex at the origin, particles at distances 0.25 (w = 3) and 0.5 (w = 1) on the x axis:

@@ -36,6 +36,16 @@ struct StopAlways : openvdb::util::NullInterrupter
     bool wasInterrupted(int = -1) override { return true; }
 };
 
+/// Says stop from the start of the stage @a stage on.
+struct StopInStage : openvdb::util::NullInterrupter
+{
+    explicit StopInStage(std::string stage) : stage(std::move(stage)) {}
+    void start(const char* name) override { stopping = stopping || (name && stage == name); }
+    bool wasInterrupted(int = -1) override { return stopping; }
+    std::string stage;
+    bool stopping = false;
+};
+
 } // namespace
 
 TEST(SurfaceReconstructor, EqualsBuildSurfaceFrameAfterFrame)
@@ -67,6 +77,26 @@ TEST(SurfaceReconstructor, KeepsTheFirstFramesParametersWhenAsked)
     EXPECT_EQ(reconstructor.reconstruct(ParticleSet{sparse, {}}).parameters.spacing, spacing);
     reconstructor.setKeepParameters(false);
     EXPECT_NEAR(reconstructor.reconstruct(ParticleSet{sparse, {}}).parameters.spacing, 0.2, 0.005 * 0.2);
+}
+
+TEST(SurfaceReconstructor, AFrameThatFailsKeepsNoParameters)
+{
+    // The parameters were kept as soon as they were resolved: a frame stopped later (or
+    // throwing later) left them for the next frame, which then differed from a fresh object's.
+    const auto dense = latticeParticles(0.1, 0.7, [](const openvdb::Vec3d& x) { return x.length() < 0.6; });
+    const auto sparse = latticeParticles(0.2, 0.7, [](const openvdb::Vec3d& x) { return x.length() < 0.6; });
+    for (const char* stage : {"rasterize density", "relax vertices", "compute normals"}) {
+        SCOPED_TRACE(stage);
+        SurfaceReconstructor reconstructor;
+        reconstructor.setKeepParameters(true);
+        StopInStage stop(stage);
+        EXPECT_THROW(reconstructor.reconstruct(ParticleSet{dense, {}}, &stop), CancelledError);
+        const SurfaceResult& next = reconstructor.reconstruct(ParticleSet{sparse, {}});
+        EXPECT_NEAR(next.parameters.spacing, 0.2, 0.005 * 0.2);
+        SurfaceReconstructor fresh;
+        fresh.setKeepParameters(true);
+        expectSameMesh(next.mesh, fresh.reconstruct(ParticleSet{sparse, {}}).mesh);
+    }
 }
 
 TEST(SurfaceReconstructor, CancelledFrameLeavesItUsable)

@@ -40,7 +40,9 @@ class NONBLOPPY_API ParticleIndex
 public:
     using PosType = openvdb::Vec3R;  ///< position type of the PointArray concept
 
-    /// An empty index (no particles, no grid); assign the result of build() to it.
+    /// An empty index: no particles, an empty grid of unit cells, as build() of no
+    /// particles gives (rasterizeDensity() makes an empty grid of it, relaxVertices() leaves
+    /// the vertices where they are); assign the result of build() to it.
     ParticleIndex();
     ~ParticleIndex();
     /// Move: the source is left empty-handed and must only be assigned to or destroyed.
