@@ -95,6 +95,10 @@ void computeNormals(SurfaceMesh& mesh, CancelPoll& poll);
 ///        public function
 double calibrateThreshold(double effectiveRadiusOverSpacing, CancelPoll& poll);
 
+/// @a threshold, a calibrated r_0, if it is > 0. Defined in EstimateParameters.cc.
+/// @throw ParameterError("--radius is too small to calibrate --threshold: ...") otherwise.
+double requireCalibratedThreshold(double threshold, double effectiveRadiusOverSpacing);
+
 /// calibrateRelaxedThreshold() asking @a poll before every relaxation step of a sample
 /// vertex: its cost grows with t, which the caller chooses. Defined in CorrectSurface.cc.
 /// @throw CancelledError("interrupted during <poll's stage>"), or ParameterError as the

@@ -306,14 +306,14 @@ double cancellation_internal::calibrateRelaxedThreshold(double effectiveRadiusOv
         high += kScanStep;
         if (high >= limit) {
             if (reachesSurface) *reachesSurface = false;
-            return planeDensity(ratio, limit, poll);
+            return cancellation_internal::requireCalibratedThreshold(planeDensity(ratio, limit, poll), ratio);
         }
     }
     for (int step = 0; step < 24; ++step) {
         const double middle = 0.5 * (low + high);
         (relaxedHeight(ratio, blend, maxStep, iterations, middle, poll) < 0.5 ? low : high) = middle;
     }
-    return planeDensity(ratio, 0.5 * (low + high), poll);
+    return cancellation_internal::requireCalibratedThreshold(planeDensity(ratio, 0.5 * (low + high), poll), ratio);
 }
 
 size_t countFoldedTriangles(const SurfaceMesh& mesh, const std::vector<openvdb::Vec3s>& before)
@@ -357,10 +357,26 @@ void offsetSurface(SurfaceMesh& mesh, double distance)
         });
 }
 
+namespace {
+
+/// @throw ParameterError unless @a maxDistance > 0 (a negative one moved the surface the
+///        wrong way, and turned it inside out when large).
+void requireMaxDistance(double maxDistance)
+{
+    if (!(maxDistance > 0.0)) {
+        std::ostringstream msg;
+        msg << "largest volume offset must be > 0, got " << maxDistance;
+        throw ParameterError(msg.str());
+    }
+}
+
+} // namespace
+
 double preserveVolume(SurfaceMesh& mesh, double targetVolume, double maxDistance,
                       openvdb::util::NullInterrupter* interrupter)
 {
     requireTargetVolume(targetVolume);
+    requireMaxDistance(maxDistance);
     CancelPoll poll(interrupter, "correct surface");
     double total = 0.0;
     for (int pass = 0; pass < 2; ++pass) {
@@ -386,11 +402,7 @@ double preserveVolume(SurfaceMesh& mesh, const VolumeSettings& settings,
         msg << "convexity floor must be >= 0, got " << settings.convexityFloor;
         throw ParameterError(msg.str());
     }
-    if (!(settings.maxDistance > 0.0)) {
-        std::ostringstream msg;
-        msg << "largest volume offset must be > 0, got " << settings.maxDistance;
-        throw ParameterError(msg.str());
-    }
+    requireMaxDistance(settings.maxDistance);
     if (settings.offset == VolumeOffset::Uniform) {
         return preserveVolume(mesh, settings.targetVolume, settings.maxDistance, interrupter);
     }

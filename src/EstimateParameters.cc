@@ -158,7 +158,13 @@ double spacingGuess(const std::vector<openvdb::Vec3f>& positions, CancelPoll& po
     openvdb::BBoxd bounds;
     for (size_t n = 0; n < positions.size(); ++n) {
         if (poll.stoppedAt(n)) poll.throwIfStopped();
-        bounds.expand(openvdb::Vec3d(positions[n]));
+        const openvdb::Vec3f& p = positions[n];
+        if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2])) {
+            // As ParticleIndex::build() says it; an infinite coordinate was reported as an
+            // infinite cell size, or as all particles at one position.
+            throw ParameterError("non-finite position of particle " + std::to_string(n));
+        }
+        bounds.expand(openvdb::Vec3d(p));
     }
     openvdb::Vec3d extent = bounds.extents();
     std::sort(extent.asPointer(), extent.asPointer() + 3);  // ascending
@@ -283,7 +289,20 @@ double cancellation_internal::calibrateThreshold(double effectiveRadiusOverSpaci
             }
         }
     }
-    return sum / (kSamples * kSamples);
+    return cancellation_internal::requireCalibratedThreshold(sum / (kSamples * kSamples), ratio);
+}
+
+double cancellation_internal::requireCalibratedThreshold(double threshold, double effectiveRadiusOverSpacing)
+{
+    if (!(threshold > 0.0)) {
+        // Just above half a spacing the kernel reaches no sample of the plane where the
+        // surface belongs: r_0 = 0, which every entry point refuses, would mesh nothing.
+        throw ParameterError("--radius is too small to calibrate --threshold: at " +
+                             formatNumber(effectiveRadiusOverSpacing) +
+                             " spacings the density where the surface belongs is 0; give a larger --radius "
+                             "or --threshold");
+    }
+    return threshold;
 }
 
 namespace {

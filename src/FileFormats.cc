@@ -124,6 +124,49 @@ fail(const std::string& path, const std::string& what)
     throw FileError(what + " (" + path + ")");
 }
 
+namespace {
+
+std::string
+lowerCase(std::string_view text)
+{
+    std::string out(text);
+    for (char& c : out) c = toLower(c);
+    return out;
+}
+
+} // namespace
+
+int
+tableComponentOf(const std::string& name, std::string& base)
+{
+    static const char* suffixes[3][4] = {{":0", "_x", "[0]", ".x"},
+                                         {":1", "_y", "[1]", ".y"},
+                                         {":2", "_z", "[2]", ".z"}};
+    const std::string low = lowerCase(name);
+    for (int c = 0; c < 3; ++c) {
+        for (const char* suffix : suffixes[c]) {
+            const size_t n = std::strlen(suffix);
+            if (low.size() > n && low.compare(low.size() - n, n, suffix) == 0) {
+                base = name.substr(0, name.size() - n);
+                return c;
+            }
+        }
+    }
+    return -1;
+}
+
+int
+tablePositionAxis(const std::string& name)
+{
+    const std::string low = lowerCase(name);
+    if (low == "x" || low == "y" || low == "z") return low[0] - 'x';
+    std::string base;
+    const int component = tableComponentOf(name, base);
+    const std::string lowBase = lowerCase(base);
+    const bool positionBase = lowBase == "points" || lowBase == "position" || lowBase == "pos" || lowBase == "p";
+    return component >= 0 && positionBase ? component : -1;
+}
+
 std::vector<ColumnGroup>
 groupColumns(const std::vector<AttributeColumn>& columns)
 {

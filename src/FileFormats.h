@@ -69,6 +69,16 @@ std::string lowerExtension(const std::string& path);
 /// non-printable bytes replaced by '?'.
 std::string printable(std::string_view text, size_t maxLength = 40);
 
+/// If the table (CSV/TXT) column @a name is "<base><suffix>" with suffix one of the
+/// component spellings (:0 _x [0] .x, :1 _y [1] .y, :2 _z [2] .z, any case), the component
+/// (0..2), with @a base set; else -1.
+int tableComponentOf(const std::string& name, std::string& base);
+
+/// The axis (0..2) a table column named @a name holds: x, y or z, or a component of
+/// Points, position, pos or p (any case, e.g. "Points:0", "P_y"); -1 for an attribute
+/// column. The reader takes these as positions, so the writer must not name attributes so.
+int tablePositionAxis(const std::string& name);
+
 /// An attribute column of a record (CSV) or a vertex property (PLY), as groupColumns()
 /// sees it.
 struct AttributeColumn

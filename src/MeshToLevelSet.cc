@@ -4,6 +4,9 @@
 
 #include <nonbloppy/Error.h>
 #include <nonbloppy/MeshToLevelSet.h>
+#include <nonbloppy/ParticleIndex.h>
+
+#include "OpenVdbScale.h"
 
 #pragma GCC visibility push(default)  // OpenVDB templates: see src/VisibilityPrelude.h
 #include <openvdb/tools/MeshToVolume.h>
@@ -23,6 +26,23 @@ meshToLevelSet(const SurfaceMesh& mesh, double voxelSize, float halfWidth)
         throw ParameterError(message.str());
     }
     if (!(halfWidth >= 1.0f)) throw ParameterError("level set half width must be >= 1 voxel");
+    // Below it OpenVDB throws its own ArithmeticError, not a nonbloppy::Error.
+    openvdb_scale_internal::requireOpenVdbScale(voxelSize, kMinCellSize, "--voxel-size");
+    // meshToVolume reads the corners unchecked: an index out of range crashed.
+    const size_t vertexCount = mesh.points.size();
+    const auto requireCorners = [&](size_t polygon, const uint32_t* corners, int n) {
+        for (int k = 0; k < n; ++k) {
+            if (corners[k] >= vertexCount) {
+                throw ParameterError("polygon " + std::to_string(polygon) + " references vertex " +
+                                     std::to_string(corners[k]) + " but the mesh has " +
+                                     std::to_string(vertexCount) + " vertices");
+            }
+        }
+    };
+    for (size_t t = 0; t < mesh.triangles.size(); ++t) requireCorners(t, mesh.triangles[t].asPointer(), 3);
+    for (size_t q = 0; q < mesh.quads.size(); ++q) {
+        requireCorners(mesh.triangles.size() + q, mesh.quads[q].asPointer(), 4);
+    }
     openvdb::initialize();
     const auto transform = openvdb::math::Transform::createLinearTransform(voxelSize);
     // meshToVolume wants index-space points.

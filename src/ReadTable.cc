@@ -38,13 +38,6 @@ namespace io_internal {
 
 namespace {
 
-std::string
-lower(std::string_view text)
-{
-    std::string out(text);
-    for (char& c : out) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-    return out;
-}
 
 std::string_view
 trimmed(std::string_view text)
@@ -79,34 +72,6 @@ splitLine(std::string_view line, char separator, std::vector<std::string_view>& 
         if (end == std::string_view::npos) break;
         start = end + 1;
     }
-}
-
-/// If @a name is "<base><suffix>" with suffix one of the component spellings, return the
-/// component (0..2) and set @a base; else -1.
-int
-componentOf(const std::string& name, std::string& base)
-{
-    static const char* suffixes[3][4] = {{":0", "_x", "[0]", ".x"},
-                                         {":1", "_y", "[1]", ".y"},
-                                         {":2", "_z", "[2]", ".z"}};
-    const std::string low = lower(name);
-    for (int c = 0; c < 3; ++c) {
-        for (const char* suffix : suffixes[c]) {
-            const size_t n = std::strlen(suffix);
-            if (low.size() > n && low.compare(low.size() - n, n, suffix) == 0) {
-                base = name.substr(0, name.size() - n);
-                return c;
-            }
-        }
-    }
-    return -1;
-}
-
-bool
-isPositionBase(const std::string& base)
-{
-    const std::string low = lower(base);
-    return low == "points" || low == "position" || low == "pos" || low == "p";
 }
 
 struct Column
@@ -183,11 +148,9 @@ parseTable(StreamReader& in, const std::string& path)
     for (size_t i = 0; i < fields.size(); ++i) {
         const std::string name(trimmed(fields[i]));
         if (name.empty()) fail(path, "empty column name in header (column " + std::to_string(i + 1) + ")");
-        const std::string low = lower(name);
-        int axis = low == "x" ? 0 : low == "y" ? 1 : low == "z" ? 2 : -1;
         std::string base;
-        const int component = componentOf(name, base);
-        if (axis < 0 && component >= 0 && isPositionBase(base)) axis = component;
+        const int component = tableComponentOf(name, base);
+        const int axis = tablePositionAxis(name);
         if (axis >= 0) {
             if (axisColumn[axis] >= 0) fail(path, "two columns for coordinate " + std::string(1, "xyz"[axis]));
             axisColumn[axis] = int(i);

@@ -5,10 +5,12 @@
 #include <nonbloppy/WriteParticles.h>
 
 #include <nonbloppy/Error.h>
+#include <nonbloppy/ParticleIndex.h>
 #include <nonbloppy/WriteVdb.h>
 
 #include "AtomicFile.h"
 #include "FileFormats.h"
+#include "OpenVdbScale.h"
 
 // OpenVDB's point templates must keep default visibility (see src/VisibilityPrelude.h).
 #pragma GCC visibility push(default)
@@ -22,6 +24,7 @@
 #include <functional>
 #include <ostream>
 #include <set>
+#include <type_traits>
 
 namespace nonbloppy {
 
@@ -58,16 +61,33 @@ vdbWord(const std::string& name)
 /// The columns (or arrays) an attribute called @a base is written as, in one format.
 using ColumnsOf = std::function<std::vector<std::string>(const std::string& base, int components)>;
 
+/// Whether a reader takes the column @a name for positions: x, y, z or P as they are.
+bool
+isPositionName(const std::string& name)
+{
+    return name == "x" || name == "y" || name == "z" || name == "P";
+}
+
+/// The same for CSV, whose reader also takes X, Points:0, p_y, ... (tablePositionAxis()): an
+/// attribute "X" or a vector "P" written as such made a file nonbloppy then refused ("two
+/// columns for coordinate x").
+bool
+isCsvPositionName(const std::string& name)
+{
+    return io_internal::tablePositionAxis(name) >= 0;
+}
+
 /// The names the attributes are written under: @a word of each name (the format's
-/// alphabet), then, if any column it gives is taken (by the positions' x, y, z or P, or
+/// alphabet), then, if any column it gives is taken (by the positions: @a isPosition, or
 /// by another attribute), the first of word_2, word_3, ... whose columns are all free.
 /// Names the format takes as they are claim theirs first, in order; renamed ones follow.
 /// Renaming "a b" to "a_b" beside an attribute "a_b" gave two columns of one name, which
 /// nonbloppy's own readers then refused ("duplicate column").
 std::vector<std::string>
-uniqueNames(const ParticleSet& particles, std::string (*word)(const std::string&), const ColumnsOf& columnsOf)
+uniqueNames(const ParticleSet& particles, std::string (*word)(const std::string&), const ColumnsOf& columnsOf,
+            bool (*isPosition)(const std::string&) = isPositionName)
 {
-    std::set<std::string> taken{"x", "y", "z", "P"};
+    std::set<std::string> taken;
     std::vector<std::string> names(particles.attributes.size());
     for (const bool renamed : {false, true}) {
         for (size_t i = 0; i < particles.attributes.size(); ++i) {
@@ -77,7 +97,8 @@ uniqueNames(const ParticleSet& particles, std::string (*word)(const std::string&
             std::string name = base;
             for (int suffix = 2;; ++suffix) {
                 const std::vector<std::string> columns = columnsOf(name, a.components);
-                if (std::none_of(columns.begin(), columns.end(), [&](const std::string& c) { return taken.count(c); })) {
+                if (std::none_of(columns.begin(), columns.end(),
+                                 [&](const std::string& c) { return taken.count(c) || isPosition(c); })) {
                     taken.insert(columns.begin(), columns.end());
                     break;
                 }
@@ -354,7 +375,7 @@ void
 writeCsv(const ParticleSet& particles, std::ostream& os)
 {
     std::string out = "x,y,z";
-    const std::vector<std::string> names = uniqueNames(particles, headerWord, csvColumns);
+    const std::vector<std::string> names = uniqueNames(particles, headerWord, csvColumns, isCsvPositionName);
     for (size_t i = 0; i < particles.attributes.size(); ++i) {
         for (const std::string& column : csvColumns(names[i], particles.attributes[i].components)) out += "," + column;
     }
@@ -402,7 +423,20 @@ addScalarAttribute(PointDataGrid& grid, const PointIndexGrid& index, const Parti
                    const std::string& name)
 {
     std::vector<ScalarT> values(a.size());
-    for (size_t n = 0; n < values.size(); ++n) values[n] = static_cast<ScalarT>(a.asDouble(n, c));
+    for (size_t n = 0; n < values.size(); ++n) {
+        const double value = a.asDouble(n, c);
+        if constexpr (std::is_same_v<ScalarT, int64_t>) {
+            // A uint64 above 2^63 - 1 has no int64 (the widest integer a .vdb attribute holds):
+            // the cast gave -9.22e18.
+            if (!(value < 9223372036854775808.0)) {
+                uint64_t stored;  // only a uint64 gets here: its own bits, not the rounded double
+                std::memcpy(&stored, a.bytes.data() + (n * size_t(a.components) + size_t(c)) * 8, 8);
+                throw ParameterError("attribute '" + a.name + "' holds " + std::to_string(stored) +
+                                     ", above 9223372036854775807, the largest integer a .vdb stores");
+            }
+        }
+        values[n] = static_cast<ScalarT>(value);
+    }
     addVdbAttribute(grid, index, name, values);
 }
 
@@ -430,6 +464,10 @@ makePointDataGrid(const ParticleSet& particles, double voxelSize)
     const openvdb::points::PointAttributeVector<openvdb::Vec3R> wrapper(positions);
     if (!(voxelSize > 0.0)) {
         voxelSize = positions.size() > 1 ? double(openvdb::points::computeVoxelSize(wrapper, 8)) : 1.0;
+    } else {
+        // OpenVDB's own message for these is an ArithmeticError, not a nonbloppy::Error.
+        if (!std::isfinite(voxelSize)) throw ParameterError("--voxel-size must be finite, got inf");
+        openvdb_scale_internal::requireOpenVdbScale(voxelSize, kMinCellSize, "--voxel-size");
     }
     const auto transform = openvdb::math::Transform::createLinearTransform(voxelSize);
     const auto index = openvdb::tools::createPointIndexGrid<PointIndexGrid>(wrapper, *transform);
@@ -439,11 +477,17 @@ makePointDataGrid(const ParticleSet& particles, double voxelSize)
     const std::vector<std::string> names = uniqueNames(particles, vdbWord, vdbColumns);
     for (size_t i = 0; i < particles.attributes.size(); ++i) {
         const ParticleAttribute& a = particles.attributes[i];
-        if (a.name == "P" || a.size() != particles.size()) continue;  // P is the positions
+        if (a.size() != particles.size()) continue;
         if (a.components == 3) {
             if (a.type == ScalarType::Float32) addVectorAttribute<openvdb::Vec3f>(*grid, *index, a, names[i]);
             else if (a.type == ScalarType::Float64) addVectorAttribute<openvdb::Vec3d>(*grid, *index, a, names[i]);
-            else addVectorAttribute<openvdb::Vec3i>(*grid, *index, a, names[i]);
+            // Integers up to 32 bits as vec3i; wider ones (int64, uint32, uint64) as vec3d,
+            // exact to 2^53, where vec3i wrapped 4e9 and 2^40 to -2147483648.
+            else if (a.type == ScalarType::Int64 || a.type == ScalarType::UInt32 || a.type == ScalarType::UInt64) {
+                addVectorAttribute<openvdb::Vec3d>(*grid, *index, a, names[i]);
+            } else {
+                addVectorAttribute<openvdb::Vec3i>(*grid, *index, a, names[i]);
+            }
             continue;
         }
         const std::vector<std::string> columns = vdbColumns(names[i], a.components);

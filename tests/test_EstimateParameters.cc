@@ -24,6 +24,20 @@ TEST(EstimateParameters, SpacingOfALatticeIsItsStep)
     EXPECT_NEAR(estimateSpacing(withStrays), 0.05, 0.005 * 0.05);
 }
 
+TEST(EstimateParameters, AnInfiniteCoordinateIsNamedAsSuch)
+{
+    // It was "particle index cell size must be > 0, got inf", or, with three particles, "all
+    // particles are at the same position".
+    for (const size_t count : {size_t(3), size_t(10)}) {
+        std::vector<openvdb::Vec3f> positions = latticeParticles(0.1, 1.0, [](const openvdb::Vec3d&) { return true; });
+        positions.resize(count);
+        positions[1][0] = -std::numeric_limits<float>::infinity();
+        const std::string message = "non-finite position of particle 1";
+        EXPECT_EQ(nonbloppy_test::messageOf<ParameterError>([&] { estimateSpacing(positions); }), message);
+        EXPECT_EQ(nonbloppy_test::messageOf<ParameterError>([&] { buildSurface(positions); }), message);
+    }
+}
+
 TEST(EstimateParameters, SpacingOfAJitteredLatticeIsItsStep)
 {
     // Jitter brings nearest neighbours closer (median 0.9 s) but keeps the volume per particle.
@@ -112,6 +126,18 @@ TEST(EstimateParameters, ThresholdGrowsWithTheRadius)
     EXPECT_THROW(calibrateThreshold(0.5), ParameterError);
     EXPECT_THROW(calibrateThreshold(32.5), ParameterError);
     EXPECT_THROW(calibrateRelaxedThreshold(32.5, 0.3, 2), ParameterError);
+    // Just above half a spacing the kernel reached no sample: both returned r_0 = 0, and
+    // buildSurface() meshed nothing without a word.
+    for (const auto& [ratio, spelled] : {std::pair<double, const char*>{0.5000001, "0.5"}, {0.501, "0.501"}}) {
+        const std::string message = std::string("--radius is too small to calibrate --threshold: at ") + spelled +
+                                    " spacings the density where the surface belongs is 0; give a larger --radius "
+                                    "or --threshold";
+        EXPECT_EQ(nonbloppy_test::messageOf<ParameterError>([&] { calibrateThreshold(ratio); }), message);
+        EXPECT_EQ(nonbloppy_test::messageOf<ParameterError>([&] { calibrateRelaxedThreshold(ratio, 0.3, 2); }),
+                  message);
+    }
+    EXPECT_GT(calibrateThreshold(0.51), 0.0);
+    EXPECT_GT(calibrateRelaxedThreshold(0.51, 0.3, 2), 0.0);
 }
 
 TEST(EstimateParameters, AnIndexOfAnyCellSizeServesTheEstimate)

@@ -360,6 +360,14 @@ TEST(Fidelity, VolumeSettingsAreChecked)
     settings.targetVolume = 0.0;
     EXPECT_EQ(message(settings), "target volume must be > 0, got 0");
     settings.targetVolume = 64.0;
+    // The plain overload took a negative limit and moved the surface the wrong way (by -1:
+    // inside out); the mesh is left as it was.
+    const SurfaceMesh before = mesh;
+    for (const double maxDistance : {-0.01, -1.0}) {
+        EXPECT_EQ(nonbloppy_test::messageOf<ParameterError>([&] { preserveVolume(mesh, 128.0, maxDistance); }),
+                  "largest volume offset must be > 0, got " + std::string(maxDistance == -1.0 ? "-1" : "-0.01"));
+    }
+    EXPECT_EQ(mesh.points, before.points);
     mesh.normals.clear();
     EXPECT_EQ(message(settings), "offsetting a surface needs its normals (computeNormals())");
 }

@@ -3,6 +3,7 @@
 // the readers, `mesh --attributes` (PLY/VTK vertex data, OBJ warning), and the extra grids
 // --vdb-surface and --vdb-points.
 
+#include <nonbloppy/Error.h>
 #include <nonbloppy/ReadMesh.h>
 #include <nonbloppy/ReadParticles.h>
 #include <nonbloppy/WriteParticles.h>
@@ -18,6 +19,8 @@
 
 #include <cmath>
 #include <cstring>
+#include <filesystem>
+#include <limits>
 #include <map>
 #include <string>
 #include <vector>
@@ -293,13 +296,17 @@ TEST_F(CliFormatsTest, RenamedAttributesStayDistinctAndReadBack)
     add("a_b", 1, 20.0f);
     add("x", 1, 50.0f);
     add("my attr", 1, 60.0f);
+    // The CSV reader takes X and P:0..2 for positions too ("two columns for coordinate x"
+    // on nonbloppy's own file); .vdb dropped an attribute P without a word.
+    add("X", 1, 70.0f);
+    add("P", 3, 80.0f);
     // The name each attribute reads back under, per format; an unchanged name keeps its own.
     const std::map<std::string, std::vector<std::string>> expected{
-        {".csv", {"a_b_2", "a_b", "x_2", "my_attr"}},
-        {".ply", {"a_b_2", "a_b", "x_2", "my_attr"}},
-        {".vtk", {"a_b_2", "a_b", "x_2", "my_attr"}},
-        {".vtu", {"a_b_2", "a_b", "x_2", "my_attr"}},
-        {".vdb", {"a_b_2", "a_b", "x_2", "my_attr"}}};
+        {".csv", {"a_b_2", "a_b", "x_2", "my_attr", "X_2", "P_2"}},
+        {".ply", {"a_b_2", "a_b", "x_2", "my_attr", "X", "P"}},
+        {".vtk", {"a_b_2", "a_b", "x_2", "my_attr", "X", "P_2"}},
+        {".vtu", {"a_b_2", "a_b", "x_2", "my_attr", "X", "P_2"}},
+        {".vdb", {"a_b_2", "a_b", "x_2", "my_attr", "X", "P_2"}}};
     for (const auto& [ext, names] : expected) {
         const std::string file = path("renamed" + ext);
         nonbloppy::writeParticles(particles, file);
@@ -315,4 +322,47 @@ TEST_F(CliFormatsTest, RenamedAttributesStayDistinctAndReadBack)
             }
         }
     }
+}
+
+TEST_F(CliFormatsTest, WideIntegersSurviveAVdbOrAreRefused)
+{
+    // 3-vectors of uint32 and int64 were stored as vec3i: 4e9 and 2^40 read back as
+    // -2147483648. A uint64 above 2^63 - 1 read back as -9.22e18.
+    ParticleSet particles;
+    particles.positions = {{0.0f, 0.0f, 0.0f}};
+    const auto add = [&](const std::string& name, nonbloppy::ScalarType type, const void* values, size_t bytes,
+                         int components) {
+        ParticleAttribute a;
+        a.name = name;
+        a.type = type;
+        a.components = components;
+        a.bytes.resize(bytes);
+        std::memcpy(a.bytes.data(), values, bytes);
+        particles.attributes.push_back(a);
+    };
+    const uint32_t wide32[3] = {4000000000u, 1u, 2u};
+    const int64_t wide64[3] = {int64_t(1) << 40, -5, 7};
+    add("u", nonbloppy::ScalarType::UInt32, wide32, sizeof(wide32), 3);
+    add("i", nonbloppy::ScalarType::Int64, wide64, sizeof(wide64), 3);
+    const std::string file = path("wide.vdb");
+    nonbloppy::writeParticles(particles, file);
+    const ParticleSet back = nonbloppy::readParticles(file);
+    for (const auto& [name, values] : {std::pair<const char*, std::vector<double>>{"u", {4e9, 1, 2}},
+                                       {"i", {1099511627776.0, -5, 7}}}) {
+        const ParticleAttribute* a = back.findAttribute(name);
+        ASSERT_NE(a, nullptr) << name;
+        ASSERT_EQ(a->components, 3) << name;
+        for (int c = 0; c < 3; ++c) EXPECT_EQ(a->asDouble(0, c), values[size_t(c)]) << name << c;
+    }
+    const uint64_t huge = std::numeric_limits<uint64_t>::max();
+    add("h", nonbloppy::ScalarType::UInt64, &huge, sizeof(huge), 1);
+    std::string message;
+    try {
+        nonbloppy::writeParticles(particles, path("huge.vdb"));
+    } catch (const nonbloppy::ParameterError& e) {
+        message = e.what();
+    }
+    EXPECT_EQ(message, "attribute 'h' holds 18446744073709551615, above 9223372036854775807, the largest integer "
+                       "a .vdb stores");
+    EXPECT_FALSE(std::filesystem::exists(path("huge.vdb")));
 }

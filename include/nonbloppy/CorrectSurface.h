@@ -120,7 +120,7 @@ struct VolumeSettings
 /// Only meaningful for a closed mesh whose target is known (e.g. N·s³ for an incompressible
 /// fluid of N particles at spacing s); a wrong target shifts the whole surface.
 /// @return the total distance moved along the normals (world units)
-/// @throw ParameterError if targetVolume is not > 0 or normals are missing;
+/// @throw ParameterError if targetVolume or maxDistance is not > 0 or normals are missing;
 ///        CancelledError("interrupted during correct surface") when @a interrupter says stop.
 /// @param mesh         closed mesh with normals; vertices moved, normals recomputed
 /// @param targetVolume volume to enclose, world units³, > 0

@@ -60,7 +60,8 @@ constexpr double kMaxCalibratedRadiusOverSpacing = 32.0;
 /// The result depends only on the ratio r_e/s. Cost: 256·(2⌈r_e/s⌉ + 4)²·(⌈r_e/s⌉ + 2)
 /// kernel evaluations: 65,536 at r_e = 2 s (under 1 ms), 40M at the limit of 32 s.
 /// @throw ParameterError if @a effectiveRadiusOverSpacing ≤ 0.5 (the density at s/2 outside
-///        would be 0 and no threshold could place the surface there) or above
+///        would be 0 and no threshold could place the surface there), so close above 0.5
+///        that the kernel reaches none of the samples there (up to about 0.502), or above
 ///        kMaxCalibratedRadiusOverSpacing.
 NONBLOPPY_API double calibrateThreshold(double effectiveRadiusOverSpacing);
 

@@ -17,7 +17,9 @@ namespace nonbloppy {
 /// units, negative inside) to @a mesh within @a halfWidth voxels of it, voxel size
 /// @a voxelSize world units. The mesh should be closed; holes leak the inside sign.
 /// Cost: O(polygons · halfWidth³), parallel inside OpenVDB.
-/// @throw ParameterError if voxelSize ≤ 0 or halfWidth < 1.
+/// @throw ParameterError if voxelSize ≤ 0 or below kMinCellSize, halfWidth < 1, or a
+///        polygon references a vertex the mesh does not have ("polygon P references vertex
+///        I but the mesh has N vertices", polygons numbered triangles first, then quads).
 NONBLOPPY_API openvdb::FloatGrid::Ptr meshToLevelSet(const SurfaceMesh& mesh, double voxelSize,
                                        float halfWidth = 3.0f);
 

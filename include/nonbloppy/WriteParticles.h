@@ -38,12 +38,15 @@ struct ParticleWriteSettings
 /// - `.vdb`  one PointDataGrid named "points" (see makePointDataGrid()).
 /// Attribute names are written in the format's alphabet (spaces, commas, quotes, <, >, &
 /// and non-ASCII bytes become '_'; for `.vdb` all but letters, digits, '_', '|' and ':'),
-/// and kept distinct: a name that would repeat another column (or x, y, z, P) gets _2,
+/// and kept distinct: a name that would repeat another column, or that the format's
+/// reader takes for positions (x, y, z, P; in CSV also X, Points:0, p_y, ...), gets _2,
 /// _3, ...; names that need no change keep theirs ("a b" beside "a_b" is "a_b_2").
 /// Written through a temporary file renamed into place; same particles, same bytes (with
 /// or without direct I/O, see ParticleWriteSettings; `.vdb` goes through OpenVDB's own
 /// writer and always uses the page cache).
-/// @throw FileError for an unknown extension or an unwritable path.
+/// @throw FileError for an unknown extension or an unwritable path; ParameterError for an
+///        attribute that does not hold one value per particle, or (`.vdb`) a uint64 value
+///        above 2^63 - 1.
 NONBLOPPY_API void writeParticles(const ParticleSet& particles, const std::string& path,
                                   const ParticleWriteSettings& settings = ParticleWriteSettings());
 
@@ -52,9 +55,13 @@ NONBLOPPY_API bool isParticleOutputFile(const std::string& path);
 
 /// The particles as an openvdb::points::PointDataGrid named "points": position `P`
 /// (world positions, NullCodec) and every attribute in the nearest OpenVDB type (3
-/// components become vec3s/vec3d/vec3i; unsigned integers widen to the next signed type;
-/// other component counts become one scalar attribute per component, "name_<c>").
+/// components become vec3s, vec3d, vec3i for integers of up to 32 bits, vec3d for wider
+/// ones; scalar unsigned integers widen to the next signed type, uint64 to int64; other
+/// component counts become one scalar attribute per component, "name_<c>"). The grid
+/// holds the particles in voxel order: readParticles() gives them back in that order.
 /// @a voxelSize ≤ 0 picks one with about 8 points per voxel (points::computeVoxelSize).
+/// @throw ParameterError for an infinite @a voxelSize or one below kMinCellSize, or a
+///        uint64 value above 2^63 - 1.
 /// Returned as GridBase so this header stays light (cast with
 /// openvdb::gridPtrCast<openvdb::points::PointDataGrid>).
 NONBLOPPY_API openvdb::GridBase::Ptr makePointDataGrid(const ParticleSet& particles, double voxelSize = 0.0);

@@ -1,0 +1,56 @@
+// SPDX-License-Identifier: Apache-2.0
+// Tests for meshToLevelSet(): the signed distance to a closed mesh, and its checks.
+#include "TestUtil.h"
+
+#include <nonbloppy/Error.h>
+#include <nonbloppy/MeshToLevelSet.h>
+
+#include <gtest/gtest.h>
+
+using nonbloppy::ParameterError;
+using nonbloppy::SurfaceMesh;
+
+namespace {
+
+/// The unit cube [0,1]³ as 6 outward quads.
+SurfaceMesh unitCube()
+{
+    SurfaceMesh cube;
+    for (int i = 0; i < 8; ++i) cube.points.emplace_back(float(i & 1), float((i >> 1) & 1), float((i >> 2) & 1));
+    cube.quads = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
+    return cube;
+}
+
+} // namespace
+
+TEST(MeshToLevelSet, SignedDistanceToACube)
+{
+    const openvdb::FloatGrid::Ptr grid = nonbloppy::meshToLevelSet(unitCube(), 0.1);
+    EXPECT_EQ(grid->getName(), "surface");
+    EXPECT_EQ(grid->getGridClass(), openvdb::GRID_LEVEL_SET);
+    const auto value = [&](double x, double y, double z) {
+        return grid->tree().getValue(grid->transform().worldToIndexCellCentered(openvdb::Vec3d(x, y, z)));
+    };
+    EXPECT_NEAR(value(0.5, 0.5, 1.1), 0.1, 1e-5);   // outside, one voxel above the top
+    EXPECT_NEAR(value(0.5, 0.5, 0.9), -0.1, 1e-5);  // inside, one voxel below it
+    EXPECT_NEAR(value(0.5, 0.5, 1.0), 0.0, 1e-5);
+}
+
+TEST(MeshToLevelSet, BadInputIsAParameterError)
+{
+    // A vertex index out of range crashed inside OpenVDB; a voxel below kMinCellSize threw
+    // OpenVDB's ArithmeticError, which no caller catching nonbloppy::Error sees.
+    SurfaceMesh cube = unitCube();
+    cube.triangles.push_back({0, 1, 1u << 30});
+    EXPECT_EQ(nonbloppy_test::messageOf<ParameterError>([&] { nonbloppy::meshToLevelSet(cube, 0.1); }),
+              "polygon 0 references vertex 1073741824 but the mesh has 8 vertices");
+    cube.triangles.clear();
+    cube.quads[5][2] = 8;
+    EXPECT_EQ(nonbloppy_test::messageOf<ParameterError>([&] { nonbloppy::meshToLevelSet(cube, 0.1); }),
+              "polygon 5 references vertex 8 but the mesh has 8 vertices");
+    EXPECT_EQ(nonbloppy_test::messageOf<ParameterError>([&] { nonbloppy::meshToLevelSet(unitCube(), 1e-9); }),
+              "--voxel-size 1e-09 is below 1.5e-05, the smallest OpenVDB accepts: give the positions in a "
+              "smaller unit");
+    EXPECT_EQ(nonbloppy_test::messageOf<ParameterError>([&] { nonbloppy::meshToLevelSet(unitCube(), 0.0); }),
+              "--voxel-size must be > 0, got 0");
+}
