@@ -408,6 +408,15 @@ ResolvedParameters resolveParametersWith(const SurfaceParameters& params, const 
         }
     }
 
+    // (After the volume check, which names --spacing when that was given.) The kernel squares lengths in single precision: beyond this r_e² overflows to +inf and
+    // the mesh came out wrong or empty (a lattice scaled by 1e20 kept 2.6% of its volume).
+    constexpr double kMaxRadius = 1.0e18;
+    if (out.effectiveRadius > kMaxRadius) {
+        throw ParameterError("--radius " + formatNumber(out.effectiveRadius) + " is too large: at most " +
+                             formatNumber(kMaxRadius) + " (lengths are squared in single precision); give the "
+                             "positions in a larger unit");
+    }
+
     poll.throwIfStopped();
     return out;
 }

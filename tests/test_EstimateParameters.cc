@@ -38,6 +38,25 @@ TEST(EstimateParameters, AnInfiniteCoordinateIsNamedAsSuch)
     }
 }
 
+TEST(EstimateParameters, LengthsWhoseSquareOverflowsAFloatAreRefused)
+{
+    // Scaled by 1e20, a lattice gave a mesh of 2.6% of its volume (r_e² = inf in float); by
+    // 1e25, none. Up to 1e17 the mesh is the same as at scale 1.
+    const auto lattice = [](double scale) {
+        std::vector<openvdb::Vec3f> positions =
+            latticeParticles(1.0, 5.0, [](const openvdb::Vec3d&) { return true; }, /*jitter=*/0.0);
+        for (openvdb::Vec3f& p : positions) p *= float(scale);
+        return positions;
+    };
+    const size_t polygons = buildSurface(lattice(1.0)).mesh.polygonCount();
+    EXPECT_EQ(buildSurface(lattice(1e17)).mesh.polygonCount(), polygons);
+    SurfaceParameters params;
+    params.spacing = 1e20;
+    EXPECT_EQ(nonbloppy_test::messageOf<ParameterError>([&] { buildSurface(lattice(1e20), params); }),
+              "--radius 2e+20 is too large: at most 1e+18 (lengths are squared in single precision); give the "
+              "positions in a larger unit");
+}
+
 TEST(EstimateParameters, SpacingOfAJitteredLatticeIsItsStep)
 {
     // Jitter brings nearest neighbours closer (median 0.9 s) but keeps the volume per particle.
