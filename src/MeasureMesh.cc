@@ -6,6 +6,11 @@
 
 #include <nonbloppy/Error.h>
 
+#include "PolygonIndices.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_reduce.h>
+
 #include <algorithm>
 #include <cstdint>
 #include <string>
@@ -48,12 +53,42 @@ addTriangle(const SurfaceMesh& mesh, uint32_t i0, uint32_t i1, uint32_t i2, Area
 [[noreturn]] void
 throwBadIndex(const SurfaceMesh& mesh, size_t polygon, uint32_t index)
 {
-    throw ParameterError("polygon " + std::to_string(polygon) + " references vertex " +
-        std::to_string(index) + " but the mesh has " + std::to_string(mesh.points.size()) +
-        " vertices");
+    throw ParameterError(polygon_indices_internal::badIndexMessage(polygon, index, mesh.points.size()));
 }
 
 } // namespace
+
+std::string
+polygon_indices_internal::badIndexMessage(size_t polygon, uint32_t index, size_t vertexCount)
+{
+    return "polygon " + std::to_string(polygon) + " references vertex " + std::to_string(index) +
+           " but the mesh has " + std::to_string(vertexCount) + " vertices";
+}
+
+std::string
+polygon_indices_internal::firstBadIndex(const SurfaceMesh& mesh)
+{
+    const size_t vertexCount = mesh.points.size();
+    const size_t triangleCount = mesh.triangles.size(), polygonCount = triangleCount + mesh.quads.size();
+    const auto cornersOf = [&](size_t polygon) {
+        return polygon < triangleCount
+            ? std::make_pair(mesh.triangles[polygon].asPointer(), 3)
+            : std::make_pair(mesh.quads[polygon - triangleCount].asPointer(), 4);
+    };
+    const auto outOfRange = [&](uint32_t index) { return index >= vertexCount; };
+    const size_t bad = tbb::parallel_reduce(tbb::blocked_range<size_t>(0, polygonCount), polygonCount,
+        [&](const tbb::blocked_range<size_t>& range, size_t found) {
+            for (size_t n = range.begin(); n < range.end() && n < found; ++n) {
+                const auto [corners, count] = cornersOf(n);
+                if (std::any_of(corners, corners + count, outOfRange)) return n;
+            }
+            return found;
+        },
+        [](size_t a, size_t b) { return std::min(a, b); });
+    if (bad == polygonCount) return std::string();
+    const auto [corners, count] = cornersOf(bad);
+    return badIndexMessage(bad, *std::find_if(corners, corners + count, outOfRange), vertexCount);
+}
 
 AreaAndVolume
 measureAreaAndVolume(const SurfaceMesh& mesh)

@@ -7,6 +7,7 @@
 #include <nonbloppy/ParticleIndex.h>
 
 #include "OpenVdbScale.h"
+#include "PolygonIndices.h"
 
 #pragma GCC visibility push(default)  // OpenVDB templates: see src/VisibilityPrelude.h
 #include <openvdb/tools/MeshToVolume.h>
@@ -29,20 +30,8 @@ meshToLevelSet(const SurfaceMesh& mesh, double voxelSize, float halfWidth)
     // Below it OpenVDB throws its own ArithmeticError, not a nonbloppy::Error.
     openvdb_scale_internal::requireOpenVdbScale(voxelSize, kMinCellSize, "--voxel-size");
     // meshToVolume reads the corners unchecked: an index out of range crashed.
-    const size_t vertexCount = mesh.points.size();
-    const auto requireCorners = [&](size_t polygon, const uint32_t* corners, int n) {
-        for (int k = 0; k < n; ++k) {
-            if (corners[k] >= vertexCount) {
-                throw ParameterError("polygon " + std::to_string(polygon) + " references vertex " +
-                                     std::to_string(corners[k]) + " but the mesh has " +
-                                     std::to_string(vertexCount) + " vertices");
-            }
-        }
-    };
-    for (size_t t = 0; t < mesh.triangles.size(); ++t) requireCorners(t, mesh.triangles[t].asPointer(), 3);
-    for (size_t q = 0; q < mesh.quads.size(); ++q) {
-        requireCorners(mesh.triangles.size() + q, mesh.quads[q].asPointer(), 4);
-    }
+    const std::string badIndex = polygon_indices_internal::firstBadIndex(mesh);
+    if (!badIndex.empty()) throw ParameterError(badIndex);
     openvdb::initialize();
     const auto transform = openvdb::math::Transform::createLinearTransform(voxelSize);
     // meshToVolume wants index-space points.
