@@ -357,11 +357,7 @@ ResolvedParameters resolveParametersWith(const SurfaceParameters& params, const 
     requireOpenVdbScale(out.effectiveRadius, kMinCellSize / surface_stages_internal::kCellOverRadius, "--radius");
     // The grid holds (2 r_e / h)³ voxels per particle: refuse sizes that would exhaust memory,
     // before the threshold's calibration, whose cost grows as (r_e/s)³.
-    constexpr double kMaxVoxelsPerRadius = 32.0;
-    if (out.effectiveRadius / out.voxelSize > kMaxVoxelsPerRadius) {
-        throw ParameterError("--voxel-size " + formatNumber(out.voxelSize) + " is too small for --radius " +
-                             formatNumber(out.effectiveRadius) + ": at most 32 voxels per radius");
-    }
+    surface_stages_internal::requireVoxelsPerRadius(out.effectiveRadius, out.voxelSize);
     // A voxel wider than r_e leaves particles whose support holds no voxel centre: the mesh
     // would lose them (with h = 64 r_e, every one: an empty mesh and exit 0). At h ≤ r_e the
     // nearest centre is at most (√3/2) h < r_e away.

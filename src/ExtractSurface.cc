@@ -58,6 +58,18 @@ void checkExtractParameters(double threshold, double adaptivity)
     }
 }
 
+/// @throw ParameterError if @a density is classed as a level set: there the inside holds the
+/// smaller values, and its surface would come out inside out (and tileDeepInterior() would
+/// tile the outside).
+template<typename GridT>
+void requireDensityClass(const GridT& density, const char* function)
+{
+    if (density.getGridClass() == openvdb::GRID_LEVEL_SET) {
+        throw ParameterError(std::string(function) + " needs a density grid (larger values inside), got the level set '" +
+                             density.getName() + "' (smaller values inside): mesh it with openvdb::tools::volumeToMesh");
+    }
+}
+
 /// Reverse every polygon of @a mesh. The density grows inwards, the opposite of a level set,
 /// so volumeToMesh's polygons run clockwise seen from outside.
 void orientOutwards(SurfaceMesh& mesh)
@@ -755,6 +767,7 @@ bool extractByRegionImpl(const openvdb::FloatGrid& density, double threshold, Su
 
 size_t tileDeepInterior(openvdb::FloatGrid& density, double threshold)
 {
+    requireDensityClass(density, "tileDeepInterior");
     using LeafT = openvdb::FloatTree::LeafNodeType;
     openvdb::FloatTree& tree = density.tree();
     openvdb::tree::LeafManager<openvdb::FloatTree> leaves(tree);
@@ -802,6 +815,7 @@ size_t tileDeepInterior(openvdb::FloatGrid& density, double threshold)
 
 SurfaceMesh extractSurface(const openvdb::FloatGrid& density, double threshold, double adaptivity)
 {
+    requireDensityClass(density, "extractSurface");
     SurfaceMesh mesh;
     extractInto(density, threshold, adaptivity, mesh);
     return mesh;
@@ -809,6 +823,7 @@ SurfaceMesh extractSurface(const openvdb::FloatGrid& density, double threshold, 
 
 SurfaceMesh extractSurface(const openvdb::DoubleGrid& density, double threshold, double adaptivity)
 {
+    requireDensityClass(density, "extractSurface");
     SurfaceMesh mesh;
     extractInto(density, threshold, adaptivity, mesh);
     return mesh;

@@ -3,6 +3,7 @@
 #include "InstructionSet.h"
 #include "OpenVdbScale.h"
 #include "ParticleIndexImpl.h"
+#include "SurfaceStages.h"
 
 #include <nonbloppy/Error.h>
 #include <nonbloppy/Kernel.h>
@@ -345,6 +346,16 @@ struct RasterizeColumnOp
 
 } // namespace
 
+void surface_stages_internal::requireVoxelsPerRadius(double effectiveRadius, double voxelSize)
+{
+    if (effectiveRadius / voxelSize > kMaxVoxelsPerRadius) {
+        std::ostringstream msg;
+        msg << "--voxel-size " << voxelSize << " is too small for --radius " << effectiveRadius << ": at most "
+            << kMaxVoxelsPerRadius << " voxels per radius";
+        throw ParameterError(msg.str());
+    }
+}
+
 openvdb::FloatGrid::Ptr rasterizeDensity(const ParticleIndex& particles, const DensitySettings& settings,
                                          openvdb::util::NullInterrupter* interrupter)
 {
@@ -376,6 +387,7 @@ openvdb::FloatGrid::Ptr instruction_set_internal::rasterizeDensity(const Particl
         throw ParameterError("rasterizeDensity needs a uniform-scale transform without translation or rotation");
     }
     const double voxelSize = transform->voxelSize()[0];
+    surface_stages_internal::requireVoxelsPerRadius(settings.effectiveRadius, voxelSize);
 
     if (interrupter) interrupter->start("rasterize density");
     CancelPoll poll(interrupter, "rasterize density");

@@ -23,6 +23,12 @@ namespace surface_stages_internal {
 /// cells of r_e (three per axis, 27 r_e³ visited for a 4.2 r_e³ sphere).
 constexpr double kCellOverRadius = 0.5;
 
+/// Throw ParameterError("--voxel-size <h> is too small for --radius <r_e>: at most 32 voxels
+/// per radius") if r_e/h > kMaxVoxelsPerRadius: the one check of rasterizeDensity() and of
+/// the parameter estimate, which makes it before the threshold's calibration (whose cost
+/// grows as (r_e/s)³).
+void requireVoxelsPerRadius(double effectiveRadius, double voxelSize);
+
 /// Throw CancelledError("interrupted during <stage>") if @a interrupter (may be null) asks to
 /// stop. Cost: one wasInterrupted() call. Thread-safety: as the interrupter's.
 void checkCancelled(openvdb::util::NullInterrupter* interrupter, const char* stage);

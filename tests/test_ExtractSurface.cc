@@ -1,4 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
+#include "TestUtil.h"
+
 #include <nonbloppy/Error.h>
 #include <nonbloppy/ExtractSurface.h>
 #include <nonbloppy/ParticleIndex.h>
@@ -69,4 +71,27 @@ TEST(ExtractSurface, AdaptivityMergesPolygonsAndIsChecked)
     } catch (const ParameterError& e) {
         EXPECT_STREQ(e.what(), "--adaptivity must lie in [0,1], got 1.5");
     }
+}
+
+TEST(ExtractSurface, RefusesALevelSetWhichWouldComeOutInsideOut)
+{
+    // A signed distance field is smaller inside: meshed as a density it would face inwards.
+    const openvdb::FloatGrid::Ptr sphere = openvdb::FloatGrid::create(3.0f);
+    sphere->setName("sphere");
+    sphere->setGridClass(openvdb::GRID_LEVEL_SET);
+    sphere->tree().setValue(openvdb::Coord(0), -1.0f);
+    const std::string expected = "needs a density grid (larger values inside), got the level set 'sphere' "
+                                 "(smaller values inside): mesh it with openvdb::tools::volumeToMesh";
+    EXPECT_EQ(nonbloppy_test::messageOf<ParameterError>([&] { extractSurface(*sphere, 0.0); }),
+              "extractSurface " + expected);
+    EXPECT_EQ(nonbloppy_test::messageOf<ParameterError>([&] { tileDeepInterior(*sphere, 0.0); }),
+              "tileDeepInterior " + expected);
+    const openvdb::DoubleGrid::Ptr wide = openvdb::DoubleGrid::create(3.0);
+    wide->setName("sphere");
+    wide->setGridClass(openvdb::GRID_LEVEL_SET);
+    EXPECT_EQ(nonbloppy_test::messageOf<ParameterError>([&] { extractSurface(*wide, 0.0); }),
+              "extractSurface " + expected);
+    // The same values classed as anything else are meshed: the class is the caller's statement.
+    sphere->setGridClass(openvdb::GRID_UNKNOWN);
+    EXPECT_NO_THROW(extractSurface(*sphere, 0.0));
 }

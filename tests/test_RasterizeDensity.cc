@@ -157,6 +157,17 @@ TEST(RasterizeDensity, RejectsBadSettings)
     } catch (const ParameterError& e) {
         EXPECT_STREQ(e.what(), "--voxel-size must be > 0, got -0.5");
     }
+    // r_e/h = 1000 would make a 4·10⁹-voxel sphere (18 GB) of this one particle; 32 is the limit,
+    // for a caller's transform as well.
+    settings.voxelSize = 0.001;
+    EXPECT_EQ(nonbloppy_test::messageOf<ParameterError>([&] { rasterizeDensity(index, settings); }),
+              "--voxel-size 0.001 is too small for --radius 1: at most 32 voxels per radius");
+    settings.transform = openvdb::math::Transform::createLinearTransform(0.03);
+    EXPECT_EQ(nonbloppy_test::messageOf<ParameterError>([&] { rasterizeDensity(index, settings); }),
+              "--voxel-size 0.03 is too small for --radius 1: at most 32 voxels per radius");
+    settings.transform = openvdb::math::Transform::createLinearTransform(1.0 / 32.0);
+    EXPECT_GT(rasterizeDensity(index, settings)->activeVoxelCount(), 130000u);  // (4π/3)·32³ ≈ 137k
+    settings.transform.reset();
     // OpenVDB's transforms refuse such a scale with "Non-zero scale values required".
     settings.voxelSize = 1e-6;
     try {

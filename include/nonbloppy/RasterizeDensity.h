@@ -13,6 +13,11 @@
 
 namespace nonbloppy {
 
+/// The most voxels per effective radius (r_e/h) rasterizeDensity() accepts. An isolated
+/// particle's support holds (4π/3)(r_e/h)³ voxels, 137k at this limit (0.6 MB of grid); at
+/// r_e/h = 1000 it would be 4·10⁹ voxels, 18 GB, for one particle.
+constexpr double kMaxVoxelsPerRadius = 32.0;
+
 /// How the density is sampled.
 struct DensitySettings
 {
@@ -42,7 +47,8 @@ struct DensitySettings
 ///                     while assembling the tree; end().
 ///                     After a stop the partial grid is freed.
 /// Thread-safety: reentrant; the index is only read.
-/// @throw ParameterError if r_e ≤ 0 or h ≤ 0; CancelledError if @a interrupter says so.
+/// @throw ParameterError if r_e ≤ 0, h ≤ 0 or r_e/h > kMaxVoxelsPerRadius; CancelledError
+///        if @a interrupter says so.
 NONBLOPPY_API openvdb::FloatGrid::Ptr rasterizeDensity(const ParticleIndex& particles,
                                          const DensitySettings& settings,
                                          openvdb::util::NullInterrupter* interrupter = nullptr);
