@@ -22,6 +22,7 @@
 #include <charconv>
 #include <cstring>
 #include <functional>
+#include <limits>
 #include <ostream>
 #include <set>
 #include <type_traits>
@@ -424,18 +425,21 @@ addScalarAttribute(PointDataGrid& grid, const PointIndexGrid& index, const Parti
 {
     std::vector<ScalarT> values(a.size());
     for (size_t n = 0; n < values.size(); ++n) {
-        const double value = a.asDouble(n, c);
-        if constexpr (std::is_same_v<ScalarT, int64_t>) {
-            // A uint64 above 2^63 - 1 has no int64 (the widest integer a .vdb attribute holds):
-            // the cast gave -9.22e18.
-            if (!(value < 9223372036854775808.0)) {
-                uint64_t stored;  // only a uint64 gets here: its own bits, not the rounded double
-                std::memcpy(&stored, a.bytes.data() + (n * size_t(a.components) + size_t(c)) * 8, 8);
-                throw ParameterError("attribute '" + a.name + "' holds " + std::to_string(stored) +
+        if (a.type == ScalarType::Int64 || a.type == ScalarType::UInt64) {
+            // 64-bit integers are copied from their own bits: through a double, those above
+            // 2^53 lost their low bits. A uint64 above 2^63 - 1 has no int64 (the widest
+            // integer a .vdb attribute holds).
+            const unsigned char* p = a.bytes.data() + (n * size_t(a.components) + size_t(c)) * 8;
+            uint64_t bits;
+            std::memcpy(&bits, p, 8);
+            if (a.type == ScalarType::UInt64 && bits > uint64_t(std::numeric_limits<int64_t>::max())) {
+                throw ParameterError("attribute '" + a.name + "' holds " + std::to_string(bits) +
                                      ", above 9223372036854775807, the largest integer a .vdb stores");
             }
+            values[n] = static_cast<ScalarT>(static_cast<int64_t>(bits));
+        } else {
+            values[n] = static_cast<ScalarT>(a.asDouble(n, c));
         }
-        values[n] = static_cast<ScalarT>(value);
     }
     addVdbAttribute(grid, index, name, values);
 }

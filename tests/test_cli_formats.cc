@@ -344,6 +344,11 @@ TEST_F(CliFormatsTest, WideIntegersSurviveAVdbOrAreRefused)
     const int64_t wide64[3] = {int64_t(1) << 40, -5, 7};
     add("u", nonbloppy::ScalarType::UInt32, wide32, sizeof(wide32), 3);
     add("i", nonbloppy::ScalarType::Int64, wide64, sizeof(wide64), 3);
+    // Scalars above 2^53 keep every bit (they went through a double: 2^62 + 1 became 2^62).
+    const int64_t id = (int64_t(1) << 62) + 1;
+    const uint64_t largest = uint64_t(std::numeric_limits<int64_t>::max());
+    add("id", nonbloppy::ScalarType::Int64, &id, sizeof(id), 1);
+    add("largest", nonbloppy::ScalarType::UInt64, &largest, sizeof(largest), 1);
     const std::string file = path("wide.vdb");
     nonbloppy::writeParticles(particles, file);
     const ParticleSet back = nonbloppy::readParticles(file);
@@ -353,6 +358,14 @@ TEST_F(CliFormatsTest, WideIntegersSurviveAVdbOrAreRefused)
         ASSERT_NE(a, nullptr) << name;
         ASSERT_EQ(a->components, 3) << name;
         for (int c = 0; c < 3; ++c) EXPECT_EQ(a->asDouble(0, c), values[size_t(c)]) << name << c;
+    }
+    for (const auto& [name, expected] : {std::pair<const char*, int64_t>{"id", id}, {"largest", int64_t(largest)}}) {
+        const ParticleAttribute* a = back.findAttribute(name);
+        ASSERT_NE(a, nullptr) << name;
+        ASSERT_EQ(a->type, nonbloppy::ScalarType::Int64) << name;
+        int64_t value = 0;
+        std::memcpy(&value, a->bytes.data(), sizeof(value));
+        EXPECT_EQ(value, expected) << name;
     }
     const uint64_t huge = std::numeric_limits<uint64_t>::max();
     add("h", nonbloppy::ScalarType::UInt64, &huge, sizeof(huge), 1);
