@@ -414,6 +414,26 @@ TEST_F(CliTest, UnreadableNumbersAreNamed)
     expectUsageError(base + "--frame-jobs 1e3", "--frame-jobs needs an integer, got '1e3'");
 }
 
+TEST_F(CliTest, CommandLineMistakesAreSaidInTheToolsWords)
+{
+    // CLI11's own wording ("A subcommand is required", "--blend: 1 required FLOAT missing",
+    // "At Most 1 required but received 2", "The following argument was not expected") named
+    // neither the unknown command nor what was wrong with an option.
+    const std::string commands = "commands are mesh, inspect, convert, help";
+    expectUsageError("", "no command given; " + commands);
+    expectUsageError("frobnicate x", "unknown command 'frobnicate'; " + commands);
+    expectUsageError("--bogus", "unknown option '--bogus'; " + commands);
+    const std::string base = "mesh " + quote(kCube) + " -o " + quote(out("x.obj")) + " ";
+    expectUsageError(base + "--bogus 3", "mesh has no option '--bogus'; see 'nonbloppy help mesh'");
+    expectUsageError(base + "extra.vtk more.vtk", "unexpected argument 'extra.vtk' to mesh; see 'nonbloppy help mesh'");
+    expectUsageError(base + "--blend", "--blend needs a number");
+    expectUsageError(base + "--threads", "--threads needs an integer");
+    expectUsageError("mesh " + quote(kCube) + " -o", "--output needs a value");
+    expectUsageError(base + "-c 0.3 -c 0.4", "--blend given 2 times; give it once");
+    expectUsageError("inspect " + quote(kCube) + " other.vtk",
+                     "unexpected argument 'other.vtk' to inspect; see 'nonbloppy help inspect'");
+}
+
 TEST_F(CliTest, InspectMissingFile)
 {
     const std::string missing = in("missing.vdb");

@@ -18,12 +18,16 @@
 #include <openvdb/Exceptions.h>
 #include <openvdb/version.h>
 
+#include <algorithm>
 #include <exception>
 #include <iostream>
 #if defined(__GLIBC__)
 #include <malloc.h>
 #endif
 #include <new>
+#include <regex>
+#include <sstream>
+#include <string>
 #include <vector>
 
 namespace nonbloppy_tool {
@@ -77,6 +81,53 @@ std::string conversionMessage(const CLI::App& app, const std::string& message)
     return name + " needs " + (integer ? "an integer" : "a number") + ", got '" + value + "'";
 }
 
+/// CLI11's other refusals in the tool's words, where CLI11 10's spelling is known:
+///   "A subcommand is required"               → "unknown command 'frob'; commands are ..."
+///   "--output: 1 required TEXT missing"      → "--output needs a value"
+///   "--blend: At Most 1 required but received 2" → "--blend given 2 times; give it once"
+///   "The following argument was not expected: --bogus" → "mesh has no option '--bogus'; ..."
+///   (of several unexpected arguments, the first option given is named, else the first one)
+/// Any other message (or a later CLI11's spelling) is returned as it is.
+std::string parseMessage(const CLI::App& app, const std::string& message, int argc, char** argv)
+{
+    const std::string commands = "commands are mesh, inspect, convert, help";
+    if (message == "A subcommand is required") {
+        if (argc < 2) return "no command given; " + commands;
+        const std::string first = argv[1];
+        return (first[0] == '-' ? "unknown option '" : "unknown command '") + first + "'; " + commands;
+    }
+    const CLI::App* command = nullptr;
+    for (const CLI::App* c : app.get_subcommands({})) {
+        if (c->parsed()) command = c;
+    }
+    const std::string where = command ? command->get_name() : std::string("nonbloppy");
+    const std::string helpHint = "see 'nonbloppy help " + (command ? command->get_name() + "'" : std::string("'"));
+    std::smatch match;
+    static const std::regex missing(R"(^(\S+): \d+ required (\S+) missing$)");
+    static const std::regex repeated(R"(^(\S+): At Most 1 required but received (\d+)$)");
+    static const std::regex extra(R"(^The following arguments? (?:was|were) not expected: (.+)$)");
+    if (std::regex_match(message, match, missing)) {
+        const std::string type = match[2];
+        const char* what = (type == "INT" || type == "UINT") ? "an integer" : type == "FLOAT" ? "a number" : "a value";
+        return match[1].str() + " needs " + what;
+    }
+    if (std::regex_match(message, match, repeated)) {
+        return match[1].str() + " given " + match[2].str() + " times; give it once";
+    }
+    if (std::regex_match(message, match, extra)) {
+        // CLI11 lists them last first: name the first unknown option given, else the first
+        // argument ("--bogus 3" leaves "3 --bogus").
+        std::vector<std::string> arguments;
+        std::istringstream words(match[1].str());
+        for (std::string word; words >> word;) arguments.insert(arguments.begin(), word);
+        const auto option = std::find_if(arguments.begin(), arguments.end(),
+                                          [](const std::string& a) { return a.size() > 1 && a[0] == '-'; });
+        if (option != arguments.end()) return where + " has no option '" + *option + "'; " + helpHint;
+        return "unexpected argument '" + arguments.front() + "' to " + where + "; " + helpHint;
+    }
+    return message;
+}
+
 int run(int argc, char** argv)
 {
     using namespace nonbloppy_tool;
@@ -118,7 +169,7 @@ int run(int argc, char** argv)
     } catch (const CLI::ConversionError& e) {
         return fail(conversionMessage(app, e.what()), kExitUsage);
     } catch (const CLI::ParseError& e) {
-        return fail(e.what(), kExitUsage);
+        return fail(parseMessage(app, e.what(), argc, argv), kExitUsage);
     }
 
     for (const Command& command : commands) {
