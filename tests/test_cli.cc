@@ -434,6 +434,25 @@ TEST_F(CliTest, CommandLineMistakesAreSaidInTheToolsWords)
                      "unexpected argument 'other.vtk' to inspect; see 'nonbloppy help inspect'");
 }
 
+TEST_F(CliTest, AFailedVdbWriteLeavesTheEarlierMeshInPlace)
+{
+    // The mesh is written before the .vdb; when the .vdb then failed, removing the new mesh
+    // also lost the one an earlier run had left there.
+    const std::string mesh = out("keep.obj");
+    ASSERT_EQ(run("mesh " + quote(kCube) + " -q -o " + quote(mesh)).exitCode, 0);
+    const std::string before = readText(mesh);
+    ASSERT_FALSE(before.empty());
+    const RunResult r = run("mesh " + quote(kCube) + " -q -c 0.1 -o " + quote(mesh) + " --vdb /proc/nonbloppy.vdb");
+    EXPECT_EQ(r.exitCode, 1);
+    EXPECT_EQ(r.err, "nonbloppy: cannot write /proc/nonbloppy.vdb: No such file or directory\n");
+    EXPECT_EQ(readText(mesh), before);
+    EXPECT_EQ(listDir(out("")), std::vector<std::string>{"keep.obj"});  // no link to the old file left
+    // A first run that fails the same way leaves nothing.
+    fs::remove(mesh);
+    EXPECT_EQ(run("mesh " + quote(kCube) + " -q -o " + quote(mesh) + " --vdb /proc/nonbloppy.vdb").exitCode, 1);
+    EXPECT_TRUE(listDir(out("")).empty());
+}
+
 TEST_F(CliTest, InspectMissingFile)
 {
     const std::string missing = in("missing.vdb");

@@ -412,20 +412,71 @@ void printSummary(const MeshOptions& o, const nonbloppy::SurfaceResult& result,
 // ---------------------------------------------------------------------------------------
 // The command
 
-/// Files this run has written; removed again unless the run succeeds, so a failed or
-/// interrupted run leaves no half-set of outputs.
+/// The outputs of one frame, put back as they were unless the frame succeeds. Each output
+/// is written atomically, but the mesh is in place before the .vdb is written: when that
+/// failed, removing the new mesh used to leave neither it nor the mesh an earlier run had
+/// written there. So before an output is written, the file it will replace (symbolic links
+/// followed, as the writers do) gets a hard link beside it; on failure that link is renamed
+/// back over the new file, or, where nothing was replaced, the new file is removed.
+/// Cost: a link() and an unlink() per existing output. Where the file system has no hard
+/// links, a failed run still removes the new file (the old one is then lost, as before).
 class OutputCleanup
 {
 public:
-    void add(const std::string& path) { mPaths.push_back(path); }
-    void keep() { mPaths.clear(); }
+    /// Call before writing @a path.
+    void willWrite(const std::string& path)
+    {
+        Output output{path, path, "", false};
+        std::error_code error;
+        if (std::filesystem::exists(path, error)) {
+            const std::filesystem::path target = std::filesystem::canonical(path, error);
+            if (!error) {
+                output.target = target.string();
+                const std::string backup = output.target + ".nonbloppy-old-" + std::to_string(::getpid());
+                if (::link(output.target.c_str(), backup.c_str()) == 0) output.backup = backup;
+            }
+        }
+        mOutputs.push_back(output);
+    }
+    /// Call once the output last announced by willWrite() is written.
+    void written() { mOutputs.back().written = true; }
+    /// The frame succeeded: keep the new files, drop the links to the old ones.
+    void keep()
+    {
+        for (const Output& output : mOutputs) {
+            if (!output.backup.empty()) ::unlink(output.backup.c_str());
+        }
+        mOutputs.clear();
+    }
     ~OutputCleanup()
     {
-        for (const std::string& path : mPaths) std::remove(path.c_str());
+        for (const Output& output : mOutputs) {
+            if (!output.backup.empty()) {
+                // Renaming a link over the same file would leave both names (POSIX).
+                struct stat now{}, old{};
+                const bool replaced = ::stat(output.target.c_str(), &now) != 0 ||
+                                      ::stat(output.backup.c_str(), &old) != 0 || now.st_ino != old.st_ino ||
+                                      now.st_dev != old.st_dev;
+                if (replaced) {
+                    std::rename(output.backup.c_str(), output.target.c_str());
+                } else {
+                    ::unlink(output.backup.c_str());
+                }
+            } else if (output.written) {
+                std::remove(output.path.c_str());
+            }
+        }
     }
 
 private:
-    std::vector<std::string> mPaths;
+    struct Output
+    {
+        std::string path;    ///< as given
+        std::string target;  ///< the file it names (links followed)
+        std::string backup;  ///< hard link to the replaced file, or empty
+        bool written;
+    };
+    std::vector<Output> mOutputs;
 };
 
 /// What meshing one frame produced: the library's result and every stage's seconds
@@ -488,8 +539,9 @@ FrameOutcome meshFrame(const MeshOptions& o, ProgressInterrupter& interrupter)
         nonbloppy::MeshWriteSettings settings;
         settings.keepQuads = o.quads;
         settings.directIo = !o.noDirectIo;
+        cleanup.willWrite(o.output);
         nonbloppy::writeMesh(result.mesh, o.output, settings);
-        cleanup.add(o.output);
+        cleanup.written();
     }
     throwIfInterrupted();
 
@@ -501,8 +553,9 @@ FrameOutcome meshFrame(const MeshOptions& o, ProgressInterrupter& interrupter)
         fileMetadata.insertMeta("creator", openvdb::StringMetadata(versionLine()));
         openvdb::GridCPtrVec grids{result.density};
         appendVdbGrids(grids, result, particles, o.outputs);
+        cleanup.willWrite(o.vdbPath);
         nonbloppy::writeVdb(grids, o.vdbPath, fileMetadata);
-        cleanup.add(o.vdbPath);
+        cleanup.written();
     }
     throwIfInterrupted();
     cleanup.keep();
