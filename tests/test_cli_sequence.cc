@@ -130,6 +130,28 @@ TEST_F(CliSequenceTest, LogNamingAnInputFrameOrAnOutputIsRefusedBeforeAnyWork)
                   "cannot write " + out("density_0001.vdb") + ": --log names an output of frame 1");
 }
 
+TEST_F(CliSequenceTest, NoFrameWritesAnotherFramesInputOrTheLog)
+{
+    // Frame 1's mesh in/fluid_11.vtk would have replaced frame 11's particles, and then been
+    // read as them: the output was only compared with its own frame's input.
+    fs::copy_file(kFree, in("fluid_1.vtk"));
+    fs::copy_file(kCube, in("fluid_11.vtk"));
+    const std::string frame11 = in("fluid_11.vtk");
+    const std::string before = readText(frame11);
+    const std::string pattern = "mesh " + quote(in("fluid_{}.vtk")) + " ";
+    expectUsageError(pattern + "-o " + quote(in("fluid_1{}.vtk")), "cannot write " + frame11 + ": it is the input of frame 11");
+    // Also when frame 11 is not among the requested frames, and for the log.
+    expectUsageError(pattern + "--frames 1 -o " + quote(in("fluid_1{}.vtk")),
+                     "cannot write " + frame11 + ": it is the input of frame 11");
+    expectUsageError(pattern + "--frames 1 -o " + quote(out("m_{}.obj")) + " --log " + quote(frame11),
+                     "cannot write " + frame11 + ": --log names the input of frame 11");
+    EXPECT_EQ(readText(frame11), before);
+    // A log spelled differently from the output it names ("./" inside the path).
+    const std::string dotted = dir() + "/out/./m_11.obj";
+    expectUsageError(pattern + "-o " + quote(out("m_{}.obj")) + " --log " + quote(dotted),
+                     "cannot write " + dotted + ": --log names an output of frame 11");
+}
+
 TEST_F(CliSequenceTest, SequenceOptionsNeedASequence)
 {
     const RunResult r = run("mesh " + quote(kFree) + " -o " + quote(out("m.obj")) + " --frames 1-3");

@@ -29,6 +29,7 @@
 #include <cstring>
 #include <filesystem>
 #include <iostream>
+#include <map>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -620,19 +621,48 @@ void requirePlaceholder(const std::string& path, const std::string& option, cons
     }
 }
 
-/// Refuse a --log that names an input frame (it would be overwritten with JSON before the
-/// frame is read) or a frame's output (whose rename would replace the log).
-void requireLogApart(const std::string& logPath, const std::vector<BatchJob>& jobs)
+/// What names one file: its device and inode when it exists (hard links, symbolic links and
+/// "./" all agree), else its path made absolute and normal ("./m_0002.obj" and m_0002.obj).
+std::string fileIdentity(const std::string& path)
 {
-    for (const BatchJob& job : jobs) {
-        if (sameFile(logPath, job.frame.input)) {
-            throw UsageError("cannot write " + logPath + ": --log names the input of frame "
-                                       + std::to_string(job.frame.number));
+    struct stat info;
+    if (::stat(path.c_str(), &info) == 0) {
+        return std::to_string(info.st_dev) + ":" + std::to_string(info.st_ino);
+    }
+    std::error_code ec;
+    const fs::path normal = fs::weakly_canonical(fs::absolute(path, ec), ec);
+    return "path:" + (ec ? path : normal.string());
+}
+
+/// Refuse, before any frame is meshed, an output of one frame that is an input of the
+/// sequence (@a sequence: every frame on disk, requested or not; 'x{}.vtk' -o 'x1{}.vtk':
+/// frame 1's mesh x11.vtk would replace frame 11's particles, then be read as them), and a
+/// --log that names an input (overwritten with JSON) or an output (whose rename would
+/// replace the log). Each frame's own input is
+/// checked again by validatePaths(). Cost: one stat() (and, for files not yet there, one
+/// weakly_canonical()) per path, O(F log F) for F frames.
+void requireOutputsApart(const std::vector<Frame>& sequence, const std::vector<BatchJob>& jobs,
+                         const std::string& logPath)
+{
+    std::map<std::string, int> inputs;
+    for (const Frame& frame : sequence) inputs.emplace(fileIdentity(frame.input), frame.number);
+    const std::string log = logPath.empty() ? std::string() : fileIdentity(logPath);
+    if (!log.empty()) {
+        if (const auto input = inputs.find(log); input != inputs.end()) {
+            throw UsageError("cannot write " + logPath + ": --log names the input of frame " +
+                             std::to_string(input->second));
         }
+    }
+    for (const BatchJob& job : jobs) {
         for (const std::string& output : job.outputs) {
-            if (sameFile(logPath, output)) {
-                throw UsageError("cannot write " + logPath + ": --log names an output of frame "
-                                           + std::to_string(job.frame.number));
+            const std::string identity = fileIdentity(output);
+            if (const auto input = inputs.find(identity); input != inputs.end()) {
+                throw UsageError("cannot write " + output + ": it is the input of frame " +
+                                 std::to_string(input->second));
+            }
+            if (identity == log) {
+                throw UsageError("cannot write " + logPath + ": --log names an output of frame " +
+                                 std::to_string(job.frame.number));
             }
         }
     }
@@ -666,7 +696,7 @@ int runSequence(const MeshOptions& o)
     }
     // Output extensions and directories, before any work.
     validatePaths(optionsForFrame(o, plan.frames.front()));
-    if (!o.logPath.empty()) requireLogApart(o.logPath, jobs);
+    requireOutputsApart(findFrames(input), jobs, o.logPath);
 
     std::unique_ptr<tbb::global_control> threadLimit;
     if (o.threadsOpt->count() > 0) {
