@@ -307,12 +307,34 @@ double cancellation_internal::requireCalibratedThreshold(double threshold, doubl
 
 namespace {
 
-/// resolveParameters() of @a positions, searched through @a shared (an index of those same
-/// particles) when it is given.
-ResolvedParameters resolveParametersWith(const SurfaceParameters& params, const std::vector<openvdb::Vec3f>& positions,
-                                         const ParticleIndex* shared, openvdb::util::NullInterrupter* interrupter)
+/// @throw ParameterError if a voxel of @a voxelSize is wider than @a effectiveRadius (both
+/// given): particles whose support holds no voxel centre would be lost (with h = 64 r_e,
+/// every one: an empty mesh). At h ≤ r_e the nearest centre is at most (√3/2) h < r_e away.
+void requireVoxelWithinRadius(double effectiveRadius, double voxelSize)
 {
-    CancelPoll poll(interrupter, "estimate parameters");
+    if (voxelSize > effectiveRadius) {
+        throw ParameterError("--voxel-size " + formatNumber(voxelSize) + " is too large for --radius " +
+                             formatNumber(effectiveRadius) + ": at least one voxel per radius");
+    }
+}
+
+/// @throw ParameterError if r_e > 1e18: the kernel squares lengths in single precision, so
+/// beyond it r_e² overflows to +inf and the mesh came out wrong or empty (a lattice scaled
+/// by 1e20 kept 2.6% of its volume).
+void requireRadiusBelowMaximum(double effectiveRadius)
+{
+    constexpr double kMaxRadius = 1.0e18;
+    if (effectiveRadius > kMaxRadius) {
+        throw ParameterError("--radius " + formatNumber(effectiveRadius) + " is too large: at most " +
+                             formatNumber(kMaxRadius) + " (lengths are squared in single precision); give the "
+                             "positions in a larger unit");
+    }
+}
+
+} // namespace
+
+void checkParameters(const SurfaceParameters& params)
+{
     auto requirePositive = [](const std::optional<double>& value, const char* name) {
         if (value && (!(*value > 0.0) || !std::isfinite(*value))) {
             throw ParameterError(std::string(name) + " must be > 0, got " + formatNumber(*value));
@@ -331,6 +353,34 @@ ResolvedParameters resolveParametersWith(const SurfaceParameters& params, const 
     if (!(params.adaptivity >= 0.0 && params.adaptivity <= 1.0)) {
         throw ParameterError("--adaptivity must lie in [0,1], got " + formatNumber(params.adaptivity));
     }
+    if (params.method == Method::Faithful && params.maxStep &&
+        (!(*params.maxStep >= 0.0) || !std::isfinite(*params.maxStep))) {
+        throw ParameterError("--max-step must be >= 0, got " + formatNumber(*params.maxStep));
+    }
+    // The limits between lengths, where the lengths are given; resolveParameters() checks
+    // them again once the others are derived.
+    using openvdb_scale_internal::requireOpenVdbScale;
+    if (params.voxelSize) requireOpenVdbScale(*params.voxelSize, kMinCellSize, "--voxel-size");
+    if (params.effectiveRadius) {
+        requireOpenVdbScale(*params.effectiveRadius, kMinCellSize / surface_stages_internal::kCellOverRadius,
+                            "--radius");
+        if (params.voxelSize) {
+            surface_stages_internal::requireVoxelsPerRadius(*params.effectiveRadius, *params.voxelSize);
+            requireVoxelWithinRadius(*params.effectiveRadius, *params.voxelSize);
+        }
+        requireRadiusBelowMaximum(*params.effectiveRadius);
+    }
+}
+
+namespace {
+
+/// resolveParameters() of @a positions, searched through @a shared (an index of those same
+/// particles) when it is given.
+ResolvedParameters resolveParametersWith(const SurfaceParameters& params, const std::vector<openvdb::Vec3f>& positions,
+                                         const ParticleIndex* shared, openvdb::util::NullInterrupter* interrupter)
+{
+    CancelPoll poll(interrupter, "estimate parameters");
+    checkParameters(params);
     if (positions.empty()) throw ParameterError("no particles to mesh");
 
     ResolvedParameters out;
@@ -358,9 +408,6 @@ ResolvedParameters resolveParametersWith(const SurfaceParameters& params, const 
     // The grid holds (2 r_e / h)³ voxels per particle: refuse sizes that would exhaust memory,
     // before the threshold's calibration, whose cost grows as (r_e/s)³.
     surface_stages_internal::requireVoxelsPerRadius(out.effectiveRadius, out.voxelSize);
-    // A voxel wider than r_e leaves particles whose support holds no voxel centre: the mesh
-    // would lose them (with h = 64 r_e, every one: an empty mesh and exit 0). At h ≤ r_e the
-    // nearest centre is at most (√3/2) h < r_e away.
     if (out.voxelSize > out.effectiveRadius) {
         // Name what the user gave: a derived voxel size (s/2) is not theirs to fix.
         if (!out.voxelSizeGiven) {
@@ -368,15 +415,11 @@ ResolvedParameters resolveParametersWith(const SurfaceParameters& params, const 
                                  formatNumber(out.voxelSize) + " (derived: half the particle spacing): at least one "
                                  "voxel per radius");
         }
-        throw ParameterError("--voxel-size " + formatNumber(out.voxelSize) + " is too large for --radius " +
-                             formatNumber(out.effectiveRadius) + ": at least one voxel per radius");
+        requireVoxelWithinRadius(out.effectiveRadius, out.voxelSize);
     }
     out.method = params.method;
     const bool faithful = params.method == Method::Faithful;
     if (faithful) {
-        if (params.maxStep && (!(*params.maxStep >= 0.0) || !std::isfinite(*params.maxStep))) {
-            throw ParameterError("--max-step must be >= 0, got " + formatNumber(*params.maxStep));
-        }
         out.maxStep = params.maxStep ? *params.maxStep : kDefaultMaxStepOverSpacing * out.spacing;
     }
     bool calibratedForRelaxedSurface = false;
@@ -404,14 +447,8 @@ ResolvedParameters resolveParametersWith(const SurfaceParameters& params, const 
         }
     }
 
-    // (After the volume check, which names --spacing when that was given.) The kernel squares lengths in single precision: beyond this r_e² overflows to +inf and
-    // the mesh came out wrong or empty (a lattice scaled by 1e20 kept 2.6% of its volume).
-    constexpr double kMaxRadius = 1.0e18;
-    if (out.effectiveRadius > kMaxRadius) {
-        throw ParameterError("--radius " + formatNumber(out.effectiveRadius) + " is too large: at most " +
-                             formatNumber(kMaxRadius) + " (lengths are squared in single precision); give the "
-                             "positions in a larger unit");
-    }
+    // After the volume check, which names --spacing when that was given.
+    requireRadiusBelowMaximum(out.effectiveRadius);
 
     poll.throwIfStopped();
     return out;

@@ -259,11 +259,24 @@ TEST_F(CliTest, BadParameters)
     expectUsageError(base + "--iterations=-1", "--iterations must be >= 0, got -1");
     expectUsageError(base + "--adaptivity 1.5", "--adaptivity must lie in [0,1], got 1.5");
     expectUsageError(base + "--region-leaves -1", "--region-leaves must be >= 0, got -1");
-    expectUsageError(base + "--threads 0", "--threads must be >= 1, got 0");
+    expectUsageError(base + "--threads 0", "--threads must lie in [1, 4096], got 0");
+    expectUsageError(base + "--threads 100000000", "--threads must lie in [1, 4096], got 100000000");
     // An empty value was read as 0.
     expectUsageError(base + "--blend ''", "--blend needs a number, got ''");
     expectUsageError(base + "--adaptivity ''", "--adaptivity needs a number, got ''");
-    // Judged against the particles (their spacing) or each other: exit 1.
+    // Given lengths judged against each other or OpenVDB's limits: also before the input is
+    // read (these exited 1 after reading it).
+    expectUsageError(base + "--voxel-size 0.001 --radius 1",
+                     "--voxel-size 0.001 is too small for --radius 1: at most 32 voxels per radius");
+    expectUsageError(base + "--voxel-size 0.2 --radius 0.1",
+                     "--voxel-size 0.2 is too large for --radius 0.1: at least one voxel per radius");
+    expectUsageError(base + "--voxel-size 1e-6",
+                     "--voxel-size 1e-06 is below 1.5e-05, the smallest OpenVDB accepts: give the positions in a "
+                     "smaller unit");
+    expectUsageError(base + "--radius 2e18 --voxel-size 1e18",
+                     "--radius 2e+18 is too large: at most 1e+18 (lengths are squared in single precision); give the "
+                     "positions in a larger unit");
+    // Judged against the particles (their spacing, given or estimated): exit 1.
     // Refused before r_0 is calibrated over a kernel 1000 spacings wide (hours).
     expectFailure(base + "--spacing 0.05 --radius 50",
                   "--voxel-size 0.025 is too small for --radius 50: at most 32 voxels per radius");

@@ -186,6 +186,14 @@ struct ResolvedParameters
     bool thresholdReachesSurface = true;
 };
 
+/// Check what @a params fixes without looking at particles: each value's range, and where
+/// the lengths are given, the limits between them (r_e and h at least OpenVDB's smallest
+/// cell, r_e/h in [1, kMaxVoxelsPerRadius], r_e ≤ 1e18). resolveParameters() makes the same
+/// checks first; the command line calls this before reading a file, so a mistake costs
+/// nothing. Cost: O(1).
+/// @throw ParameterError naming the parameter, as resolveParameters().
+NONBLOPPY_API void checkParameters(const SurfaceParameters& params);
+
 /// Check @a params and fill in what is missing. @a positions is only read when the spacing
 /// must be estimated (spacing unset and effectiveRadius, threshold or voxelSize unset).
 /// @throw ParameterError naming the parameter, e.g. "--blend must lie in [0,1], got 1.5"
