@@ -474,21 +474,25 @@ TEST_F(CliTest, InspectMissingFile)
     EXPECT_EQ(r.err, "nonbloppy: cannot open " + missing + ": No such file or directory\n");
 }
 
-TEST_F(CliTest, SigintCancelsWithoutLeavingFiles)
+TEST_F(CliTest, SigintSigtermAndSighupCancelWithoutLeavingFiles)
 {
     // A run long enough to be caught mid-way: a fine grid on the dam-break frame. The
-    // progress line shows that the signal handlers are installed; interrupt then.
-    const RunResult r = interruptWhen(
-        {"mesh", kData + "/dam_break_frame_23_24389_particles.vtk", "-o", out("dam.obj"), "--vdb",
-         out("dam.vdb"), "--voxel-size", "0.005", "-v"},
-        [](const std::string& err) { return err.find("[progress] rasterize density") != std::string::npos; },
-        SIGINT);
-    ASSERT_EQ(r.killedBy, 0) << "killed by the signal instead of handling it";
-    EXPECT_EQ(r.exitCode, 130);
-    const std::vector<std::string> errLines = lines(r.err);
-    ASSERT_FALSE(errLines.empty());
-    EXPECT_EQ(errLines.back(), "nonbloppy: interrupted");
-    EXPECT_TRUE(listDir(dir() + "/out").empty()) << "output files left behind";
+    // progress line shows that the signal handlers are installed; interrupt then. SIGHUP
+    // (terminal or ssh session closed) used to end the run at once, exit 129.
+    for (const int signal : {SIGINT, SIGTERM, SIGHUP}) {
+        SCOPED_TRACE(signal);
+        const RunResult r = interruptWhen(
+            {"mesh", kData + "/dam_break_frame_23_24389_particles.vtk", "-o", out("dam.obj"), "--vdb",
+             out("dam.vdb"), "--voxel-size", "0.005", "-v"},
+            [](const std::string& err) { return err.find("[progress] rasterize density") != std::string::npos; },
+            signal);
+        ASSERT_EQ(r.killedBy, 0) << "killed by the signal instead of handling it";
+        EXPECT_EQ(r.exitCode, 130);
+        const std::vector<std::string> errLines = lines(r.err);
+        ASSERT_FALSE(errLines.empty());
+        EXPECT_EQ(errLines.back(), "nonbloppy: interrupted");
+        EXPECT_TRUE(listDir(dir() + "/out").empty()) << "output files left behind";
+    }
 }
 
 TEST_F(CliTest, VersionAndHelp)

@@ -317,6 +317,22 @@ TEST_F(CliSequenceTest, LogHasOneObjectPerFrameAndASummary)
     }
 }
 
+TEST_F(CliSequenceTest, AReaderOfStdoutThatGoesAwayDoesNotEndTheRun)
+{
+    // A reader that stops reading (here at once; "| head -1" alike) used to kill the run with
+    // SIGPIPE (exit 141): frames unmeshed, the log without its summary.
+    makeFrames({kFree, kFree, kFree});
+    const std::string log = out("run.jsonl");
+    const std::string command = "set -o pipefail; " + quote(kCli) + " mesh " + quote(in("fluid_{}.vtk")) + " -o " +
+                                quote(out("mesh_{}.obj")) + " --log " + quote(log) + " | true";
+    const int status = std::system(("bash -c " + quote(command)).c_str());
+    EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << status;
+    for (const char* mesh : {"mesh_0001.obj", "mesh_0002.obj", "mesh_0003.obj"}) EXPECT_TRUE(fs::exists(out(mesh))) << mesh;
+    const std::vector<std::string> logLines = lines(readText(log));
+    ASSERT_EQ(logLines.size(), 4u);
+    EXPECT_NE(logLines.back().find("\"frames_done\": 3"), std::string::npos) << logLines.back();
+}
+
 TEST_F(CliSequenceTest, InterruptedRunLeavesNoPartialFile)
 {
     // Frame 1 is quick; frame 2, the dam break on a fine grid, takes long enough to be caught.

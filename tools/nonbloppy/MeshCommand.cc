@@ -19,6 +19,7 @@
 #include <openvdb/util/NullInterrupter.h>
 #include <tbb/global_control.h>
 
+#include <array>
 #include <atomic>
 #include <cctype>
 #include <cerrno>
@@ -51,8 +52,8 @@ namespace fs = std::filesystem;
 // ---------------------------------------------------------------------------------------
 // Cancellation and progress
 
-/// Set by SIGINT/SIGTERM; the interrupter reports it to the library, which then throws
-/// CancelledError at its next check.
+/// Set by SIGINT, SIGTERM or SIGHUP; the interrupter reports it to the library, which then
+/// throws CancelledError at its next check.
 std::atomic<bool> gInterruptRequested{false};
 static_assert(std::atomic<bool>::is_always_lock_free, "the signal handler needs a lock-free flag");
 
@@ -65,27 +66,38 @@ extern "C" void onInterruptSignal(int signalNumber)
     }
 }
 
-/// Restores the previous SIGINT/SIGTERM handlers when the command ends.
+/// For the command's duration: SIGINT, SIGTERM and SIGHUP (a closed terminal or ssh session)
+/// stop the run cleanly, as an interrupt (exit 130, no partial files, the log's summary
+/// written); a SIGHUP that was ignored (nohup) stays ignored. SIGPIPE is ignored: a reader
+/// of stdout that went away ('| head -1') used to end the run silently with exit 141 and
+/// the log unfinished; now only the lost stdout lines are lost. The previous handlers are
+/// restored at the end.
 class SignalHandlerScope
 {
 public:
     SignalHandlerScope()
     {
         gInterruptRequested = false;
-        mOldInt = std::signal(SIGINT, onInterruptSignal);
-        mOldTerm = std::signal(SIGTERM, onInterruptSignal);
+        for (size_t n = 0; n < kStopSignals.size(); ++n) {
+            mOld[n] = std::signal(kStopSignals[n], onInterruptSignal);
+            if (kStopSignals[n] == SIGHUP && mOld[n] == SIG_IGN) std::signal(SIGHUP, SIG_IGN);
+        }
+        mOldPipe = std::signal(SIGPIPE, SIG_IGN);
     }
     ~SignalHandlerScope()
     {
-        std::signal(SIGINT, mOldInt == SIG_ERR ? SIG_DFL : mOldInt);
-        std::signal(SIGTERM, mOldTerm == SIG_ERR ? SIG_DFL : mOldTerm);
+        for (size_t n = 0; n < kStopSignals.size(); ++n) {
+            std::signal(kStopSignals[n], mOld[n] == SIG_ERR ? SIG_DFL : mOld[n]);
+        }
+        std::signal(SIGPIPE, mOldPipe == SIG_ERR ? SIG_DFL : mOldPipe);
     }
     SignalHandlerScope(const SignalHandlerScope&) = delete;
     SignalHandlerScope& operator=(const SignalHandlerScope&) = delete;
 
 private:
-    void (*mOldInt)(int) = SIG_DFL;
-    void (*mOldTerm)(int) = SIG_DFL;
+    static constexpr std::array<int, 3> kStopSignals{SIGINT, SIGTERM, SIGHUP};
+    std::array<void (*)(int), 3> mOld{SIG_DFL, SIG_DFL, SIG_DFL};
+    void (*mOldPipe)(int) = SIG_DFL;
 };
 
 /// The library's interrupter: says "stop" after SIGINT/SIGTERM and, with -v, prints each
