@@ -5,6 +5,7 @@
 ///        thread-count independence.
 
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include "CliTestUtil.h"
 
@@ -162,6 +163,24 @@ TEST_F(CliTest, InspectParticleFile)
     ASSERT_EQ(text.exitCode, 0) << text.err;
     EXPECT_NE(text.out.find("24389"), std::string::npos) << text.out;
     EXPECT_NE(text.out.find("velocity"), std::string::npos) << text.out;
+}
+
+TEST_F(CliTest, InspectJsonIsValidForNamesThatAreNotUtf8)
+{
+    // A Latin-1 file name ("café" with é as the byte 0xe9) was copied into the JSON as it was:
+    // strict parsers refuse it. Well-formed UTF-8 stays; each stray byte becomes U+FFFD.
+    const std::string latin1 = in("caf\xe9 \xff.vtk"), utf8 = in("caf\xc3\xa9 \xe5\x90\x8d.vtk");
+    fs::copy_file(kCube, latin1);
+    fs::copy_file(kCube, utf8);
+    for (const auto& [path, expected] : {std::pair<std::string, std::string>{latin1, in("caf\xef\xbf\xbd \xef\xbf\xbd.vtk")},
+                                         {utf8, utf8}}) {
+        const RunResult r = run("inspect --json " + quote(path));
+        ASSERT_EQ(r.exitCode, 0) << r.err;
+        nlohmann::json document;
+        ASSERT_NO_THROW(document = nlohmann::json::parse(r.out)) << r.out;
+        EXPECT_EQ(document["file"].get<std::string>(), expected);
+        EXPECT_EQ(document["particles"].get<int>(), 2366);
+    }
 }
 
 TEST_F(CliTest, VdbPrintReadsTheCache)

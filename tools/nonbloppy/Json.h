@@ -11,7 +11,8 @@
 namespace nonbloppy_tool {
 
 /// @a text as a JSON string literal, quotes included: `"` `\` and control characters
-/// escaped, other bytes (UTF-8) passed through.
+/// escaped, well-formed UTF-8 passed through, and each byte that is not part of it (a
+/// Latin-1 file name) written as U+FFFD, so that the result is valid JSON.
 std::string jsonString(const std::string& text);
 
 /// @a value as a JSON number in the fewest significant digits (at least 6) that read back
