@@ -2,8 +2,9 @@
 /// @file ReadTable.cc
 /// @brief Text particle tables: CSV/TXT with a header row, and JSON `[[x,y,z], ...]`.
 ///
-/// Table layout: lines starting with '#' and blank lines are skipped; the first other line
-/// names the columns, separated by ',' or ';' or tabs or spaces (the first of these found
+/// Table layout: a UTF-8 byte order mark is skipped, and so are lines starting with '#' and
+/// blank lines; the first other line names the columns, separated by ',' or ';' or tabs or
+/// spaces (the first of these found
 /// in the header is the separator), names optionally quoted. Positions are the columns
 /// x, y, z (any case), or ParaView's `Points:0..2`, or `<name>_x/_y/_z` with name
 /// position, pos or p. Every other column is an attribute; two or three consecutive columns
@@ -121,6 +122,11 @@ parseTable(StreamReader& in, const std::string& path)
     auto nextLine = [&](std::string_view& line) {
         while (in.line(line)) {
             ++lineNumber;
+            // Excel's "CSV UTF-8" starts with a byte order mark, which is no part of a name.
+            constexpr std::string_view kByteOrderMark = "\xef\xbb\xbf";
+            if (lineNumber == 1 && line.substr(0, kByteOrderMark.size()) == kByteOrderMark) {
+                line.remove_prefix(kByteOrderMark.size());
+            }
             const std::string_view content = trimmed(line);
             if (content.empty() || content[0] == '#') continue;
             return true;

@@ -441,6 +441,19 @@ TEST_F(ReadFormatsTest, CsvWithVectorAndScalarColumns)
     EXPECT_EQ(attribute(particles, "density").asDouble(0), 1000.5);
 }
 
+TEST_F(ReadFormatsTest, CsvWithAByteOrderMarkAsExcelWritesIt)
+{
+    // Excel's "CSV UTF-8" starts with EF BB BF: the header read '\xef\xbb\xbfx,y,z' and was
+    // refused for naming no column x.
+    for (const std::string& first : {std::string(""), std::string("# comment\n")}) {
+        const std::string file = write("bom.csv", "\xef\xbb\xbf" + first + "x,y,z,temp\n1,2,3,20.5\n");
+        const ParticleSet particles = readParticles(file);
+        ASSERT_EQ(particles.size(), 1u);
+        EXPECT_EQ(particles.positions[0], openvdb::Vec3f(1.0f, 2.0f, 3.0f));
+        EXPECT_EQ(attribute(particles, "temp").asDouble(0), 20.5);
+    }
+}
+
 TEST_F(ReadFormatsTest, CsvComponentSpellingsFormVectorsOnlyWhenTheyAreOne)
 {
     // speed_x alone is a scalar of that name (it was read as a 1-component "speed", so a
