@@ -113,6 +113,9 @@ TEST_F(CliFormatsTest, ConvertToXyzWarnsAndErrorsAreOneLine)
     const ParticleSet vtu = nonbloppy::readParticles(source);
     ASSERT_EQ(xyz.size(), 250u);
     for (size_t n = 0; n < 250; ++n) EXPECT_EQ(xyz.positions[n], vtu.positions[n]);
+    // Without -q the summary counts what was written (it said "with 4 attributes").
+    const RunResult loud = run("convert " + quote(source) + " " + quote(path("q.xyz")));
+    EXPECT_EQ(loud.out, "converted 250 particles with 0 attributes: " + source + " -> " + path("q.xyz") + "\n");
 
     RunResult bad = run("convert " + quote(source) + " " + quote(path("p.obj")));
     EXPECT_EQ(bad.exitCode, 2);

@@ -51,7 +51,8 @@ int runConvert(const ConvertOptions& o)
     }
 
     const nonbloppy::ParticleSet particles = nonbloppy::readParticles(o.input);
-    if (lowerExtensionOf(o.output) == ".xyz" && !particles.attributes.empty()) {
+    const bool positionsOnly = lowerExtensionOf(o.output) == ".xyz";
+    if (positionsOnly && !particles.attributes.empty()) {
         std::string names;
         for (const auto& a : particles.attributes) names += (names.empty() ? "" : ", ") + a.name;
         std::cerr << "nonbloppy: warning: .xyz holds positions only; attributes dropped: " << names
@@ -61,9 +62,10 @@ int runConvert(const ConvertOptions& o)
     settings.directIo = !o.noDirectIo;
     nonbloppy::writeParticles(particles, o.output, settings);
     if (!o.quiet) {
+        // As written: .xyz keeps none of them (the warning above names those dropped).
         std::cout << "converted " << particles.size() << " particles with "
-                  << particles.attributes.size() << " attributes: " << o.input << " -> " << o.output
-                  << std::endl;
+                  << (positionsOnly ? 0 : particles.attributes.size()) << " attributes: " << o.input << " -> "
+                  << o.output << std::endl;
     }
     return 0;
 }
