@@ -493,6 +493,28 @@ TEST_F(CliTest, InspectMissingFile)
     EXPECT_EQ(r.err, "nonbloppy: cannot open " + missing + ": No such file or directory\n");
 }
 
+TEST_F(CliTest, OnATerminalASingleFrameShowsItsStagesOnOneLine)
+{
+    // Long work shows progress: a single frame on a terminal was silent until its summary.
+    // util-linux's script(1) gives the run a terminal.
+    if (std::system("command -v script >/dev/null 2>&1") != 0) GTEST_SKIP() << "script(1) not installed";
+    const std::string transcript = dir() + "/terminal.txt";
+    const std::string command = "script -qec " + quote(quote(kCli) + " mesh " + quote(kCube) + " -o " + quote(out("cube.obj"))) +
+                                " /dev/null >" + quote(transcript) + " 2>&1";
+    ASSERT_EQ(std::system(command.c_str()), 0) << readText(transcript);
+    const std::string shown = readText(transcript);
+    for (const char* stage : {"\rread particles\033[K", "\rrasterize density", "\rextract surface", "\rwrite mesh"}) {
+        EXPECT_NE(shown.find(stage), std::string::npos) << stage;
+    }
+    // Erased before the summary, which starts on a clean line.
+    const size_t summary = shown.find("input");
+    ASSERT_NE(summary, std::string::npos) << shown;
+    EXPECT_EQ(shown.rfind("\r\033[K", summary), summary - 4) << shown;
+    // Not through a pipe or file, nor with -q: their output is unchanged.
+    const RunResult piped = run("mesh " + quote(kCube) + " -o " + quote(out("cube2.obj")));
+    EXPECT_EQ(piped.out.find('\r'), std::string::npos);
+}
+
 TEST_F(CliTest, SigintSigtermAndSighupCancelWithoutLeavingFiles)
 {
     // A run long enough to be caught mid-way: a fine grid on the dam-break frame. The

@@ -341,7 +341,7 @@ TEST_F(CliSequenceTest, InterruptedRunLeavesNoPartialFile)
     const RunResult r = interruptWhen(
         {"mesh", in("fluid_{}.vtk"), "-o", out("mesh_{}.obj"), "--vdb", out("d_{}.vdb"),
          "--voxel-size", "0.005", "-v", "--log", dir() + "/run.jsonl"},
-        [](const std::string& err) { return count(err, "[progress] rasterize density ...") >= 2; },
+        [](const std::string& err) { return count(err, "[progress] frame 2: rasterize density ...") >= 1; },
         SIGTERM);
     ASSERT_EQ(r.killedBy, 0) << "killed by the signal instead of handling it";
     EXPECT_EQ(r.exitCode, 130);
@@ -352,6 +352,27 @@ TEST_F(CliSequenceTest, InterruptedRunLeavesNoPartialFile)
     const std::string log = readText(dir() + "/run.jsonl");
     EXPECT_NE(log.find("\"interrupted\": true"), std::string::npos) << log;
     EXPECT_NE(log.find("\"frames_done\": 1, "), std::string::npos) << log;
+}
+
+TEST_F(CliSequenceTest, VerboseProgressLinesNameTheirFrameAndStayWhole)
+{
+    // With --frame-jobs 2 the frames' lines interleaved mid-line ("[progress] [progress]
+    // rasterize density 75%") and none named its frame.
+    makeFrames({kCube, kCube, kCube, kCube});
+    const RunResult r = run("mesh " + quote(in("fluid_{}.vtk")) + " -o " + quote(out("mesh_{}.obj")) +
+                            " -v --frame-jobs 2");
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    size_t progressLines = 0;
+    for (const std::string& line : lines(r.err)) {
+        if (line.rfind("[progress]", 0) != 0) continue;
+        ++progressLines;
+        EXPECT_EQ(count(line, "[progress]"), 1u) << line;
+        EXPECT_EQ(line.rfind("[progress] frame ", 0), 0u) << line;
+    }
+    EXPECT_GE(progressLines, 4u * 2u * 8u);  // a start and an end line per stage and frame
+    for (const char* frame : {"1", "2", "3", "4"}) {
+        EXPECT_EQ(count(r.err, std::string("[progress] frame ") + frame + ": read particles ..."), 1u) << frame;
+    }
 }
 
 TEST_F(CliSequenceTest, VerbosePrintsBytesPerParticle)

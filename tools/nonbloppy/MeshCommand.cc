@@ -19,6 +19,7 @@
 #include <openvdb/util/NullInterrupter.h>
 #include <tbb/global_control.h>
 
+#include <algorithm>
 #include <array>
 #include <atomic>
 #include <cctype>
@@ -100,13 +101,23 @@ private:
     void (*mOldPipe)(int) = SIG_DFL;
 };
 
-/// The library's interrupter: says "stop" after SIGINT/SIGTERM and, with -v, prints each
-/// stage's name, its progress in quarters and its duration on stderr.
-/// wasInterrupted() is called from worker threads, so printing is serialized.
+/// The library's interrupter: says "stop" after SIGINT/SIGTERM/SIGHUP and shows progress.
+/// - verbose (-v): each stage's name, its progress in quarters and its duration, one line
+///   each on stderr, "[progress] frame 12: rasterize density 25%" (@a frame: "frame 12: "
+///   in a sequence, whose frames may run side by side);
+/// - live: one line on stdout redrawn in place at most every 0.1 s ("rasterize density
+///   47%"), for a single frame on a terminal without -v or -q, so long work shows it is
+///   going; clearLine() (or the destructor) erases it before anything else is printed.
+/// wasInterrupted() is called from worker threads: every line is written whole, under one
+/// mutex shared by all interrupters; a live redraw never waits for it.
 class ProgressInterrupter : public openvdb::util::NullInterrupter
 {
 public:
-    explicit ProgressInterrupter(bool verbose) : mVerbose(verbose) {}
+    explicit ProgressInterrupter(bool verbose, bool live = false, std::string frame = "")
+        : mVerbose(verbose), mLive(live), mFrame(std::move(frame)) {}
+    ~ProgressInterrupter() override { clearLine(); }
+    ProgressInterrupter(const ProgressInterrupter&) = delete;
+    ProgressInterrupter& operator=(const ProgressInterrupter&) = delete;
 
     void start(const char* name = nullptr) override
     {
@@ -116,23 +127,24 @@ public:
         // they add to the peak of large frames (12.5M particles: 6.6 GiB -> 5.5 GiB).
         if (name && std::strcmp(name, "relax vertices") == 0) malloc_trim(0);
 #endif
-        std::lock_guard<std::mutex> lock(mMutex);
+        std::lock_guard<std::mutex> lock(outputMutex());
         mStages.push_back({name ? name : "working", std::chrono::steady_clock::now()});
         mNextQuarter = 1;
-        if (mVerbose) std::cerr << "[progress] " << mStages.back().name << " ..." << std::endl;
+        if (mVerbose) std::cerr << ("[progress] " + mFrame + mStages.back().name + " ...\n") << std::flush;
+        if (mLive) draw(-1);
     }
 
     void end() override
     {
-        std::lock_guard<std::mutex> lock(mMutex);
+        std::lock_guard<std::mutex> lock(outputMutex());
         if (mStages.empty()) return;
         if (mVerbose) {
             const std::chrono::duration<double> elapsed =
                 std::chrono::steady_clock::now() - mStages.back().start;
             char seconds[32];
             std::snprintf(seconds, sizeof(seconds), "%.3f", elapsed.count());
-            std::cerr << "[progress] " << mStages.back().name << " done (" << seconds << " s)"
-                      << std::endl;
+            std::cerr << ("[progress] " + mFrame + mStages.back().name + " done (" + seconds + " s)\n")
+                      << std::flush;
         }
         mStages.pop_back();
     }
@@ -140,23 +152,57 @@ public:
     bool wasInterrupted(int percent = -1) override
     {
         if (mVerbose && percent >= 0 && percent >= 25 * mNextQuarter.load() && percent < 100) {
-            std::lock_guard<std::mutex> lock(mMutex);
+            std::lock_guard<std::mutex> lock(outputMutex());
             const int quarter = percent / 25;
             if (quarter >= mNextQuarter && !mStages.empty()) {
                 mNextQuarter = quarter + 1;
-                std::cerr << "[progress] " << mStages.back().name << " " << 25 * quarter << "%"
-                          << std::endl;
+                std::cerr << ("[progress] " + mFrame + mStages.back().name + " " + std::to_string(25 * quarter) +
+                              "%\n")
+                          << std::flush;
             }
+        }
+        if (mLive && percent >= 0) {
+            const auto now = std::chrono::steady_clock::now();
+            std::unique_lock<std::mutex> lock(outputMutex(), std::try_to_lock);
+            if (lock.owns_lock() && now - mLastDraw >= std::chrono::milliseconds(100)) draw(percent);
         }
         return gInterruptRequested.load(std::memory_order_relaxed);
     }
 
+    /// Erase the live line, if one is shown.
+    void clearLine()
+    {
+        if (!mLive) return;
+        std::lock_guard<std::mutex> lock(outputMutex());
+        if (mDrawn) std::cout << "\r\033[K" << std::flush;
+        mDrawn = false;
+    }
+
 private:
+    static std::mutex& outputMutex()
+    {
+        static std::mutex mutex;
+        return mutex;
+    }
+
+    /// Redraw the live line (outputMutex() held): the current stage, and @a percent if >= 0.
+    void draw(int percent)
+    {
+        if (mStages.empty()) return;
+        std::string line = "\r" + mStages.back().name;
+        if (percent >= 0) line += " " + std::to_string(std::min(percent, 100)) + "%";
+        std::cout << line << "\033[K" << std::flush;
+        mDrawn = true;
+        mLastDraw = std::chrono::steady_clock::now();
+    }
+
     struct Stage { std::string name; std::chrono::steady_clock::time_point start; };
-    bool mVerbose;
-    std::mutex mMutex;
+    bool mVerbose, mLive;
+    std::string mFrame;
     std::vector<Stage> mStages;
     std::atomic<int> mNextQuarter{1};
+    bool mDrawn = false;
+    std::chrono::steady_clock::time_point mLastDraw{};
 };
 
 /// Runs the tool's own stages (reading, writing) under the same names in the interrupter
@@ -722,7 +768,7 @@ int runSequence(const MeshOptions& o)
     auto meshOne = [&](const BatchJob& job) {
         const MeshOptions f = optionsForFrame(o, job.frame);
         validatePaths(f);
-        ProgressInterrupter interrupter(o.verbose);
+        ProgressInterrupter interrupter(o.verbose, false, "frame " + std::to_string(job.frame.number) + ": ");
         std::unique_ptr<ResidentSampler> sampler;
         if (o.verbose) sampler = std::make_unique<ResidentSampler>();
         const FrameOutcome outcome = meshFrame(f, interrupter);
@@ -773,12 +819,14 @@ int runMesh(const MeshOptions& o)
         tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
 
     SignalHandlerScope signals;
-    ProgressInterrupter interrupter(o.verbose);
+    const bool live = !o.quiet && !o.verbose && ::isatty(STDOUT_FILENO) == 1;
+    ProgressInterrupter interrupter(o.verbose, live);
     std::unique_ptr<ResidentSampler> sampler;
     if (o.verbose) sampler = std::make_unique<ResidentSampler>();
 
     try {
         const FrameOutcome outcome = meshFrame(o, interrupter);
+        interrupter.clearLine();
         warnIfFacesEndInside(o, outcome.result.parameters);
         warnIfEmpty(outcome.result, o.output);
         if (sampler) {
