@@ -12,6 +12,7 @@
 #include <tbb/parallel_sort.h>
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <cmath>
 #include <limits>
@@ -328,9 +329,9 @@ void writeGroups(size_t count, const KeyAt& keyAt, const VertexAt& vertexAt, std
 }
 
 /// Sort vertex numbers by the group cell (edge @a groupSize) their position falls in and
-/// return the start of each run of equal cells (plus the end). Cells are packed into 64-bit
-/// keys relative to the smallest cell, so the sort compares integers, not coordinates through
-/// an index; ties keep vertex order, so grouping is deterministic. Every pass is parallel:
+/// return the start of each run of equal cells (plus the end). Cells are keyed relative to
+/// the smallest cell, so the sort compares integers, not coordinates through an index; ties
+/// keep vertex order, so grouping is deterministic. Every pass is parallel:
 /// on millions of vertices, serial passes left the second thread idle. When the cells of the
 /// vertices' box number fewer than 2^32 (always, but for scattered vertices), the key is the
 /// cell's rank in that box and the vertex number packed into 64 bits, sorted by a stable
@@ -360,39 +361,40 @@ void groupVerticesByCell(const std::vector<openvdb::Vec3s>& points, double group
         });
     poll.throwIfStopped();
     const openvdb::Coord lowest = bounds.first, highest = bounds.second;
-    constexpr int64_t kSpan = int64_t(1) << 21;
-    const openvdb::Coord extent = highest - lowest;
-    if (extent[0] >= kSpan || extent[1] >= kSpan || extent[2] >= kSpan) {
-        throw ParameterError("mesh vertices span more than 2^21 relaxation cells per axis; use a larger --radius");
-    }
-    const openvdb::Coord dims = extent + openvdb::Coord(1);
-    const uint64_t cellCount = uint64_t(dims[0]) * uint64_t(dims[1]) * uint64_t(dims[2]);
-    if (cellCount <= (uint64_t(1) << 32)) {
+    // Extents in 64 bits: a box of cells from -2^31 to 2^31 - 1 overflows a Coord.
+    const uint64_t dims[3] = {uint64_t(int64_t(highest[0]) - lowest[0] + 1), uint64_t(int64_t(highest[1]) - lowest[1] + 1),
+                              uint64_t(int64_t(highest[2]) - lowest[2] + 1)};
+    const double cellCount = double(dims[0]) * double(dims[1]) * double(dims[2]);
+    if (cellCount <= double(uint64_t(1) << 32)) {
         std::vector<uint64_t> packed(points.size()), spare;  // cell rank and vertex
         tbb::parallel_for(tbb::blocked_range<size_t>(0, points.size()), [&](const tbb::blocked_range<size_t>& r) {
             for (size_t i = r.begin(); i < r.end(); ++i) {
                 if (poll.stoppedAt(i - r.begin())) return;
                 const openvdb::Coord c = cellOf(points[i], groupSize) - lowest;
-                const uint64_t rank = (uint64_t(c[0]) * uint64_t(dims[1]) + uint64_t(c[1])) * uint64_t(dims[2])
-                                      + uint64_t(c[2]);
+                const uint64_t rank = (uint64_t(c[0]) * dims[1] + uint64_t(c[1])) * dims[2] + uint64_t(c[2]);
                 packed[i] = (rank << 32) | uint64_t(i);
             }
         });
         poll.throwIfStopped();
         int bits = 0;
-        while (bits < 32 && (uint64_t(1) << bits) < cellCount) ++bits;
+        while (bits < 32 && double(uint64_t(1) << bits) < cellCount) ++bits;
         radixSortHigh(packed, spare, 32, bits, poll);
         poll.throwIfStopped();
         writeGroups(packed.size(), [&](size_t n) { return packed[n] >> 32; },
                     [&](size_t n) { return uint32_t(packed[n]); }, order, groupStart, poll);
         return;
     }
-    std::vector<std::pair<uint64_t, uint32_t>> keyed(points.size());  // cell key and vertex
+    // Scattered vertices (a particle flung 10^5 r_e away from the rest): the cell's offsets
+    // from the lowest, 32 bits per axis, compared lexicographically. (A key of 21 bits per
+    // axis refused such frames after their density and surface were done.)
+    using CellKey = std::array<uint32_t, 3>;
+    std::vector<std::pair<CellKey, uint32_t>> keyed(points.size());  // cell key and vertex
     tbb::parallel_for(tbb::blocked_range<size_t>(0, points.size()), [&](const tbb::blocked_range<size_t>& r) {
         for (size_t i = r.begin(); i < r.end(); ++i) {
             if (poll.stoppedAt(i - r.begin())) return;
-            const openvdb::Coord c = cellOf(points[i], groupSize) - lowest;
-            const uint64_t key = (uint64_t(c[0]) << 42) | (uint64_t(c[1]) << 21) | uint64_t(c[2]);
+            const openvdb::Coord c = cellOf(points[i], groupSize);
+            const CellKey key = {uint32_t(int64_t(c[0]) - lowest[0]), uint32_t(int64_t(c[1]) - lowest[1]),
+                                 uint32_t(int64_t(c[2]) - lowest[2])};
             keyed[i] = {key, uint32_t(i)};
         }
     });

@@ -111,33 +111,39 @@ TEST(RelaxVertices, MovesTowardsTheWeightedMeanOfTwoParticles)
 
 TEST(RelaxVertices, PiecesFarApartRelaxAsEachWouldAlone)
 {
-    // Two one-particle spheres 3000 apart on every axis: their vertices' box holds 2000^3 =
-    // 8e9 groups of 3 index cells (1.5), more than the 2^32 the radix sort's keys can rank,
-    // so the vertices are grouped by the comparison sort. Each vertex sees only its own
-    // particle either way: the joint result is each piece's own, bit for bit.
-    const openvdb::Vec3f farCentre = kCentre + openvdb::Vec3f(3000.0f);
-    DensitySettings density;
-    density.effectiveRadius = 1.0;
-    density.voxelSize = 0.05;
-    const auto sphereAt = [&](const openvdb::Vec3f& centre) {
-        return extractSurface(*rasterizeDensity(ParticleIndex::build({centre}, 0.5), density), 1.0);
-    };
-    SurfaceMesh near = sphereAt(kCentre), far = sphereAt(farCentre);
-    SurfaceMesh both;
-    both.points = near.points;
-    both.points.insert(both.points.end(), far.points.begin(), far.points.end());
-    ASSERT_GT(near.points.size(), 100u);
+    // Two one-particle spheres far apart: 3000 on every axis puts 2000^3 = 8e9 groups of 3
+    // index cells (1.5) in their box, more than the 2^32 the radix sort's keys can rank, so
+    // the vertices are grouped by the comparison sort; 4e6 on x puts 2.7e6 groups between
+    // them, more than the 2^21 per axis its keys once held (such a frame, a particle flung
+    // far away, was refused after its density and surface were done). Each vertex sees only
+    // its own particle either way: the joint result is each piece's own, bit for bit.
+    for (const openvdb::Vec3f& offset : {openvdb::Vec3f(3000.0f), openvdb::Vec3f(4.0e6f, 0.0f, 0.0f)}) {
+        SCOPED_TRACE(offset);
+        const openvdb::Vec3f farCentre = kCentre + offset;
+        DensitySettings density;
+        density.effectiveRadius = 1.0;
+        density.voxelSize = 0.05;
+        const auto sphereAt = [&](const openvdb::Vec3f& centre) {
+            return extractSurface(*rasterizeDensity(ParticleIndex::build({centre}, 0.5), density), 1.0);
+        };
+        SurfaceMesh near = sphereAt(kCentre), far = sphereAt(farCentre);
+        SurfaceMesh both;
+        both.points = near.points;
+        both.points.insert(both.points.end(), far.points.begin(), far.points.end());
+        ASSERT_GT(near.points.size(), 100u);
+        ASSERT_GT(far.points.size(), 0u);
 
-    const RelaxSettings settings = relaxSettings(0.3, 2);
-    relaxVertices(both, ParticleIndex::build({kCentre, farCentre}, 0.5), settings);
-    relaxVertices(near, ParticleIndex::build({kCentre}, 0.5), settings);
-    relaxVertices(far, ParticleIndex::build({farCentre}, 0.5), settings);
-    for (size_t i = 0; i < near.points.size(); ++i) ASSERT_EQ(both.points[i], near.points[i]) << i;
-    for (size_t i = 0; i < far.points.size(); ++i) {
-        ASSERT_EQ(both.points[near.points.size() + i], far.points[i]) << i;
+        const RelaxSettings settings = relaxSettings(0.3, 2);
+        relaxVertices(both, ParticleIndex::build({kCentre, farCentre}, 0.5), settings);
+        relaxVertices(near, ParticleIndex::build({kCentre}, 0.5), settings);
+        relaxVertices(far, ParticleIndex::build({farCentre}, 0.5), settings);
+        for (size_t i = 0; i < near.points.size(); ++i) ASSERT_EQ(both.points[i], near.points[i]) << i;
+        for (size_t i = 0; i < far.points.size(); ++i) {
+            ASSERT_EQ(both.points[near.points.size() + i], far.points[i]) << i;
+        }
+        // And they did move: by 1 − 0.7² of their distance to the particle.
+        EXPECT_NEAR((near.points[0] - kCentre).length(), 0.49 * 0.5, 0.01);
     }
-    // And they did move: by 1 − 0.7² of their distance to the particle.
-    EXPECT_NEAR((near.points[0] - kCentre).length(), 0.49 * 0.5, 0.01);
 }
 
 TEST(RelaxVertices, VerticesThatTravelFarMatchTheDirectSum)
