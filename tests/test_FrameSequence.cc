@@ -143,6 +143,14 @@ TEST(FrameListTest, FormatFoldsRuns)
     EXPECT_EQ(formatFrameList({4}), "4");
     EXPECT_EQ(formatFrameList({}), "");
     EXPECT_EQ(formatFrameList({9, 8, 8}), "8-9");
+    // Stepped runs fold too: '--frames 1-2000:2' with three files on disk listed its 997
+    // missing frames one by one (at '1-2000000000:1000', a 22 MB line).
+    EXPECT_EQ(formatFrameList({7, 9, 11, 13, 20, 21, 30, 32}), "7-13:2, 20-21, 30, 32");
+    EXPECT_EQ(formatFrameList({5, 7}), "5, 7");
+    std::vector<int> stepped;
+    for (int f = 1007; f <= 1999001007; f += 1000) stepped.push_back(f);
+    EXPECT_EQ(formatFrameList(stepped), "1007-1999001007:1000");
+    EXPECT_EQ(parseFrameList(formatFrameList(stepped)), stepped);
 }
 
 class FindFramesTest : public ::testing::Test

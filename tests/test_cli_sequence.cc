@@ -172,6 +172,12 @@ TEST_F(CliSequenceTest, FramesSelectsAndListsMissingOnce)
     EXPECT_NE(r.out.find("4 frames: 2 done, 0 failed, 0 skipped, 2 missing"), std::string::npos)
         << r.out;
 
+    // -q: the notice (not an error) is left to the summary and the log.
+    const RunResult quiet = run("mesh " + quote(in("fluid_{}.vtk")) + " -o " + quote(out("q_{}.obj")) +
+                                " --frames 1-7:2 -q");
+    EXPECT_EQ(quiet.exitCode, 0);
+    EXPECT_EQ(quiet.err, "");
+
     const RunResult none = run("mesh " + quote(in("fluid_{}.vtk")) + " -o " + quote(out("m_{}.obj"))
                                + " --frames 20-21");
     EXPECT_EQ(none.exitCode, 1);

@@ -359,7 +359,8 @@ int runBatch(const std::vector<BatchJob>& jobs, const BatchSettings& settings,
              const std::function<bool()>& interrupted)
 {
     BatchState state(jobs, settings);
-    if (!settings.missing.empty()) {
+    // A notice, not an error: -q leaves it to the summary's count and the log's "missing".
+    if (!settings.missing.empty() && !settings.quiet) {
         std::cerr << "nonbloppy: " << settings.missing.size() << " missing frame"
                   << (settings.missing.size() == 1 ? "" : "s") << " skipped: "
                   << formatFrameList(settings.missing) << " (" << settings.inputPattern << ")"

@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <cctype>
 #include <climits>
+#include <cstdint>
 #include <cstdio>
 #include <filesystem>
 #include <map>
@@ -230,11 +231,21 @@ std::string formatFrameList(std::vector<int> frames)
     frames.erase(std::unique(frames.begin(), frames.end()), frames.end());
     std::string out;
     for (size_t i = 0; i < frames.size();) {
+        // The longest run from frames[i] with one step: consecutive frames fold from two on
+        // ("4-5"), stepped ones from three ("7-11:2"; "5, 7" reads better than "5-7:2").
         size_t j = i;
-        while (j + 1 < frames.size() && frames[j + 1] == frames[j] + 1) ++j;
+        if (i + 1 < frames.size()) {
+            const int64_t step = int64_t(frames[i + 1]) - frames[i];
+            while (j + 1 < frames.size() && int64_t(frames[j + 1]) - frames[j] == step) ++j;
+            if (step > 1 && j < i + 2) j = i;
+        }
         if (!out.empty()) out += ", ";
         out += std::to_string(frames[i]);
-        if (j > i) out += "-" + std::to_string(frames[j]);
+        if (j > i) {
+            out += "-" + std::to_string(frames[j]);
+            const int64_t step = int64_t(frames[i + 1]) - frames[i];
+            if (step > 1) out += ":" + std::to_string(step);
+        }
         i = j + 1;
     }
     return out;

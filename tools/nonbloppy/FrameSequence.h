@@ -81,7 +81,8 @@ FramePattern parseFramePattern(const std::string& text, const std::string& what)
 /// @throw nonbloppy::ParameterError
 std::vector<int> parseFrameList(const std::string& text, const std::string& what = "--frames");
 
-/// "1-3, 5, 7-9": increasing @a frames with consecutive runs folded.
+/// "1-3, 5, 7-9, 20-2000:10": increasing @a frames with runs of one step folded, as
+/// parseFrameList() reads them (consecutive frames from two, stepped ones from three).
 std::string formatFrameList(std::vector<int> frames);
 
 /// Every frame of @a input on disk, in increasing order (the placeholder must be in the file
