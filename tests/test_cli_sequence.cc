@@ -274,6 +274,24 @@ TEST_F(CliSequenceTest, KeepGoingListsFailedFrames)
     EXPECT_NE(log.find("\"failed\": [2]"), std::string::npos) << log;
 }
 
+TEST_F(CliSequenceTest, EveryCountIsOfTheFramesAskedFor)
+{
+    // stdout said "5 frames", the failure "2 of 3 frames failed" and the log "frames": 3.
+    makeCorruptFrame(1);
+    makeCorruptFrame(2);
+    makeFrames({kFree}, 4);
+    const std::string log = out("run.jsonl");
+    const RunResult r = run("mesh " + quote(in("fluid_{}.vtk")) + " -o " + quote(out("m_{}.obj")) +
+                            " --keep-going --frames 1-5 --log " + quote(log));
+    EXPECT_EQ(r.exitCode, 1);
+    EXPECT_NE(r.out.find("5 frames: 1 done, 2 failed, 0 skipped, 2 missing in "), std::string::npos) << r.out;
+    EXPECT_EQ(lines(r.err).back(), "nonbloppy: 2 of 5 frames failed: 1-2");
+    const std::string summary = lines(readText(log)).back();
+    EXPECT_NE(summary.find("\"frames\": 5, \"frames_done\": 1, \"frames_failed\": 2, \"frames_skipped\": 0, "
+                           "\"frames_missing\": 2, \"frames_interrupted\": 0, \"frames_not_run\": 0"),
+              std::string::npos) << summary;
+}
+
 TEST_F(CliSequenceTest, SplitRangesGiveTheSameFiles)
 {
     makeFrames({kFree, kCube, kFree, kFree});
@@ -358,6 +376,12 @@ TEST_F(CliSequenceTest, InterruptedRunLeavesNoPartialFile)
     const std::string log = readText(dir() + "/run.jsonl");
     EXPECT_NE(log.find("\"interrupted\": true"), std::string::npos) << log;
     EXPECT_NE(log.find("\"frames_done\": 1, "), std::string::npos) << log;
+    // Frame 2, cut short, is logged and counted as interrupted; frame 3 was never started. Its
+    // stage is reported stopped, not done.
+    EXPECT_NE(log.find("{\"frame\": 2, \"status\": \"interrupted\""), std::string::npos) << log;
+    EXPECT_NE(log.find("\"frames_interrupted\": 1, \"frames_not_run\": 1, "), std::string::npos) << log;
+    EXPECT_NE(r.err.find("[progress] frame 2: rasterize density stopped ("), std::string::npos) << r.err;
+    EXPECT_EQ(r.err.find("[progress] frame 2: rasterize density done"), std::string::npos) << r.err;
 }
 
 TEST_F(CliSequenceTest, VerboseProgressLinesNameTheirFrameAndStayWhole)

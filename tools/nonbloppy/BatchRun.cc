@@ -156,10 +156,15 @@ public:
         if (mBarShown || mFinished == 0) drawBar();
     }
 
+    /// A frame a stop cut short (its partial outputs are removed): logged, and counted apart
+    /// from the frames the stop left unstarted.
     void interrupted(size_t index)
     {
         std::lock_guard<std::mutex> lock(mMutex);
         mStatus[index] = Status::Interrupted;
+        const BatchJob& job = mJobs[index];
+        logLine("{\"frame\": " + std::to_string(job.frame.number) + ", \"status\": \"interrupted\", "
+                "\"input\": " + jsonString(job.frame.input) + ", \"output\": " + jsonString(job.outputs.front()) + "}");
     }
 
     /// The summary (stdout and log); then the exit code, or the error to throw.
@@ -167,18 +172,22 @@ public:
     {
         std::lock_guard<std::mutex> lock(mMutex);
         clearBar();
-        std::vector<int> doneFrames, failedFrames, skippedFrames, notRun;
+        std::vector<int> doneFrames, failedFrames, skippedFrames, cutShort, notRun;
         for (size_t i = 0; i < mJobs.size(); ++i) {
             const int number = mJobs[i].frame.number;
             switch (mStatus[i]) {
             case Status::Done: doneFrames.push_back(number); break;
             case Status::Failed: failedFrames.push_back(number); break;
             case Status::Skipped: skippedFrames.push_back(number); break;
+            case Status::Interrupted: cutShort.push_back(number); break;
             default: notRun.push_back(number); break;
             }
         }
         // A signal after the last frame finished interrupted nothing.
-        wasInterrupted = wasInterrupted && !notRun.empty();
+        wasInterrupted = wasInterrupted && (!notRun.empty() || !cutShort.empty());
+        // Every count is of the frames asked for: those found plus those missing (the stdout
+        // summary, the log's "frames" and the failure line once counted differently).
+        const size_t requested = mJobs.size() + mSettings.missing.size();
         const double total = secondsSince(mStart);
         const double rate = total > 0 ? double(mParticles) / total : 0.0;
 
@@ -189,11 +198,12 @@ public:
         };
         logLine("{\"summary\": true, \"input\": " + jsonString(mSettings.inputPattern)
                 + ", \"output\": " + jsonString(mSettings.outputPattern)
-                + ", \"frames\": " + std::to_string(mJobs.size())
+                + ", \"frames\": " + std::to_string(requested)
                 + ", \"frames_done\": " + std::to_string(doneFrames.size())
                 + ", \"frames_failed\": " + std::to_string(failedFrames.size())
                 + ", \"frames_skipped\": " + std::to_string(skippedFrames.size())
                 + ", \"frames_missing\": " + std::to_string(mSettings.missing.size())
+                + ", \"frames_interrupted\": " + std::to_string(cutShort.size())
                 + ", \"frames_not_run\": " + std::to_string(notRun.size())
                 + ", \"failed\": " + list(failedFrames) + ", \"missing\": " + list(mSettings.missing)
                 + ", \"interrupted\": " + (wasInterrupted ? "true" : "false")
@@ -211,13 +221,14 @@ public:
 
         if (!mSettings.quiet) {
             // Frames a stop left unstarted are counted too, so that the parts add up.
-            const std::string notRunPart =
-                notRun.empty() ? std::string() : ", " + std::to_string(notRun.size()) + " not run";
+            std::string notRunPart;
+            if (!cutShort.empty()) notRunPart += ", " + std::to_string(cutShort.size()) + " interrupted";
+            if (!notRun.empty()) notRunPart += ", " + std::to_string(notRun.size()) + " not run";
             char line[256];
             std::snprintf(line, sizeof(line),
                           "%zu frames: %zu done, %zu failed, %zu skipped, %zu missing%s in %.2f s "
                           "(%s particles/s)",
-                          mJobs.size() + mSettings.missing.size(), doneFrames.size(),
+                          requested, doneFrames.size(),
                           failedFrames.size(), skippedFrames.size(), mSettings.missing.size(),
                           notRunPart.c_str(), total, formatCount(uint64_t(rate)).c_str());
             std::cout << line << std::endl;
@@ -227,13 +238,13 @@ public:
             std::cerr << "nonbloppy: interrupted; "
                       << (doneFrames.empty() ? std::string("no frame finished")
                                              : "finished frames: " + formatFrameList(doneFrames))
-                      << " (" << doneFrames.size() << " of " << mJobs.size() << ")" << std::endl;
+                      << " (" << doneFrames.size() << " of " << requested << ")" << std::endl;
             return kExitInterrupted;
         }
         if (!failedFrames.empty()) {
             if (!mSettings.keepGoing) throw nonbloppy::Error(mFirstError);
             throw nonbloppy::Error(std::to_string(failedFrames.size()) + " of "
-                                   + std::to_string(mJobs.size()) + " frames failed: "
+                                   + std::to_string(requested) + " frames failed: "
                                    + formatFrameList(failedFrames));
         }
         return 0;

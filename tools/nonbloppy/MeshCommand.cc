@@ -143,8 +143,9 @@ public:
                 std::chrono::steady_clock::now() - mStages.back().start;
             char seconds[32];
             std::snprintf(seconds, sizeof(seconds), "%.3f", elapsed.count());
-            std::cerr << ("[progress] " + mFrame + mStages.back().name + " done (" + seconds + " s)\n")
-                      << std::flush;
+            // A stage a signal cut short ends too (its scope unwinds): not "done".
+            const char* how = gInterruptRequested.load() ? " stopped (" : " done (";
+            std::cerr << ("[progress] " + mFrame + mStages.back().name + how + seconds + " s)\n") << std::flush;
         }
         mStages.pop_back();
     }
