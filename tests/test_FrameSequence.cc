@@ -203,13 +203,19 @@ TEST_F(FindFramesTest, FindsFramesInOrderAndPlansMissingOnes)
     EXPECT_EQ(some.missing, (std::vector<int>{1, 4}));
 }
 
-TEST_F(FindFramesTest, TwoNamesForOneFrameIsAnError)
+TEST_F(FindFramesTest, TwoNamesForOneFrameIsAnErrorWhenThatFrameIsPlanned)
 {
     touch("f_1.vtk");
     touch("f_01.vtk");
+    touch("f_2.vtk");
     const FramePattern braces = parseFramePattern(mDir + "/f_{}.vtk", "IN");
-    EXPECT_EQ(errorOf([&] { nonbloppy_tool::findFrames(braces); }),
-              mDir + "/f_01.vtk and " + mDir + "/f_1.vtk are both frame 1");
+    const std::string message = mDir + "/f_01.vtk and " + mDir + "/f_1.vtk are both frame 1";
+    EXPECT_EQ(errorOf([&] { nonbloppy_tool::planFrames(braces, std::nullopt); }), message);
+    EXPECT_EQ(errorOf([&] { nonbloppy_tool::planFrames(braces, parseFrameList("1-2")); }), message);
+    // A leftover file of frame 1 used to stop '--frames 2' as well: every farm task failed.
+    const nonbloppy_tool::FramePlan two = nonbloppy_tool::planFrames(braces, parseFrameList("2"));
+    ASSERT_EQ(two.frames.size(), 1u);
+    EXPECT_EQ(two.frames[0].input, mDir + "/f_2.vtk");
 }
 
 TEST_F(FindFramesTest, PlaceholderInDirectoryIsAnError)

@@ -277,10 +277,11 @@ std::vector<Frame> findFrames(const FramePattern& input)
         frame.input = (dir.empty() ? fs::path(name) : fs::path(dir) / name).string();
         const auto [at, inserted] = byNumber.emplace(frame.number, frame);
         if (!inserted) {
+            // Directory order is arbitrary: keep the names sorted, so the message is stable.
             std::string a = at->second.input, b = frame.input;
             if (b < a) std::swap(a, b);
-            throw nonbloppy::FileError(a + " and " + b + " are both frame "
-                                       + std::to_string(frame.number));
+            at->second.input = a;
+            if (at->second.otherInput.empty() || b < at->second.otherInput) at->second.otherInput = b;
         }
     }
     std::vector<Frame> frames;
@@ -295,14 +296,20 @@ FramePlan planFrames(const FramePattern& input, const std::optional<std::vector<
     std::vector<Frame> found = findFrames(input);
     if (!requested) {
         plan.frames = std::move(found);
-        return plan;
+    } else {
+        std::map<int, Frame> byNumber;
+        for (Frame& f : found) byNumber.emplace(f.number, std::move(f));
+        for (int number : *requested) {
+            auto it = byNumber.find(number);
+            if (it == byNumber.end()) plan.missing.push_back(number);
+            else plan.frames.push_back(it->second);
+        }
     }
-    std::map<int, Frame> byNumber;
-    for (Frame& f : found) byNumber.emplace(f.number, std::move(f));
-    for (int number : *requested) {
-        auto it = byNumber.find(number);
-        if (it == byNumber.end()) plan.missing.push_back(number);
-        else plan.frames.push_back(it->second);
+    for (const Frame& frame : plan.frames) {
+        if (!frame.otherInput.empty()) {
+            throw nonbloppy::FileError(frame.input + " and " + frame.otherInput + " are both frame " +
+                                       std::to_string(frame.number));
+        }
     }
     return plan;
 }

@@ -33,6 +33,9 @@ struct Frame
     int number = 0;
     std::string digits;   ///< the number as the input file name spells it ("0012")
     std::string input;    ///< the input file's path
+    /// Another file that names the same frame ("fluid_01.vtk" beside "fluid_1.vtk"), or empty;
+    /// planFrames() refuses such a frame only when the run asks for it.
+    std::string otherInput;
 };
 
 /// A file name with at most one frame-number placeholder.
@@ -87,8 +90,8 @@ std::string formatFrameList(std::vector<int> frames);
 
 /// Every frame of @a input on disk, in increasing order (the placeholder must be in the file
 /// name, not in a directory).
-/// @throw nonbloppy::FileError if the directory cannot be read or two files give the same
-///        number ("fluid_1.vtk and fluid_01.vtk are both frame 1"),
+/// Two files that give the same number are both kept (Frame::otherInput).
+/// @throw nonbloppy::FileError if the directory cannot be read,
 ///        nonbloppy::ParameterError if the placeholder is in a directory name.
 std::vector<Frame> findFrames(const FramePattern& input);
 
@@ -101,6 +104,9 @@ struct FramePlan
 
 /// Every frame found when @a requested is empty, else the requested ones that exist
 /// (the rest in missing).
+/// @throw nonbloppy::FileError if two files give the number of a planned frame
+///        ("fluid_01.vtk and fluid_1.vtk are both frame 1"): a leftover file of frame 1
+///        does not stop a run of --frames 2.
 FramePlan planFrames(const FramePattern& input, const std::optional<std::vector<int>>& requested);
 
 } // namespace nonbloppy_tool

@@ -695,7 +695,10 @@ void requireOutputsApart(const std::vector<Frame>& sequence, const std::vector<B
                          const std::string& logPath)
 {
     std::map<std::string, int> inputs;
-    for (const Frame& frame : sequence) inputs.emplace(fileIdentity(frame.input), frame.number);
+    for (const Frame& frame : sequence) {
+        inputs.emplace(fileIdentity(frame.input), frame.number);
+        if (!frame.otherInput.empty()) inputs.emplace(fileIdentity(frame.otherInput), frame.number);
+    }
     const std::string log = logPath.empty() ? std::string() : fileIdentity(logPath);
     if (!log.empty()) {
         if (const auto input = inputs.find(log); input != inputs.end()) {
