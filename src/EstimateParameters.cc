@@ -336,7 +336,10 @@ void requireRadiusBelowMaximum(double effectiveRadius)
 void checkParameters(const SurfaceParameters& params)
 {
     auto requirePositive = [](const std::optional<double>& value, const char* name) {
-        if (value && (!(*value > 0.0) || !std::isfinite(*value))) {
+        if (value && !std::isfinite(*value)) {
+            throw ParameterError(std::string(name) + " must be finite, got " + formatNumber(*value));
+        }
+        if (value && !(*value > 0.0)) {
             throw ParameterError(std::string(name) + " must be > 0, got " + formatNumber(*value));
         }
     };

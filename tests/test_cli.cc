@@ -272,6 +272,8 @@ TEST_F(CliTest, BadParameters)
     expectUsageError(base + "--radius 0", "--radius must be > 0, got 0");
     expectUsageError(base + "--radius=-1", "--radius must be > 0, got -1");
     expectUsageError(base + "--voxel-size 0", "--voxel-size must be > 0, got 0");
+    expectUsageError(base + "--voxel-size inf", "--voxel-size must be finite, got inf");
+    expectUsageError(base + "--radius nan", "--radius must be finite, got nan");
     expectUsageError(base + "--blend 1.5", "--blend must lie in [0,1], got 1.5");
     expectUsageError(base + "--blend=-0.1", "--blend must lie in [0,1], got -0.1");
     expectUsageError(base + "-c 2", "--blend must lie in [0,1], got 2");

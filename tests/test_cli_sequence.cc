@@ -120,6 +120,8 @@ TEST_F(CliSequenceTest, LogNamingAnInputFrameOrAnOutputIsRefusedBeforeAnyWork)
     const std::string frame2 = in("fluid_0002.vtk");
     const std::string before = readText(frame2);
     // Written first, the log would have replaced frame 2 with JSON.
+    expectUsageError("mesh " + quote(in("fluid_{}.vtk")) + " -o " + quote(out("mesh_{}.obj")) + " --log ''",
+                     "--log needs a file name, got ''");
     expectUsageError("mesh " + quote(in("fluid_{}.vtk")) + " -o " + quote(out("mesh_{}.obj")) + " --log "
                       + quote(frame2),
                   "cannot write " + frame2 + ": --log names the input of frame 2");

@@ -728,6 +728,7 @@ int runSequence(const MeshOptions& o)
         throw UsageError("--frame-jobs must be >= 1, got "
                                         + std::to_string(o.frameJobs));
     }
+    if (o.logOpt->count() > 0 && o.logPath.empty()) throw UsageError("--log needs a file name, got ''");
     const FramePattern input = parseFramePattern(o.input, "IN");
     requirePlaceholder(o.output, "--output", o);
     if (!o.vdbPath.empty()) requirePlaceholder(o.vdbPath, "--vdb", o);
