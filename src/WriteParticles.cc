@@ -6,6 +6,7 @@
 
 #include <nonbloppy/Error.h>
 #include <nonbloppy/ParticleIndex.h>
+#include <nonbloppy/Version.h>
 #include <nonbloppy/WriteVdb.h>
 
 #include "AtomicFile.h"
@@ -526,7 +527,7 @@ writeParticles(const ParticleSet& particles, const std::string& path, const Part
     requireSizes(particles, path);
     if (ext == ".vdb") {
         openvdb::MetaMap metadata;
-        metadata.insertMeta("creator", openvdb::StringMetadata("nonbloppy"));
+        metadata.insertMeta("creator", openvdb::StringMetadata(std::string("nonbloppy ") + version()));
         writeVdb({makePointDataGrid(particles)}, path, metadata);
         return;
     }

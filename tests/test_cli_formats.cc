@@ -6,6 +6,7 @@
 #include <nonbloppy/Error.h>
 #include <nonbloppy/ReadMesh.h>
 #include <nonbloppy/ReadParticles.h>
+#include <nonbloppy/Version.h>
 #include <nonbloppy/WriteParticles.h>
 
 #include <openvdb/openvdb.h>
@@ -325,6 +326,25 @@ TEST_F(CliFormatsTest, RenamedAttributesStayDistinctAndReadBack)
             }
         }
     }
+}
+
+TEST_F(CliFormatsTest, InspectOfAPointsVdbCountsItsPointsAndNamesItsAttributes)
+{
+    // It showed voxels and leaves only; and convert's creator named no version.
+    const std::string vdb = path("f.vdb");
+    ASSERT_EQ(run("convert -q " + quote(kData + "/fluid_250_particles.vtu") + " " + quote(vdb)).exitCode, 0);
+    const RunResult text = run("inspect " + quote(vdb));
+    ASSERT_EQ(text.exitCode, 0) << text.err;
+    EXPECT_NE(text.out.find("  creator: nonbloppy " + std::string(nonbloppy::version()) + "\n"), std::string::npos)
+        << text.out;
+    EXPECT_NE(text.out.find("\n    points: 250; attributes: P vec3s, velocity vec3d, pressure double, density double, "
+                            "index int64\n"),
+              std::string::npos)
+        << text.out;
+    const RunResult json = run("inspect --json " + quote(vdb));
+    ASSERT_EQ(json.exitCode, 0) << json.err;
+    EXPECT_NE(json.out.find("\"points\": 250,"), std::string::npos) << json.out;
+    EXPECT_NE(json.out.find("\"name\": \"velocity\",\n          \"type\": \"vec3d\""), std::string::npos) << json.out;
 }
 
 TEST_F(CliFormatsTest, WideIntegersSurviveAVdbOrAreRefused)

@@ -16,6 +16,8 @@
 #include <nonbloppy/ReadVdb.h>
 
 #include <openvdb/openvdb.h>
+#include <openvdb/points/PointCount.h>
+#include <openvdb/points/PointDataGrid.h>
 #include <openvdb/tools/Count.h>
 
 #include <algorithm>
@@ -336,6 +338,31 @@ void printMetadata(const openvdb::MetaMap& metadata, const char* indent)
     }
 }
 
+/// What a PointDataGrid holds: its points and their attributes (name and value type, in
+/// the order they are stored), as vdb_print -l shows them.
+struct PointsSummary
+{
+    uint64_t points = 0;
+    std::vector<std::pair<std::string, std::string>> attributes;
+};
+
+std::optional<PointsSummary> pointsSummary(const openvdb::GridBase& grid)
+{
+    const auto* points = dynamic_cast<const openvdb::points::PointDataGrid*>(&grid);
+    if (!points) return std::nullopt;
+    PointsSummary summary;
+    summary.points = openvdb::points::pointCount(points->tree());
+    // Every leaf shares one descriptor.
+    if (const auto leaf = points->tree().cbeginLeaf()) {
+        const openvdb::points::AttributeSet::Descriptor& descriptor = leaf->attributeSet().descriptor();
+        std::vector<std::pair<size_t, std::string>> byIndex;
+        for (const auto& [name, index] : descriptor.map()) byIndex.emplace_back(index, name);
+        std::sort(byIndex.begin(), byIndex.end());
+        for (const auto& [index, name] : byIndex) summary.attributes.emplace_back(name, descriptor.type(index).first);
+    }
+    return summary;
+}
+
 int inspectVdb(const std::string& path, bool json)
 {
     const nonbloppy::VdbFileContents contents = nonbloppy::readVdbFile(path);
@@ -378,6 +405,17 @@ int inspectVdb(const std::string& path, bool json)
                 w.raw("min", "null");
                 w.raw("max", "null");
             }
+            if (const auto points = pointsSummary(*grid)) {
+                w.integer("points", static_cast<long long>(points->points));
+                w.beginArray("attributes");
+                for (const auto& [name, type] : points->attributes) {
+                    w.beginObject();
+                    w.string("name", name);
+                    w.string("type", type);
+                    w.endObject();
+                }
+                w.endArray();
+            }
             writeMetadataJson(w, "metadata", *grid);
             w.endObject();
         }
@@ -418,6 +456,15 @@ int inspectVdb(const std::string& path, bool json)
                  << formatNumber(range->second) << "]";
         }
         std::cout << line.str() << "\n";
+        if (const auto points = pointsSummary(*grid)) {
+            std::cout << "    points: " << points->points;
+            const char* separator = "; attributes: ";
+            for (const auto& [name, type] : points->attributes) {
+                std::cout << separator << name << " " << type;
+                separator = ", ";
+            }
+            std::cout << "\n";
+        }
         printMetadata(*grid, "    ");
     }
     std::cout.flush();
