@@ -276,6 +276,27 @@ TEST_F(CliSequenceTest, KeepGoingListsFailedFrames)
     EXPECT_NE(log.find("\"failed\": [2]"), std::string::npos) << log;
 }
 
+TEST_F(CliSequenceTest, ARunWithoutFramesReplacesAnEarlierLog)
+{
+    // A resubmitted farm task that found none of its frames left the earlier attempt's log,
+    // which monitoring then read as this attempt's result.
+    makeFrames({kFree});
+    const std::string log = out("run.jsonl");
+    writeText(log, "{\"summary\": true, \"frames_done\": 1}\n");
+    const std::string base = "mesh " + quote(in("fluid_{}.vtk")) + " -o " + quote(out("m_{}.obj"));
+    const RunResult r = run(base + " --frames 5 --log " + quote(log));
+    EXPECT_EQ(r.exitCode, 1);
+    EXPECT_EQ(r.err, "nonbloppy: none of the frames 5 of " + in("fluid_{}.vtk") + " exist\n");
+    EXPECT_EQ(readText(log), "{\"summary\": true, \"input\": " + ("\"" + in("fluid_{}.vtk") + "\"") +
+                                 ", \"output\": " + ("\"" + out("m_{}.obj") + "\"") +
+                                 ", \"frames_done\": 0, \"error\": \"none of the frames 5 of " +
+                                 in("fluid_{}.vtk") + " exist\"}\n");
+    // Never over an input of the sequence, even one not asked for.
+    const std::string frame1 = in("fluid_0001.vtk"), before = readText(frame1);
+    EXPECT_EQ(run(base + " --frames 5 --log " + quote(frame1)).exitCode, 1);
+    EXPECT_EQ(readText(frame1), before);
+}
+
 TEST_F(CliSequenceTest, EveryCountIsOfTheFramesAskedFor)
 {
     // stdout said "5 frames", the failure "2 of 3 frames failed" and the log "frames": 3.

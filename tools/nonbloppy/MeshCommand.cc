@@ -8,6 +8,7 @@
 
 #include "BatchRun.h"
 #include "FrameSequence.h"
+#include "Json.h"
 
 #include <nonbloppy/BuildSurface.h>
 #include <nonbloppy/Error.h>
@@ -721,6 +722,32 @@ void requireOutputsApart(const std::vector<Frame>& sequence, const std::vector<B
     }
 }
 
+/// For a run that ends before its first frame for want of frames (none of them on disk, two
+/// files for one frame): replace the --log with one summary line naming the error, so that a
+/// log an earlier run left there is not read as this run's. Left alone when the log names an
+/// input of the sequence (or the directory cannot be read to tell); a log that cannot be
+/// written is not reported over @a error.
+void logEarlyFailure(const MeshOptions& o, const FramePattern& input, const std::string& error)
+{
+    if (o.logPath.empty()) return;
+    try {
+        const std::string log = fileIdentity(o.logPath);
+        for (const Frame& frame : findFrames(input)) {
+            if (fileIdentity(frame.input) == log) return;
+            if (!frame.otherInput.empty() && fileIdentity(frame.otherInput) == log) return;
+        }
+    } catch (const std::exception&) {
+        return;
+    }
+    if (std::FILE* file = std::fopen(o.logPath.c_str(), "w")) {
+        const std::string line = "{\"summary\": true, \"input\": " + jsonString(o.input) + ", \"output\": " +
+                                 jsonString(o.output) + ", \"frames_done\": 0, \"error\": " + jsonString(error) +
+                                 "}\n";
+        std::fputs(line.c_str(), file);
+        std::fclose(file);
+    }
+}
+
 int runSequence(const MeshOptions& o)
 {
     validateParameters(o);
@@ -735,11 +762,17 @@ int runSequence(const MeshOptions& o)
     std::optional<std::vector<int>> requested;
     if (o.framesOpt->count() > 0) requested = parseFrameList(o.frames, "--frames");
 
-    const FramePlan plan = planFrames(input, requested);
-    if (plan.frames.empty()) {
-        throw nonbloppy::FileError(requested ? "none of the frames " + formatFrameList(*requested)
-                                                   + " of " + o.input + " exist"
-                                             : "no file matches " + o.input);
+    FramePlan plan;
+    try {
+        plan = planFrames(input, requested);
+        if (plan.frames.empty()) {
+            throw nonbloppy::FileError(requested ? "none of the frames " + formatFrameList(*requested) + " of " +
+                                                       o.input + " exist"
+                                                 : "no file matches " + o.input);
+        }
+    } catch (const nonbloppy::FileError& e) {
+        logEarlyFailure(o, input, e.what());
+        throw;
     }
     std::vector<BatchJob> jobs;
     for (const Frame& frame : plan.frames) {
