@@ -19,7 +19,8 @@
 namespace nonbloppy {
 
 openvdb::FloatGrid::Ptr
-meshToLevelSet(const SurfaceMesh& mesh, double voxelSize, float halfWidth)
+meshToLevelSet(const SurfaceMesh& mesh, double voxelSize, float halfWidth,
+               openvdb::util::NullInterrupter* interrupter)
 {
     if (!(voxelSize > 0.0) || !std::isfinite(voxelSize)) {
         std::ostringstream message;
@@ -46,9 +47,14 @@ meshToLevelSet(const SurfaceMesh& mesh, double voxelSize, float halfWidth)
         triangles.emplace_back(q[0], q[1], q[2]);
         triangles.emplace_back(q[0], q[2], q[3]);
     }
+    // Unlike volumeToMesh, meshToVolume is built to be stopped: it cancels its voxelization
+    // tasks, merges what they made and returns that partial grid, which is dropped here.
+    openvdb::util::NullInterrupter never;
     openvdb::FloatGrid::Ptr grid = openvdb::tools::meshToVolume<openvdb::FloatGrid>(
+        interrupter ? *interrupter : never,
         openvdb::tools::QuadAndTriangleDataAdapter<openvdb::Vec3s, openvdb::Vec3I>(indexPoints, triangles),
         *transform, halfWidth, halfWidth);
+    if (interrupter && interrupter->wasInterrupted()) throw CancelledError("interrupted during mesh to level set");
     grid->setName("surface");
     grid->setGridClass(openvdb::GRID_LEVEL_SET);
     return grid;

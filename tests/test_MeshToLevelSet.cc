@@ -7,6 +7,8 @@
 
 #include <gtest/gtest.h>
 
+#include <atomic>
+
 using nonbloppy::ParameterError;
 using nonbloppy::SurfaceMesh;
 
@@ -53,4 +55,29 @@ TEST(MeshToLevelSet, BadInputIsAParameterError)
               "smaller unit");
     EXPECT_EQ(nonbloppy_test::messageOf<ParameterError>([&] { nonbloppy::meshToLevelSet(unitCube(), 0.0); }),
               "--voxel-size must be > 0, got 0");
+}
+
+TEST(MeshToLevelSet, AnInterrupterStopsItAndOneThatDoesNotChangesNothing)
+{
+    // --vdb-surface spent seconds in meshToVolume on large frames with SIGTERM unheard.
+    struct StopAfter : openvdb::util::NullInterrupter
+    {
+        explicit StopAfter(int calls) : remaining(calls) {}
+        bool wasInterrupted(int = -1) override { return --remaining < 0; }
+        std::atomic<int> remaining;
+    };
+    const SurfaceMesh cube = unitCube();
+    for (const int calls : {0, 1, 3}) {
+        StopAfter stop(calls);
+        EXPECT_EQ(nonbloppy_test::messageOf<nonbloppy::CancelledError>([&] { nonbloppy::meshToLevelSet(cube, 0.02, 3.0f, &stop); }),
+                  "interrupted during mesh to level set")
+            << calls;
+    }
+    StopAfter never(1 << 30);
+    const openvdb::FloatGrid::Ptr asked = nonbloppy::meshToLevelSet(cube, 0.02, 3.0f, &never);
+    const openvdb::FloatGrid::Ptr plain = nonbloppy::meshToLevelSet(cube, 0.02);
+    EXPECT_LT(never.remaining.load(), 1 << 30);  // it was asked
+    ASSERT_EQ(asked->activeVoxelCount(), plain->activeVoxelCount());
+    auto accessor = plain->getConstAccessor();
+    for (auto value = asked->cbeginValueOn(); value; ++value) ASSERT_EQ(*value, accessor.getValue(value.getCoord()));
 }

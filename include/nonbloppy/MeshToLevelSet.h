@@ -10,18 +10,25 @@
 #include <nonbloppy/Mesh.h>
 
 #include <openvdb/openvdb.h>
+#include <openvdb/util/NullInterrupter.h>
 
 namespace nonbloppy {
 
 /// A FloatGrid named "surface", class GRID_LEVEL_SET, holding the signed distance (world
 /// units, negative inside) to @a mesh within @a halfWidth voxels of it, voxel size
 /// @a voxelSize world units. The mesh should be closed; holes leak the inside sign.
-/// Cost: O(polygons · halfWidth³), parallel inside OpenVDB.
+/// Cost: O(polygons · halfWidth³), parallel inside OpenVDB; on the dam-break frame's
+/// surface (108k triangles, h = 0.023) 0.6 s at two threads, ten times its extraction.
+/// @param interrupter  optional; handed to OpenVDB's meshToVolume, which asks it per
+///                     polygon batch and between its passes (wasInterrupted(percent)) and
+///                     then returns early; this function then throws. No start()/end().
 /// @throw ParameterError if voxelSize ≤ 0 or below kMinCellSize, halfWidth < 1, or a
 ///        polygon references a vertex the mesh does not have ("polygon P references vertex
-///        I but the mesh has N vertices", polygons numbered triangles first, then quads).
+///        I but the mesh has N vertices", polygons numbered triangles first, then quads);
+///        CancelledError("interrupted during mesh to level set") if @a interrupter says so.
 NONBLOPPY_API openvdb::FloatGrid::Ptr meshToLevelSet(const SurfaceMesh& mesh, double voxelSize,
-                                       float halfWidth = 3.0f);
+                                       float halfWidth = 3.0f,
+                                       openvdb::util::NullInterrupter* interrupter = nullptr);
 
 } // namespace nonbloppy
 

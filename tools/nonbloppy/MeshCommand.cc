@@ -604,7 +604,7 @@ FrameOutcome meshFrame(const MeshOptions& o, ProgressInterrupter& interrupter)
         openvdb::MetaMap fileMetadata;
         fileMetadata.insertMeta("creator", openvdb::StringMetadata(versionLine()));
         openvdb::GridCPtrVec grids{result.density};
-        appendVdbGrids(grids, result, particles, o.outputs);
+        appendVdbGrids(grids, result, particles, o.outputs, &interrupter);
         cleanup.willWrite(o.vdbPath);
         nonbloppy::writeVdb(grids, o.vdbPath, fileMetadata);
         cleanup.written();

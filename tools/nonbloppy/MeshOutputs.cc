@@ -72,9 +72,12 @@ void addSurfaceAttributes(nonbloppy::SurfaceResult& result, const nonbloppy::Par
 }
 
 void appendVdbGrids(openvdb::GridCPtrVec& grids, const nonbloppy::SurfaceResult& result,
-                    const nonbloppy::ParticleSet& particles, const MeshOutputOptions& o)
+                    const nonbloppy::ParticleSet& particles, const MeshOutputOptions& o,
+                    openvdb::util::NullInterrupter* interrupter)
 {
-    if (o.vdbSurface) grids.push_back(nonbloppy::meshToLevelSet(result.mesh, result.parameters.voxelSize));
+    if (o.vdbSurface) {
+        grids.push_back(nonbloppy::meshToLevelSet(result.mesh, result.parameters.voxelSize, 3.0f, interrupter));
+    }
     if (o.vdbPoints) grids.push_back(nonbloppy::makePointDataGrid(particles));
 }
 
