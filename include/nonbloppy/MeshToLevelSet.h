@@ -19,6 +19,9 @@ namespace nonbloppy {
 /// @a voxelSize world units. The mesh should be closed; holes leak the inside sign.
 /// Cost: O(polygons · halfWidth³), parallel inside OpenVDB; on the dam-break frame's
 /// surface (108k triangles, h = 0.023) 0.6 s at two threads, ten times its extraction.
+/// @param mesh         the surface, world units (triangles and quads)
+/// @param voxelSize    the grid's voxel size h, world units
+/// @param halfWidth    narrow band half width in voxels, on each side (≥ 1)
 /// @param interrupter  optional; handed to OpenVDB's meshToVolume, which asks it per
 ///                     polygon batch and between its passes (wasInterrupted(percent)) and
 ///                     then returns early; this function then throws. No start()/end().
