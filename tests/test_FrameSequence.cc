@@ -3,6 +3,7 @@
 /// @brief The tool's frame-sequence parsing, in-process: placeholders, names of frames,
 ///        --frames lists and their errors, frames found on disk.
 
+#include "Commands.h"
 #include "FrameSequence.h"
 
 #include <nonbloppy/Error.h>
@@ -230,3 +231,16 @@ TEST_F(FindFramesTest, PlaceholderInDirectoryIsAnError)
 }
 
 } // namespace
+
+TEST(FormatBytesTest, PowersOf1024NamedSoAndNoExponents)
+{
+    // "-v" memory lines said "MB" for MiB and printed 1023.6 KiB as "1.02e+03 KB".
+    using nonbloppy_tool::formatBytes;
+    EXPECT_EQ(formatBytes(512), "512 B");
+    EXPECT_EQ(formatBytes(1536), "1.5 KiB");
+    EXPECT_EQ(formatBytes(1047552), "1023 KiB");
+    EXPECT_EQ(formatBytes(1048200), "1 MiB");  // 1023.6 KiB
+    EXPECT_EQ(formatBytes(1048576), "1 MiB");
+    EXPECT_EQ(formatBytes(119345152), "114 MiB");
+    EXPECT_EQ(formatBytes(uint64_t(5) << 30), "5 GiB");
+}

@@ -69,14 +69,20 @@ inline std::string formatCount(uint64_t n)
     return buffer;
 }
 
-/// A byte count in KB/MB/GB (powers of 1024, as vdb_print).
+/// A byte count in KiB/MiB/GiB ("28.8 MiB", "1023 KiB"): powers of 1024, named so (they
+/// read "MB", and 1023.6 KiB printed as "1.02e+03 KB").
 inline std::string formatBytes(uint64_t n)
 {
+    if (n < 1024) return std::to_string(n) + " B";
+    const char* units[] = {"KiB", "MiB", "GiB", "TiB"};
+    double value = double(n) / 1024.0;
+    size_t unit = 0;
+    while (value >= 1023.5 && unit + 1 < sizeof(units) / sizeof(units[0])) {
+        value /= 1024.0;
+        ++unit;
+    }
     char buffer[32];
-    if (n < 1024) std::snprintf(buffer, sizeof(buffer), "%llu B", static_cast<unsigned long long>(n));
-    else if (n < (1u << 20)) std::snprintf(buffer, sizeof(buffer), "%.3g KB", double(n) / 1024.0);
-    else if (n < (1u << 30)) std::snprintf(buffer, sizeof(buffer), "%.3g MB", double(n) / 1048576.0);
-    else std::snprintf(buffer, sizeof(buffer), "%.3g GB", double(n) / 1073741824.0);
+    std::snprintf(buffer, sizeof(buffer), value >= 99.95 ? "%.0f %s" : "%.3g %s", value, units[unit]);
     return buffer;
 }
 
