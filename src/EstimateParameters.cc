@@ -160,9 +160,9 @@ double spacingGuess(const std::vector<openvdb::Vec3f>& positions, CancelPoll& po
         if (poll.stoppedAt(n)) poll.throwIfStopped();
         const openvdb::Vec3f& p = positions[n];
         if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2])) {
-            // As ParticleIndex::build() says it; an infinite coordinate was reported as an
-            // infinite cell size, or as all particles at one position.
-            throw ParameterError("non-finite position of particle " + std::to_string(n));
+            // An infinite coordinate was reported as an infinite cell size, or as all
+            // particles at one position.
+            throw ParameterError(particle_index_internal::nonFinitePositionMessage(n));
         }
         bounds.expand(openvdb::Vec3d(p));
     }
@@ -450,7 +450,8 @@ ResolvedParameters resolveParametersWith(const SurfaceParameters& params, const 
         }
     }
 
-    // After the volume check, which names --spacing when that was given.
+    // A derived r_e, after the volume check, which names --spacing when that was given (a
+    // given r_e was checked by checkParameters()).
     requireRadiusBelowMaximum(out.effectiveRadius);
 
     poll.throwIfStopped();

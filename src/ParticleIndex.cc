@@ -97,9 +97,7 @@ ParticleIndex ParticleIndex::build(std::vector<openvdb::Vec3f> positions, double
     const PositionScan scan = scanPositions(positions, poll);
     poll.throwIfStopped();
     if (scan.firstNonFinite < positions.size()) {
-        std::ostringstream msg;
-        msg << "non-finite position of particle " << scan.firstNonFinite;
-        throw ParameterError(msg.str());
+        throw ParameterError(particle_index_internal::nonFinitePositionMessage(scan.firstNonFinite));
     }
     // Index coordinates are 32-bit: refuse positions whose cell number would overflow.
     if (double(scan.maxAbs) / cellSize > 1.0e9) {

@@ -12,6 +12,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <string>
 
 namespace nonbloppy {
 
@@ -31,6 +32,13 @@ namespace particle_index_internal {
 
 using IndexTree = openvdb::tools::PointIndexTree;
 using IndexLeaf = IndexTree::LeafNodeType;
+
+/// "non-finite position of particle N": how ParticleIndex::build() and the spacing estimate
+/// (which meets the positions first when no --radius is given) refuse a NaN or infinity.
+inline std::string nonFinitePositionMessage(size_t particle)
+{
+    return "non-finite position of particle " + std::to_string(particle);
+}
 
 /// Index-space cell holding world position @a x (cells are centred on integer coordinates,
 /// as OpenVDB's PointPartitioner buckets them).
