@@ -234,18 +234,12 @@ std::string formatFrameList(std::vector<int> frames)
         // The longest run from frames[i] with one step: consecutive frames fold from two on
         // ("4-5"), stepped ones from three ("7-11:2"; "5, 7" reads better than "5-7:2").
         size_t j = i;
-        if (i + 1 < frames.size()) {
-            const int64_t step = int64_t(frames[i + 1]) - frames[i];
-            while (j + 1 < frames.size() && int64_t(frames[j + 1]) - frames[j] == step) ++j;
-            if (step > 1 && j < i + 2) j = i;
-        }
+        const int64_t step = i + 1 < frames.size() ? int64_t(frames[i + 1]) - frames[i] : 1;
+        while (j + 1 < frames.size() && int64_t(frames[j + 1]) - frames[j] == step) ++j;
+        if (step > 1 && j < i + 2) j = i;
         if (!out.empty()) out += ", ";
         out += std::to_string(frames[i]);
-        if (j > i) {
-            out += "-" + std::to_string(frames[j]);
-            const int64_t step = int64_t(frames[i + 1]) - frames[i];
-            if (step > 1) out += ":" + std::to_string(step);
-        }
+        if (j > i) out += "-" + std::to_string(frames[j]) + (step > 1 ? ":" + std::to_string(step) : "");
         i = j + 1;
     }
     return out;
@@ -293,12 +287,12 @@ std::vector<Frame> findFrames(const FramePattern& input)
 FramePlan planFrames(const FramePattern& input, const std::optional<std::vector<int>>& requested)
 {
     FramePlan plan;
-    std::vector<Frame> found = findFrames(input);
+    plan.onDisk = findFrames(input);
     if (!requested) {
-        plan.frames = std::move(found);
+        plan.frames = plan.onDisk;
     } else {
         std::map<int, Frame> byNumber;
-        for (Frame& f : found) byNumber.emplace(f.number, std::move(f));
+        for (const Frame& f : plan.onDisk) byNumber.emplace(f.number, f);
         for (int number : *requested) {
             auto it = byNumber.find(number);
             if (it == byNumber.end()) plan.missing.push_back(number);

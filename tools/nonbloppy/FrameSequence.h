@@ -100,6 +100,7 @@ struct FramePlan
 {
     std::vector<Frame> frames;   ///< found and requested, in increasing order
     std::vector<int> missing;    ///< requested but not on disk
+    std::vector<Frame> onDisk;   ///< every frame found, requested or not (no output may name one)
 };
 
 /// Every frame found when @a requested is empty, else the requested ones that exist

@@ -783,7 +783,7 @@ int runSequence(const MeshOptions& o)
     }
     // Output extensions and directories, before any work.
     validatePaths(optionsForFrame(o, plan.frames.front()));
-    requireOutputsApart(findFrames(input), jobs, o.logPath);
+    requireOutputsApart(plan.onDisk, jobs, o.logPath);
 
     std::unique_ptr<tbb::global_control> threadLimit;
     if (o.threadsOpt->count() > 0) {
