@@ -16,7 +16,10 @@
 #include <atomic>
 #include <cmath>
 #include <limits>
+#include <memory>
+#include <new>
 #include <utility>
+#include <vector>
 #include <sstream>
 
 namespace nonbloppy {
@@ -24,6 +27,35 @@ namespace nonbloppy {
 namespace {
 
 using cancellation_internal::CancelPoll;
+
+/// std::allocator, except that resize() leaves new elements of trivial types unwritten
+/// (default- rather than value-initialised): the parallel loop that fills a buffer of
+/// millions of keys then touches its pages first, on both threads, instead of a serial
+/// memset faulting them all in beforehand.
+template<typename T>
+struct UnwrittenAllocator : std::allocator<T>
+{
+    template<typename U>
+    struct rebind
+    {
+        using other = UnwrittenAllocator<U>;
+    };
+    UnwrittenAllocator() = default;
+    template<typename U>
+    UnwrittenAllocator(const UnwrittenAllocator<U>&) noexcept {}
+    template<typename U>
+    void construct(U* p) noexcept
+    {
+        ::new (static_cast<void*>(p)) U;
+    }
+    template<typename U, typename... Args>
+    void construct(U* p, Args&&... args)
+    {
+        ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
+    }
+};
+template<typename T>
+using UnwrittenVector = std::vector<T, UnwrittenAllocator<T>>;
 
 /// Candidates processed side by side (two SSE registers, or one AVX register).
 constexpr size_t kLanes = 8;
@@ -115,7 +147,7 @@ private:
 struct RelaxGroupsOp
 {
     const ParticleIndex& particles;
-    const std::vector<uint32_t>& vertexOrder;   ///< vertices sorted by their first cell
+    const UnwrittenVector<uint32_t>& vertexOrder;  ///< vertices sorted by their first cell
     const std::vector<size_t>& groupStart;      ///< groups of vertexOrder sharing that cell
     std::vector<openvdb::Vec3s>& points;        ///< read, relaxed and written back per group
     int iterations;
@@ -248,7 +280,8 @@ struct RelaxGroupsOp
 /// thread): each pass counts the digits of every chunk in parallel, takes the starts in
 /// digit order then chunk order, and lets every chunk place its values in order, so the
 /// result is the same for any thread count. On a stop of @a poll the order is unspecified.
-void radixSortHigh(std::vector<uint64_t>& values, std::vector<uint64_t>& spare, int low, int bits, CancelPoll& poll)
+void radixSortHigh(UnwrittenVector<uint64_t>& values, UnwrittenVector<uint64_t>& spare, int low, int bits,
+                   CancelPoll& poll)
 {
     constexpr int kDigitBits = 11;
     constexpr size_t kDigits = size_t(1) << kDigitBits;
@@ -295,7 +328,7 @@ void radixSortHigh(std::vector<uint64_t>& values, std::vector<uint64_t>& spare, 
 /// @a groupStart, for n < @a count sorted by key: a count of starts per block, its prefix
 /// sum, then each block writes its own.
 template<typename KeyAt, typename VertexAt>
-void writeGroups(size_t count, const KeyAt& keyAt, const VertexAt& vertexAt, std::vector<uint32_t>& order,
+void writeGroups(size_t count, const KeyAt& keyAt, const VertexAt& vertexAt, UnwrittenVector<uint32_t>& order,
                  std::vector<size_t>& groupStart, CancelPoll& poll)
 {
     order.resize(count);
@@ -328,73 +361,120 @@ void writeGroups(size_t count, const KeyAt& keyAt, const VertexAt& vertexAt, std
     groupStart.back() = count;
 }
 
-/// Sort vertex numbers by the group cell (edge @a groupSize) their position falls in and
+/// Sort the vertex numbers by the group cell (edge @a groupSize) their position falls in and
 /// return the start of each run of equal cells (plus the end). Cells are keyed relative to
 /// the smallest cell, so the sort compares integers, not coordinates through an index; ties
-/// keep vertex order, so grouping is deterministic. Every pass is parallel:
-/// on millions of vertices, serial passes left the second thread idle. When the cells of the
-/// vertices' box number fewer than 2^32 (always, but for scattered vertices), the key is the
-/// cell's rank in that box and the vertex number packed into 64 bits, sorted by a stable
-/// radix sort on the rank's bits (two passes where a surface crosses a million cells; the
-/// comparison sort cost a tenth of the step). Asks @a poll as it goes and throws its
-/// CancelledError on a stop (the sort is stopped through runStoppable()).
+/// keep vertex order, so grouping is deterministic. Every pass is parallel, and the key
+/// buffers are filled without a serial memset first (UnwrittenVector): on millions of
+/// vertices, serial passes left the second thread idle. When the cells of the vertices' box
+/// number fewer than 2^32 (always, but for scattered vertices), the key is the cell's rank in
+/// that box and the vertex number packed into 64 bits, sorted by a stable radix sort on the
+/// rank's bits (two passes where a surface crosses a million cells; the comparison sort cost
+/// a tenth of the step).
+///
+/// A vertex with a coordinate that is NaN, infinite or beyond 2^30 group cells from the
+/// origin is in no group: no particle can be within r_e of it (the particle index holds
+/// cells of int coordinates, a third of a group cell each), so it stays put, as a vertex
+/// with no particle in reach does. Its cell would not fit an int either.
+/// Asks @a poll as it goes and throws its CancelledError on a stop (the sort is stopped
+/// through runStoppable()).
 void groupVerticesByCell(const std::vector<openvdb::Vec3s>& points, double groupSize,
-                         std::vector<uint32_t>& order, std::vector<size_t>& groupStart, CancelPoll& poll)
+                         UnwrittenVector<uint32_t>& order, std::vector<size_t>& groupStart, CancelPoll& poll)
 {
     using particle_index_internal::cellOf;
-    using Bounds = std::pair<openvdb::Coord, openvdb::Coord>;
-    const Bounds bounds = tbb::parallel_reduce(tbb::blocked_range<size_t>(0, points.size()),
-        Bounds(openvdb::Coord(std::numeric_limits<int>::max()), openvdb::Coord(std::numeric_limits<int>::min())),
-        [&](const tbb::blocked_range<size_t>& r, Bounds b) {
-            for (size_t i = r.begin(); i < r.end(); ++i) {
-                if (poll.stoppedAt(i - r.begin())) return b;
-                const openvdb::Coord c = cellOf(points[i], groupSize);
-                b.first.minComponent(c);
-                b.second.maxComponent(c);
-            }
-            return b;
-        },
-        [](Bounds a, const Bounds& b) {
-            a.first.minComponent(b.first);
-            a.second.maxComponent(b.second);
-            return a;
-        });
+    // Largest |coordinate| of a grouped vertex; NaN fails the comparison too.
+    const float reach = float(double(1 << 30) * groupSize);
+    const auto inReach = [reach](const openvdb::Vec3s& p) {
+        return (std::abs(p[0]) < reach) & (std::abs(p[1]) < reach) & (std::abs(p[2]) < reach);
+    };
+    // The cells of the lowest and highest corners of the grouped vertices' box bound every
+    // one of their cells, since cellOf() is monotonic in each coordinate: min and max (which
+    // vectorize) instead of a cellOf() per vertex, twice as fast. A vertex out of reach (never
+    // in a mesh from extractSurface) makes a second pass that leaves it out.
+    struct Box
+    {
+        openvdb::Vec3s lo, hi;
+        size_t outOfReach;
+    };
+    const float inf = std::numeric_limits<float>::infinity();
+    const auto boxOf = [&](bool skipOutOfReach) {
+        return tbb::parallel_reduce(tbb::blocked_range<size_t>(0, points.size()),
+            Box{openvdb::Vec3s(inf), openvdb::Vec3s(-inf), 0},
+            [&](const tbb::blocked_range<size_t>& r, Box b) {
+                if (poll.stopped()) return b;
+                size_t outOfReach = 0;
+                for (size_t i = r.begin(); i < r.end(); ++i) {
+                    const openvdb::Vec3s& p = points[i];
+                    const bool in = inReach(p);
+                    outOfReach += !in;
+                    if (skipOutOfReach && !in) continue;
+                    b.lo = openvdb::math::minComponent(b.lo, p);
+                    b.hi = openvdb::math::maxComponent(b.hi, p);
+                }
+                b.outOfReach += outOfReach;
+                return b;
+            },
+            [](const Box& a, const Box& b) {
+                return Box{openvdb::math::minComponent(a.lo, b.lo), openvdb::math::maxComponent(a.hi, b.hi),
+                           a.outOfReach + b.outOfReach};
+            });
+    };
+    Box box = boxOf(false);
     poll.throwIfStopped();
-    const openvdb::Coord lowest = bounds.first, highest = bounds.second;
-    // Extents in 64 bits: a box of cells from -2^31 to 2^31 - 1 overflows a Coord.
+    if (box.outOfReach > 0) box = boxOf(true);
+    poll.throwIfStopped();
+    const size_t grouped = points.size() - box.outOfReach;
+    if (grouped == 0) {
+        order.clear();
+        groupStart.assign(1, 0);
+        return;
+    }
+    const openvdb::Coord lowest = cellOf(box.lo, groupSize), highest = cellOf(box.hi, groupSize);
+    // Extents in 64 bits: a box of cells from -2^30 to 2^30 overflows a Coord.
     const uint64_t dims[3] = {uint64_t(int64_t(highest[0]) - lowest[0] + 1), uint64_t(int64_t(highest[1]) - lowest[1] + 1),
                               uint64_t(int64_t(highest[2]) - lowest[2] + 1)};
     const double cellCount = double(dims[0]) * double(dims[1]) * double(dims[2]);
-    if (cellCount <= double(uint64_t(1) << 32)) {
-        std::vector<uint64_t> packed(points.size()), spare;  // cell rank and vertex
+    // Vertices out of reach get a key past every cell's, so the sort puts them last, where
+    // they are cut off.
+    if (cellCount < double(uint64_t(1) << 32)) {
+        const uint64_t pastLastCell = uint64_t(cellCount);
+        UnwrittenVector<uint64_t> packed(points.size()), spare;  // cell rank and vertex
         tbb::parallel_for(tbb::blocked_range<size_t>(0, points.size()), [&](const tbb::blocked_range<size_t>& r) {
             for (size_t i = r.begin(); i < r.end(); ++i) {
                 if (poll.stoppedAt(i - r.begin())) return;
-                const openvdb::Coord c = cellOf(points[i], groupSize) - lowest;
-                const uint64_t rank = (uint64_t(c[0]) * dims[1] + uint64_t(c[1])) * dims[2] + uint64_t(c[2]);
+                uint64_t rank = pastLastCell;
+                if (inReach(points[i])) {
+                    const openvdb::Coord c = cellOf(points[i], groupSize) - lowest;
+                    rank = (uint64_t(c[0]) * dims[1] + uint64_t(c[1])) * dims[2] + uint64_t(c[2]);
+                }
                 packed[i] = (rank << 32) | uint64_t(i);
             }
         });
         poll.throwIfStopped();
         int bits = 0;
-        while (bits < 32 && double(uint64_t(1) << bits) < cellCount) ++bits;
+        while (bits < 32 && (uint64_t(1) << bits) <= pastLastCell) ++bits;
         radixSortHigh(packed, spare, 32, bits, poll);
         poll.throwIfStopped();
-        writeGroups(packed.size(), [&](size_t n) { return packed[n] >> 32; },
+        writeGroups(grouped, [&](size_t n) { return packed[n] >> 32; },
                     [&](size_t n) { return uint32_t(packed[n]); }, order, groupStart, poll);
         return;
     }
     // Scattered vertices (a particle flung 10^5 r_e away from the rest): the cell's offsets
     // from the lowest, 32 bits per axis, compared lexicographically. (A key of 21 bits per
-    // axis refused such frames after their density and surface were done.)
+    // axis refused such frames after their density and surface were done.) Offsets stay
+    // below 2^31, so all ones marks a vertex out of reach.
     using CellKey = std::array<uint32_t, 3>;
+    constexpr uint32_t kOutOfReach = std::numeric_limits<uint32_t>::max();
     std::vector<std::pair<CellKey, uint32_t>> keyed(points.size());  // cell key and vertex
     tbb::parallel_for(tbb::blocked_range<size_t>(0, points.size()), [&](const tbb::blocked_range<size_t>& r) {
         for (size_t i = r.begin(); i < r.end(); ++i) {
             if (poll.stoppedAt(i - r.begin())) return;
-            const openvdb::Coord c = cellOf(points[i], groupSize);
-            const CellKey key = {uint32_t(int64_t(c[0]) - lowest[0]), uint32_t(int64_t(c[1]) - lowest[1]),
-                                 uint32_t(int64_t(c[2]) - lowest[2])};
+            CellKey key = {kOutOfReach, kOutOfReach, kOutOfReach};
+            if (inReach(points[i])) {
+                const openvdb::Coord c = cellOf(points[i], groupSize);
+                key = {uint32_t(int64_t(c[0]) - lowest[0]), uint32_t(int64_t(c[1]) - lowest[1]),
+                       uint32_t(int64_t(c[2]) - lowest[2])};
+            }
             keyed[i] = {key, uint32_t(i)};
         }
     });
@@ -402,7 +482,7 @@ void groupVerticesByCell(const std::vector<openvdb::Vec3s>& points, double group
     // Keys are unique (they hold the vertex number), so any sort gives the same order.
     cancellation_internal::runStoppable(poll, [&] { tbb::parallel_sort(keyed.begin(), keyed.end()); });
     poll.throwIfStopped();
-    writeGroups(keyed.size(), [&](size_t n) { return keyed[n].first; }, [&](size_t n) { return keyed[n].second; },
+    writeGroups(grouped, [&](size_t n) { return keyed[n].first; }, [&](size_t n) { return keyed[n].second; },
                 order, groupStart, poll);
 }
 
@@ -443,7 +523,7 @@ void instruction_set_internal::relaxVertices(SurfaceMesh& mesh, const ParticleIn
     CancelPoll poll(interrupter, "relax vertices");
     const bool avx2 = instruction_set_internal::useAvx2(set);
     try {
-        std::vector<uint32_t> order;
+        UnwrittenVector<uint32_t> order;
         std::vector<size_t> groupStart;
         // Grouped once: each step bounds a group by its vertices' current box, so its
         // candidate lists stay exact however the vertices move, and as a step moves a vertex

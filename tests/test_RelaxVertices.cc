@@ -12,6 +12,7 @@
 
 #include <atomic>
 #include <cmath>
+#include <limits>
 
 using namespace nonbloppy;
 
@@ -283,4 +284,30 @@ TEST(RelaxVertices, RejectsBadSettings)
     RelaxSettings noRadius = relaxSettings(0.3, 2);
     noRadius.effectiveRadius = 0.0;
     expectMessage(noRadius, "--radius must be > 0, got 0");
+}
+
+TEST(RelaxVertices, VerticesThatAreNotFiniteStayPutAndTheOthersRelaxAsWithoutThem)
+{
+    // A host application's mesh may carry a NaN, an infinite or a far-flung vertex; the
+    // grouping bounds the vertices' cells by their box, and must neither take them in nor
+    // hang on them (a NaN vertex took 30 s before they were left out of every group).
+    OneParticle one;
+    SurfaceMesh expected = one.mesh;
+    relaxVertices(expected, one.index, relaxSettings(0.3, 2));
+    const float nan = std::numeric_limits<float>::quiet_NaN(), inf = std::numeric_limits<float>::infinity();
+    const std::vector<openvdb::Vec3s> bad = {{nan, 0.0f, 0.0f}, {inf, 1.0f, 2.0f}, {0.0f, -inf, nan}, {1e30f, 0.0f, 0.0f}};
+    for (const openvdb::Vec3s& vertex : bad) {
+        SurfaceMesh mesh = one.mesh;
+        mesh.points.insert(mesh.points.begin() + mesh.points.size() / 2, vertex);
+        relaxVertices(mesh, one.index, relaxSettings(0.3, 2));
+        ASSERT_EQ(mesh.points.size(), expected.points.size() + 1);
+        const size_t at = expected.points.size() / 2;
+        for (size_t i = 0; i < expected.points.size(); ++i) {
+            ASSERT_EQ(mesh.points[i < at ? i : i + 1], expected.points[i]) << "vertex " << i;
+        }
+        const openvdb::Vec3s kept = mesh.points[at];
+        for (int a = 0; a < 3; ++a) {
+            EXPECT_TRUE(std::isnan(vertex[a]) ? std::isnan(kept[a]) : kept[a] == vertex[a]) << "axis " << a;
+        }
+    }
 }
