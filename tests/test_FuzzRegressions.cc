@@ -8,13 +8,12 @@
 // operator new to record the largest single request made while a file is being read.
 
 #include "TestUtil.h"
+#include "support/OpenVdbPoints.h"
 
 #include <nonbloppy/Error.h>
 #include <nonbloppy/ReadParticles.h>
 
 #include <openvdb/openvdb.h>
-#include <openvdb/points/PointConversion.h>
-#include <openvdb/points/PointGroup.h>
 
 #include <gtest/gtest.h>
 
@@ -335,37 +334,13 @@ protected:
     /// pair "pair" (stride 2) and a group "tagged".
     std::string writePoints(size_t count, double extent, uint32_t compression, const std::string& name)
     {
-        openvdb::initialize();
         std::mt19937 random(11);
         std::uniform_real_distribution<double> coordinate(0.0, extent);
         std::vector<openvdb::Vec3R> positions(count);
         for (openvdb::Vec3R& p : positions) p = openvdb::Vec3R(coordinate(random), coordinate(random), coordinate(random));
-        const openvdb::points::PointAttributeVector<openvdb::Vec3R> wrapper(positions);
-        auto transform = openvdb::math::Transform::createLinearTransform(1.0);
-        auto index = openvdb::tools::createPointIndexGrid<openvdb::tools::PointIndexGrid>(wrapper, *transform);
-        auto grid = openvdb::points::createPointDataGrid<openvdb::points::NullCodec,
-            openvdb::points::PointDataGrid>(*index, wrapper, *transform);
-        grid->setName("points");
-        std::vector<float> temperature(count);
-        for (size_t i = 0; i < count; ++i) temperature[i] = float(i) * 0.5f;
-        openvdb::points::appendAttribute<float>(grid->tree(), "temperature");
-        openvdb::points::populateAttribute<openvdb::points::PointDataTree, openvdb::tools::PointIndexTree,
-            openvdb::points::PointAttributeVector<float>>(grid->tree(), index->tree(), "temperature",
-                openvdb::points::PointAttributeVector<float>(temperature));
-        openvdb::points::appendAttribute<int32_t>(grid->tree(), "id", 7);
-        openvdb::points::appendAttribute<float>(grid->tree(), "pair", 0.0f, /*stride=*/2);
-        for (auto leaf = grid->tree().beginLeaf(); leaf; ++leaf) {
-            openvdb::points::AttributeWriteHandle<float> pair(leaf->attributeArray("pair"));
-            pair.expand();
-            for (openvdb::Index i = 0; i < pair.size(); ++i) pair.set(i, 1, float(i));
-        }
-        openvdb::points::appendGroup(grid->tree(), "tagged");
-        openvdb::points::setGroup(grid->tree(), "tagged", true);
         const std::string file = path(name);
-        openvdb::io::File out(file);
-        out.setCompression(compression);
-        out.write({grid});
-        out.close();
+        nonbloppy_test::writeOpenVdbPoints(file, positions, 1.0, nonbloppy_test::PointExtras::IdPairAndGroup,
+                                           compression);
         return file;
     }
 

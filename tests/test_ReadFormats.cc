@@ -4,13 +4,12 @@
 // and truncated, corrupt and hostile input with their exact messages.
 
 #include "TestUtil.h"
+#include "support/OpenVdbPoints.h"
 
 #include <nonbloppy/Error.h>
 #include <nonbloppy/ReadParticles.h>
 
 #include <openvdb/openvdb.h>
-#include <openvdb/points/PointConversion.h>
-#include <openvdb/points/PointCount.h>
 
 #include <gtest/gtest.h>
 #include <zlib.h>
@@ -554,20 +553,8 @@ TEST_F(ReadFormatsTest, VdbPointDataGridWithAttributes)
     openvdb::initialize();
     const ParticleSet source = readParticles(dataPath("free_particles_125_particles.vtk"));
     std::vector<openvdb::Vec3R> positions(source.positions.begin(), source.positions.end());
-    const openvdb::points::PointAttributeVector<openvdb::Vec3R> wrapper(positions);
-    auto transform = openvdb::math::Transform::createLinearTransform(0.5);
-    auto index = openvdb::tools::createPointIndexGrid<openvdb::tools::PointIndexGrid>(wrapper, *transform);
-    auto grid = openvdb::points::createPointDataGrid<openvdb::points::NullCodec,
-        openvdb::points::PointDataGrid>(*index, wrapper, *transform);
-    grid->setName("points");
-    std::vector<float> temperature(positions.size());
-    for (size_t i = 0; i < temperature.size(); ++i) temperature[i] = float(i) * 0.5f;
-    openvdb::points::appendAttribute<float>(grid->tree(), "temperature");
-    openvdb::points::populateAttribute<openvdb::points::PointDataTree, openvdb::tools::PointIndexTree,
-        openvdb::points::PointAttributeVector<float>>(grid->tree(), index->tree(), "temperature",
-            openvdb::points::PointAttributeVector<float>(temperature));
     const std::string file = path("points.vdb");
-    openvdb::io::File(file).write({grid});
+    nonbloppy_test::writeOpenVdbPoints(file, positions, 0.5);
 
     const ParticleSet particles = readParticles(file);
     ASSERT_EQ(particles.size(), positions.size());
