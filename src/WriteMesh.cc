@@ -19,6 +19,7 @@
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/task_group.h>
 
 #include <algorithm>
 #include <charconv>
@@ -128,23 +129,38 @@ inline char* put4(char* at, T value)
 }
 
 /// Writes @a count records of @a recordBytes each, record i encoded by
-/// encode(i, char* record): batches of about 16 MB are encoded in parallel into one buffer
-/// and written in order (peak extra memory: one batch).
+/// encode(i, char* record): batches of about 8 MB are encoded in parallel into one of two
+/// buffers while the batch before is written from the other (a TBB task, so --threads holds),
+/// in order, so the bytes do not depend on the thread count. Peak extra memory: 16 MB.
+/// Writing one batch after encoding it left the threads idle during each write, which copies
+/// the batch into the file's buffer and waits for the disk: on the 64x benchmark mesh (119 MB)
+/// the writes took 0.073 s and the encoding 0.037 s, one after the other.
 template<typename EncodeT>
 void
 writeRecords(ChunkWriter& out, size_t count, size_t recordBytes, const EncodeT& encode)
 {
     if (count == 0) return;
     std::ostream& os = out.stream();
-    constexpr size_t kBatchBytes = size_t(16) << 20;
+    constexpr size_t kBatchBytes = size_t(8) << 20;
     const size_t perBatch = std::max<size_t>(1, kBatchBytes / recordBytes);
-    std::vector<char> batch(std::min(count, perBatch) * recordBytes);
-    for (size_t first = 0; first < count; first += perBatch) {
-        const size_t n = std::min(perBatch, count - first);
-        tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 8192), [&](const tbb::blocked_range<size_t>& r) {
-            for (size_t i = r.begin(); i < r.end(); ++i) encode(first + i, batch.data() + i * recordBytes);
-        });
-        os.write(batch.data(), std::streamsize(n * recordBytes));
+    std::vector<char> batches[2];
+    batches[0].resize(std::min(count, perBatch) * recordBytes);
+    if (count > perBatch) batches[1].resize(perBatch * recordBytes);
+    tbb::task_group writing;
+    try {
+        for (size_t first = 0, k = 0; first < count; first += perBatch, ++k) {
+            const size_t n = std::min(perBatch, count - first);
+            char* batch = batches[k % 2].data();
+            tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 8192), [&](const tbb::blocked_range<size_t>& r) {
+                for (size_t i = r.begin(); i < r.end(); ++i) encode(first + i, batch + i * recordBytes);
+            });
+            writing.wait();  // the batch before is written: its buffer is free for the next
+            writing.run([&os, batch, bytes = std::streamsize(n * recordBytes)] { os.write(batch, bytes); });
+        }
+        writing.wait();
+    } catch (...) {
+        writing.wait();  // the buffers outlive the write in flight
+        throw;
     }
 }
 
