@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "Cancellation.h"
 #include "OpenVdbScale.h"
+#include "ParameterChecks.h"
 #include "ParticleIndexImpl.h"
 #include "SurfaceStages.h"
 
@@ -336,12 +337,7 @@ void requireRadiusBelowMaximum(double effectiveRadius)
 void checkParameters(const SurfaceParameters& params)
 {
     auto requirePositive = [](const std::optional<double>& value, const char* name) {
-        if (value && !std::isfinite(*value)) {
-            throw ParameterError(std::string(name) + " must be finite, got " + formatNumber(*value));
-        }
-        if (value && !(*value > 0.0)) {
-            throw ParameterError(std::string(name) + " must be > 0, got " + formatNumber(*value));
-        }
+        if (value) parameter_checks_internal::requirePositive(*value, name);
     };
     requirePositive(params.spacing, "--spacing");
     requirePositive(params.effectiveRadius, "--radius");

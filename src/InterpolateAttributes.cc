@@ -2,6 +2,7 @@
 /// @file InterpolateAttributes.cc
 /// @brief Kernel-weighted particle attributes at mesh vertices, through the particle index.
 
+#include "ParameterChecks.h"
 #include "ParticleIndexImpl.h"
 
 #include <nonbloppy/Error.h>
@@ -108,11 +109,7 @@ interpolateAttributes(SurfaceMesh& mesh, const ParticleSet& particles,
                       const std::vector<std::string>& names, double effectiveRadius,
                       openvdb::util::NullInterrupter* interrupter)
 {
-    if (!(effectiveRadius > 0.0) || !std::isfinite(effectiveRadius)) {
-        std::ostringstream message;
-        message << "--radius must be > 0, got " << effectiveRadius;
-        throw ParameterError(message.str());
-    }
+    parameter_checks_internal::requirePositive(effectiveRadius, "--radius");
     const std::vector<std::string> resolved = resolveAttributeNames(particles, names);
     if (resolved.empty() || mesh.points.empty()) {
         for (const std::string& name : resolved) {

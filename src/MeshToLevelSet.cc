@@ -7,6 +7,7 @@
 #include <nonbloppy/ParticleIndex.h>
 
 #include "OpenVdbScale.h"
+#include "ParameterChecks.h"
 #include "PolygonIndices.h"
 
 #pragma GCC visibility push(default)  // OpenVDB templates: see src/VisibilityPrelude.h
@@ -22,11 +23,7 @@ openvdb::FloatGrid::Ptr
 meshToLevelSet(const SurfaceMesh& mesh, double voxelSize, float halfWidth,
                openvdb::util::NullInterrupter* interrupter)
 {
-    if (!(voxelSize > 0.0) || !std::isfinite(voxelSize)) {
-        std::ostringstream message;
-        message << "--voxel-size must be > 0, got " << voxelSize;
-        throw ParameterError(message.str());
-    }
+    parameter_checks_internal::requirePositive(voxelSize, "--voxel-size");
     if (!(halfWidth >= 1.0f)) throw ParameterError("level set half width must be >= 1 voxel");
     // Below it OpenVDB throws its own ArithmeticError, not a nonbloppy::Error.
     openvdb_scale_internal::requireOpenVdbScale(voxelSize, kMinCellSize, "--voxel-size");

@@ -2,6 +2,7 @@
 #include "Cancellation.h"
 #include "InstructionSet.h"
 #include "OpenVdbScale.h"
+#include "ParameterChecks.h"
 #include "ParticleIndexImpl.h"
 #include "SurfaceStages.h"
 
@@ -369,18 +370,10 @@ openvdb::FloatGrid::Ptr instruction_set_internal::rasterizeDensity(const Particl
                                                                    InstructionSet set)
 {
     openvdb::initialize();
-    if (!(settings.effectiveRadius > 0.0) || !std::isfinite(settings.effectiveRadius)) {
-        std::ostringstream msg;
-        msg << "--radius must be > 0, got " << settings.effectiveRadius;
-        throw ParameterError(msg.str());
-    }
+    parameter_checks_internal::requirePositive(settings.effectiveRadius, "--radius");
     openvdb::math::Transform::Ptr transform = settings.transform;
     if (!transform) {
-        if (!(settings.voxelSize > 0.0) || !std::isfinite(settings.voxelSize)) {
-            std::ostringstream msg;
-            msg << "--voxel-size must be > 0, got " << settings.voxelSize;
-            throw ParameterError(msg.str());
-        }
+        parameter_checks_internal::requirePositive(settings.voxelSize, "--voxel-size");
         openvdb_scale_internal::requireOpenVdbScale(settings.voxelSize, kMinCellSize, "--voxel-size");
         transform = openvdb::math::Transform::createLinearTransform(settings.voxelSize);
     } else if (transform->baseMap()->type() != openvdb::math::UniformScaleMap::mapType()) {

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "Cancellation.h"
 #include "InstructionSet.h"
+#include "ParameterChecks.h"
 #include "ParticleIndexImpl.h"
 
 #include <nonbloppy/Error.h>
@@ -501,10 +502,7 @@ void instruction_set_internal::relaxVertices(SurfaceMesh& mesh, const ParticleIn
                                              InstructionSet set)
 {
     std::ostringstream msg;
-    if (!(settings.effectiveRadius > 0.0) || !std::isfinite(settings.effectiveRadius)) {
-        msg << "--radius must be > 0, got " << settings.effectiveRadius;
-        throw ParameterError(msg.str());
-    }
+    parameter_checks_internal::requirePositive(settings.effectiveRadius, "--radius");
     if (!(settings.blend >= 0.0 && settings.blend <= 1.0)) {
         msg << "--blend must lie in [0,1], got " << settings.blend;
         throw ParameterError(msg.str());

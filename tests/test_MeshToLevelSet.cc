@@ -7,6 +7,8 @@
 
 #include <gtest/gtest.h>
 
+#include <limits>
+
 #include <atomic>
 
 using nonbloppy::ParameterError;
@@ -55,6 +57,9 @@ TEST(MeshToLevelSet, BadInputIsAParameterError)
               "smaller unit");
     EXPECT_EQ(nonbloppy_test::messageOf<ParameterError>([&] { nonbloppy::meshToLevelSet(unitCube(), 0.0); }),
               "--voxel-size must be > 0, got 0");
+    EXPECT_EQ(nonbloppy_test::messageOf<ParameterError>(
+                  [&] { nonbloppy::meshToLevelSet(unitCube(), std::numeric_limits<double>::infinity()); }),
+              "--voxel-size must be finite, got inf");
 }
 
 TEST(MeshToLevelSet, AnInterrupterStopsItAndOneThatDoesNotChangesNothing)

@@ -157,6 +157,23 @@ TEST(RasterizeDensity, RejectsBadSettings)
     } catch (const ParameterError& e) {
         EXPECT_STREQ(e.what(), "--voxel-size must be > 0, got -0.5");
     }
+    // Not finite: checkParameters()'s words, not "must be > 0, got inf".
+    settings.voxelSize = std::numeric_limits<double>::infinity();
+    try {
+        rasterizeDensity(index, settings);
+        FAIL() << "h = inf accepted";
+    } catch (const ParameterError& e) {
+        EXPECT_STREQ(e.what(), "--voxel-size must be finite, got inf");
+    }
+    settings.voxelSize = 0.1;
+    settings.effectiveRadius = std::numeric_limits<double>::quiet_NaN();
+    try {
+        rasterizeDensity(index, settings);
+        FAIL() << "r_e = nan accepted";
+    } catch (const ParameterError& e) {
+        EXPECT_STREQ(e.what(), "--radius must be finite, got nan");
+    }
+    settings.effectiveRadius = 1.0;
     // r_e/h = 1000 would make a 4·10⁹-voxel sphere (18 GB) of this one particle; 32 is the limit,
     // for a caller's transform as well.
     settings.voxelSize = 0.001;

@@ -284,6 +284,8 @@ TEST(RelaxVertices, RejectsBadSettings)
     RelaxSettings noRadius = relaxSettings(0.3, 2);
     noRadius.effectiveRadius = 0.0;
     expectMessage(noRadius, "--radius must be > 0, got 0");
+    noRadius.effectiveRadius = -std::numeric_limits<double>::infinity();
+    expectMessage(noRadius, "--radius must be finite, got -inf");
 }
 
 TEST(RelaxVertices, VerticesThatAreNotFiniteStayPutAndTheOthersRelaxAsWithoutThem)

@@ -1,0 +1,28 @@
+// SPDX-License-Identifier: Apache-2.0
+/// @file ParameterChecks.h
+/// @brief One wording, across the library, for a length that must be positive and finite.
+#pragma once
+
+#include <nonbloppy/Error.h>
+
+#include <cmath>
+#include <sstream>
+#include <string>
+
+namespace nonbloppy {
+namespace parameter_checks_internal {
+
+/// Returns if @a value is finite and > 0.
+/// @throw ParameterError "NAME must be finite, got inf" (or nan), else "NAME must be > 0,
+///        got V": the words checkParameters() gives the command line, so a bad length reads
+///        the same whichever stage refuses it.
+inline void requirePositive(double value, const std::string& name)
+{
+    if (std::isfinite(value) && value > 0.0) return;
+    std::ostringstream msg;
+    msg << name << (std::isfinite(value) ? " must be > 0, got " : " must be finite, got ") << value;
+    throw ParameterError(msg.str());
+}
+
+} // namespace parameter_checks_internal
+} // namespace nonbloppy
