@@ -190,23 +190,32 @@ LeafRole roleOf(const openvdb::FloatTree& tree, const FloatLeaf& leaf, float iso
     return allBelow ? LeafRole::Below : LeafRole::Above;
 }
 
-/// Turn off every voxel of @a leaf outside @a box, setting it to @a background. Branch-free
-/// over the 512 voxels from per-axis plane flags and the mask's 64-bit words: a shell leaf
-/// of a region is cut this way. A box test and setValueOff() per voxel took the leaf copies
-/// of a one-thread profile of the 64x benchmark input (a quarter of them shell leaves) to
-/// 1.43% of the samples; this takes them to 0.98%. Cost: O(512).
-void cutToBox(FloatLeaf& leaf, const openvdb::CoordBBox& box, float background)
+/// Turn off every voxel of @a leaf outside @a box and give it the value of the nearest voxel
+/// inside (coordinates clamped to the box, axis by axis): a shell leaf of a region is cut
+/// this way, and @a box must overlap the leaf. volumeToMesh looks at an edge only when one
+/// of its two voxels is active, so the voxels beyond a cut add no crossing of their own:
+/// filling them with the background instead made a false surface wherever the cut ran
+/// through the fluid, meshed and then thrown away. On the 64x benchmark input that was a
+/// quarter of the quads the regions made (3.10M made for 2.37M kept; 2.61M with this and
+/// the shell's tiles made leaves, see meshRegion). Cost: O(512).
+void cutToBox(FloatLeaf& leaf, const openvdb::CoordBBox& box)
 {
     constexpr int kDim = int(FloatLeaf::DIM);
     const openvdb::Coord origin = leaf.origin();
     bool inside[3][kDim];
+    int nearest[3][kDim];  // per axis, the leaf-local plane inside the box nearest to each plane
     for (int a = 0; a < 3; ++a) {
-        for (int l = 0; l < kDim; ++l) inside[a][l] = box.min()[a] <= origin[a] + l && origin[a] + l <= box.max()[a];
+        // 64-bit: the box is unbounded (INT_MIN..INT_MAX) along the axis no cut crosses.
+        const int low = int(std::max<int64_t>(0, int64_t(box.min()[a]) - origin[a]));
+        const int high = int(std::min<int64_t>(kDim - 1, int64_t(box.max()[a]) - origin[a]));
+        for (int l = 0; l < kDim; ++l) {
+            inside[a][l] = low <= l && l <= high;
+            nearest[a][l] = std::min(std::max(l, low), high);
+        }
     }
     // A row (x, y) of 8 voxels along z keeps the bits of the z-planes inside the box.
     uint64_t zBits = 0;
     for (int z = 0; z < kDim; ++z) zBits |= uint64_t(inside[2][z]) << z;
-    float* values = leaf.buffer().data();
     auto& mask = leaf.getValueMask();
     for (int x = 0; x < kDim; ++x) {
         uint64_t keepWord = 0;  // voxels (x, y, z) for all y, z: one word of the mask
@@ -214,8 +223,15 @@ void cutToBox(FloatLeaf& leaf, const openvdb::CoordBBox& box, float background)
             if (inside[0][x] && inside[1][y]) keepWord |= zBits << (y * kDim);
         }
         mask.template getWord<uint64_t>(openvdb::Index(x)) &= keepWord;
-        float* plane = values + x * kDim * kDim;
-        for (int n = 0; n < kDim * kDim; ++n) plane[n] = (keepWord >> n) & 1 ? plane[n] : background;
+    }
+    // In place: a voxel inside the box is its own nearest, so no value read is overwritten.
+    float* values = leaf.buffer().data();
+    for (int x = 0; x < kDim; ++x) {
+        for (int y = 0; y < kDim; ++y) {
+            const float* from = values + (nearest[0][x] * kDim + nearest[1][y]) * kDim;
+            float* to = values + (x * kDim + y) * kDim;
+            for (int z = 0; z < kDim; ++z) to[z] = from[nearest[2][z]];
+        }
     }
 }
 
@@ -382,9 +398,9 @@ std::vector<std::pair<int, int>> slabsOf(const std::vector<int>& keptPerLayer, s
 /// has its centroid in the region, so its cells lie at most two voxels below a face or
 /// one above it, and their corners at most two planes out either side; volumeToMesh also
 /// resolves a cell's ambiguous face from the signs of the cell across it, one plane further
-/// (correctCellSigns in tools/VolumeToMesh.h), hence three. The voxels beyond are dropped;
-/// the false crossings the cut makes give quads whose centroids lie at least half a voxel
-/// outside the region, which it never claims.
+/// (correctCellSigns in tools/VolumeToMesh.h), hence three. The voxels beyond are turned
+/// off (cutToBox()); whatever crossings the cut still makes give quads whose centroids lie
+/// at least half a voxel outside the region, which it never claims.
 constexpr int kShellPlanes = 3;
 
 /// One region of extractByRegionImpl(): a range of leaf layers along the grid's longest axis
@@ -503,21 +519,6 @@ bool extractByRegionImpl(const openvdb::FloatGrid& density, double threshold, Su
         regionGrid->setTransform(transform.copy());
         regionGrid->setGridClass(density.getGridClass());
         openvdb::FloatTree& regionTree = regionGrid->tree();
-        std::vector<uint32_t> regionLeaves;   // pieces of the region that are copied
-        for (int layer = std::max(region.slab.first - 1, 0);
-             layer <= std::min(region.slab.second, layerCount - 1); ++layer) {
-            for (uint32_t n : piecesPerLayer[size_t(layer)]) {
-                const Piece& piece = pieces[n];
-                const int bandLayer = layerOf(piece, cross);
-                if (bandLayer < region.band.first - 1 || bandLayer > region.band.second) continue;
-                if (!piece.leaf || piece.role == LeafRole::Above) {
-                    regionTree.addTile(1, piece.origin, piece.value, /*active=*/true);
-                } else {
-                    regionLeaves.push_back(n);
-                }
-            }
-        }
-        std::vector<FloatLeaf*> leafCopies(regionLeaves.size(), nullptr);  // in that order
         // The voxels a region keeps: kShellPlanes planes beyond each cut face, unbounded
         // along the third axis.
         openvdb::CoordBBox keep(openvdb::Coord(std::numeric_limits<int>::min()),
@@ -526,12 +527,37 @@ bool extractByRegionImpl(const openvdb::FloatGrid& density, double threshold, Su
         keep.max()[axis] = slabEnd + kShellPlanes - 1;
         keep.min()[cross] = bandBegin - kShellPlanes;
         keep.max()[cross] = bandEnd + kShellPlanes - 1;
+        std::vector<uint32_t> regionLeaves;   // pieces of the region that are copied
+        for (int layer = std::max(region.slab.first - 1, 0);
+             layer <= std::min(region.slab.second, layerCount - 1); ++layer) {
+            for (uint32_t n : piecesPerLayer[size_t(layer)]) {
+                const Piece& piece = pieces[n];
+                const int bandLayer = layerOf(piece, cross);
+                if (bandLayer < region.band.first - 1 || bandLayer > region.band.second) continue;
+                if (!piece.leaf || piece.role == LeafRole::Above) {
+                    const openvdb::CoordBBox box = openvdb::CoordBBox::createCube(piece.origin, dim);
+                    if (keep.isInside(box)) {
+                        regionTree.addTile(1, piece.origin, piece.value, /*active=*/true);
+                    } else {
+                        // A tile across the shell's edge: a tile there would border the
+                        // absent leaves beyond with a false surface (active voxels above
+                        // r_0 next to the background), so a leaf of its value, cut.
+                        auto* shell = new FloatLeaf(piece.origin, piece.value, /*active=*/true);
+                        cutToBox(*shell, keep);
+                        regionTree.addLeaf(shell);
+                    }
+                } else {
+                    regionLeaves.push_back(n);
+                }
+            }
+        }
+        std::vector<FloatLeaf*> leafCopies(regionLeaves.size(), nullptr);  // in that order
         tbb::parallel_for(tbb::blocked_range<size_t>(0, regionLeaves.size(), 64),
             [&](const tbb::blocked_range<size_t>& range) {
                 for (size_t k = range.begin(); k < range.end(); ++k) {
                     const FloatLeaf& leaf = *pieces[regionLeaves[k]].leaf;
                     auto* copy = new FloatLeaf(leaf);
-                    if (!keep.isInside(leaf.getNodeBoundingBox())) cutToBox(*copy, keep, tree.background());
+                    if (!keep.isInside(leaf.getNodeBoundingBox())) cutToBox(*copy, keep);
                     leafCopies[k] = copy;
                 }
             });
