@@ -504,6 +504,8 @@ bool extractByRegionImpl(const openvdb::FloatGrid& density, double threshold, Su
     std::unique_ptr<std::atomic<uint8_t>[]> used;
     std::vector<size_t> newBefore;
     std::vector<size_t> claimedBefore;
+    std::vector<size_t> poolStart;      // first quad of each polygon pool, counting all pools
+    std::vector<uint8_t> claimed;       // per quad of the region: whether it claims it
     constexpr uint32_t kNew = SeamTable::kNone;  // not in a seam table: a vertex of its own
 
     // Mesh @a region alone: its pieces plus kShellPlanes planes of the leaf layers around
@@ -623,12 +625,21 @@ bool extractByRegionImpl(const openvdb::FloatGrid& density, double threshold, Su
             return (region.firstSlab || alongSlab >= slabClaimBegin) && (region.lastSlab || alongSlab < slabClaimEnd)
                 && (region.firstBand || alongBand >= bandClaimBegin) && (region.lastBand || alongBand < bandClaimEnd);
         };
+        // Each quad tested once, the answer kept for the copy below (testing it again there
+        // was 0.9% of the stage's instructions, by callgrind).
+        poolStart.assign(poolCount + 1, 0);
+        for (size_t p = 0; p < poolCount; ++p) poolStart[p + 1] = poolStart[p] + pools[p].numQuads();
+        claimed.resize(poolStart[poolCount]);
         claimedBefore.assign(poolCount + 1, 0);
         tbb::parallel_for(tbb::blocked_range<size_t>(0, poolCount),
             [&](const tbb::blocked_range<size_t>& range) {
                 for (size_t p = range.begin(); p < range.end(); ++p) {
                     size_t count = 0;
-                    for (size_t q = 0; q < pools[p].numQuads(); ++q) count += claims(pools[p].quad(q));
+                    uint8_t* flags = claimed.data() + poolStart[p];
+                    for (size_t q = 0; q < pools[p].numQuads(); ++q) {
+                        flags[q] = claims(pools[p].quad(q));
+                        count += flags[q];
+                    }
                     claimedBefore[p + 1] = count;
                 }
             });
@@ -657,9 +668,9 @@ bool extractByRegionImpl(const openvdb::FloatGrid& density, double threshold, Su
             [&](const tbb::blocked_range<size_t>& range) {
                 for (size_t p = range.begin(); p < range.end(); ++p) {
                     size_t out = quadBase + claimedBefore[p];
+                    const uint8_t* flags = claimed.data() + poolStart[p];
                     for (size_t q = 0; q < pools[p].numQuads(); ++q) {
-                        const openvdb::Vec4I& quad = pools[p].quad(q);
-                        if (claims(quad)) mesh.quads[out++] = quad;  // region-local indices for now
+                        if (flags[q]) mesh.quads[out++] = pools[p].quad(q);  // region-local indices for now
                     }
                 }
             });
