@@ -156,14 +156,26 @@ scan_once() {  # scan_once LABEL ARGS...: one timed run of nonbloppy with ARGS o
 r0=$(awk '$1 == "threshold" {print $3}' "$out/nb_64.out")
 declare -A t_wall t_fixed
 for t in 0 1 2 4; do rm -f "$out/scan_t$t" "$out/scan_tfixed$t"; done
-rm -f "$out/scan_threads1" "$out/scan_threads2"
 for ((r = 0; r < scan_runs; ++r)); do
   for t in 0 1 2 4; do
     scan_once "t$t" --voxel-size 0.025 --radius 0.1 --blend 0.3 --iterations "$t"
     scan_once "tfixed$t" --voxel-size 0.025 --radius 0.1 --blend 0.3 --threshold "$r0" --iterations "$t"
   done
-  for threads in 1 2; do
+done
+# One and two threads in pairs of adjacent runs, the order swapped every other pair, at least
+# five pairs: the machine's slow spells last seconds, so a ratio of two medians taken from
+# different rounds strayed (2026-12-04: medians 3.02 / 1.97 s = 1.53x while the three pairs
+# gave 1.41, 1.71 and 1.72). Each pair's stage times are kept for the per-stage ratios.
+thread_pairs=$(( scan_runs < 5 ? 5 : scan_runs ))
+((quick)) && thread_pairs=1
+rm -f "$out/scan_threads1" "$out/scan_threads2" "$out/scan_threads_stages"
+for ((r = 0; r < thread_pairs; ++r)); do
+  order=(1 2); ((r % 2)) && order=(2 1)
+  for threads in "${order[@]}"; do
     scan_once "threads$threads" "${nb_args[@]}" --threads "$threads"
+    sed -n '/^timings/,$p' "$out/scan_threads$threads.out" | grep ' s ' \
+      | sed -E 's/^ +//; s/ +([0-9.]+) s .*/\t\1/' | awk -v t="$threads" -v r="$r" -F'\t' '{print t "\t" r "\t" $1 "\t" $2}' \
+      >> "$out/scan_threads_stages"
   done
 done
 say ""
@@ -179,11 +191,32 @@ for t in 0 1 2 4; do
 done
 threads1=$(median 1 "$out/scan_threads1")
 threads2=$(median 1 "$out/scan_threads2")
-say "| t = 2, --threads 1 | $threads1 |"
-say "| t = 2, --threads 2 | $threads2 |"
+say "| t = 2, --threads 1 (median of $thread_pairs) | $threads1 |"
+say "| t = 2, --threads 2 (median of $thread_pairs) | $threads2 |"
 say ""
 per_iteration() { awk -v a="$1" -v b="$2" 'BEGIN {printf "%.1f%%", 100 * (a - b) / 4 / b}'; }
-say "Each relaxation iteration costs $(per_iteration "${t_fixed[4]}" "${t_fixed[0]}") of the t = 0 run with r_0 fixed ($(per_iteration "${t_wall[4]}" "${t_wall[0]}") with r_0 calibrated for each t, which also grows the surface); two threads are $(awk -v a="$threads1" -v b="$threads2" 'BEGIN {printf "%.2fx", a / b}') faster than one."
+say "Each relaxation iteration costs $(per_iteration "${t_fixed[4]}" "${t_fixed[0]}") of the t = 0 run with r_0 fixed ($(per_iteration "${t_wall[4]}" "${t_wall[0]}") with r_0 calibrated for each t, which also grows the surface)."
+# thread_ratios NAME: one-thread over two-thread time of each pair for stage NAME ("wall":
+# the whole run), then their median.
+thread_ratios() {
+  if [ "$1" = wall ]; then
+    paste -d' ' "$out/scan_threads1" "$out/scan_threads2" | awk '{print $1 / $4}'
+  else
+    awk -F'\t' -v name="$1" '$3 == name {v[$1, $2] = $4; n = $2 + 1}
+      END {for (r = 0; r < n; ++r) if (v[2, r] > 0) print v[1, r] / v[2, r]}' "$out/scan_threads_stages"
+  fi
+}
+# median_of [FORMAT]: the median of the numbers on standard input (two decimals by default).
+median_of() { sort -g | awk -v f="${1:-%.2f}" '{v[NR] = $1} END {if (NR) printf f, (NR % 2 ? v[(NR + 1) / 2] : (v[NR / 2] + v[NR / 2 + 1]) / 2)}'; }
+say "Two threads against one, median of the $thread_pairs pairs' ratios: $(thread_ratios wall | median_of)x (pairs: $(thread_ratios wall | awk '{printf "%s%.2f", (NR > 1 ? " " : ""), $1}')). Per stage:"
+say ""
+say "| stage | 1 thread s | 2 threads s | ratio (median of pairs) |"
+say "| --- | --- | --- | --- |"
+while IFS= read -r stage; do
+  one=$(awk -F'\t' -v name="$stage" '$1 == 1 && $3 == name {print $4}' "$out/scan_threads_stages" | median_of %.3f)
+  two=$(awk -F'\t' -v name="$stage" '$1 == 2 && $3 == name {print $4}' "$out/scan_threads_stages" | median_of %.3f)
+  say "| $stage | $one | $two | $(thread_ratios "$stage" | median_of) |"
+done < <(awk -F'\t' '$1 == 1 && $2 == 0 && $3 != "total" {print $3}' "$out/scan_threads_stages")
 
 # The paper's figure: 14,272 particles, t = 2, about 15 s on a 2008 desktop. Compute time of the
 # 1x frame (24,389 particles; stages without reading and writing) scaled to 14,272 particles.
