@@ -27,16 +27,10 @@ struct PositionList
     void getPos(size_t n, openvdb::Vec3R& xyz) const { xyz = positions[n]; }
 };
 
-/// What one parallel pass over the positions finds: the first non-finite one, and the
-/// largest coordinate magnitude (which bounds the index coordinates).
-struct PositionScan
-{
-    size_t firstNonFinite;  ///< index of the first non-finite position, or size() if none
-    float maxAbs = 0.0f;    ///< largest |coordinate| of the finite positions before it
-};
+} // namespace
 
-/// PositionScan of @a positions (unspecified after a stop of @a poll).
-PositionScan scanPositions(const std::vector<openvdb::Vec3f>& positions, cancellation_internal::CancelPoll& poll)
+particle_index_internal::PositionScan
+particle_index_internal::scanPositions(const std::vector<openvdb::Vec3f>& positions, cancellation_internal::CancelPoll& poll)
 {
     return tbb::parallel_reduce(
         tbb::blocked_range<size_t>(0, positions.size()), PositionScan{positions.size()},
@@ -48,16 +42,21 @@ PositionScan scanPositions(const std::vector<openvdb::Vec3f>& positions, cancell
                     scan.firstNonFinite = n;
                     return scan;
                 }
-                scan.maxAbs = std::max({scan.maxAbs, std::abs(p[0]), std::abs(p[1]), std::abs(p[2])});
+                scan.min = openvdb::math::minComponent(scan.min, p);
+                scan.max = openvdb::math::maxComponent(scan.max, p);
             }
             return scan;
         },
         [](const PositionScan& a, const PositionScan& b) {
-            return PositionScan{std::min(a.firstNonFinite, b.firstNonFinite), std::max(a.maxAbs, b.maxAbs)};
+            // Positions past the first non-finite one do not count: each side only holds
+            // positions before its own first, and a's range precedes b's.
+            if (a.firstNonFinite < b.firstNonFinite) return a;
+            PositionScan joined{b.firstNonFinite};
+            joined.min = openvdb::math::minComponent(a.min, b.min);
+            joined.max = openvdb::math::maxComponent(a.max, b.max);
+            return joined;
         });
 }
-
-} // namespace
 
 ParticleIndex::ParticleIndex() : mImpl(new Impl)
 {
@@ -94,15 +93,15 @@ ParticleIndex ParticleIndex::build(std::vector<openvdb::Vec3f> positions, double
     cancellation_internal::CancelPoll poll(interrupter, "index particles");
     // One parallel pass: the serial loop for the largest coordinate it replaced took 7 ms of
     // the 64x benchmark input's 0.09 s stage at two threads.
-    const PositionScan scan = scanPositions(positions, poll);
+    const particle_index_internal::PositionScan scan = particle_index_internal::scanPositions(positions, poll);
     poll.throwIfStopped();
     if (scan.firstNonFinite < positions.size()) {
         throw ParameterError(particle_index_internal::nonFinitePositionMessage(scan.firstNonFinite));
     }
     // Index coordinates are 32-bit: refuse positions whose cell number would overflow.
-    if (double(scan.maxAbs) / cellSize > 1.0e9) {
+    if (double(scan.maxAbs()) / cellSize > 1.0e9) {
         std::ostringstream msg;
-        msg << "particle coordinates up to " << double(scan.maxAbs)
+        msg << "particle coordinates up to " << double(scan.maxAbs())
             << " are too far from the origin for a cell size of " << cellSize << " (32-bit index space)";
         throw ParameterError(msg.str());
     }

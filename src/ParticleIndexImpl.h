@@ -12,7 +12,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <string>
+#include <vector>
 
 namespace nonbloppy {
 
@@ -28,7 +30,28 @@ struct ParticleIndex::Impl
     openvdb::CoordBBox leafBounds;
 };
 
+namespace cancellation_internal { class CancelPoll; }
+
 namespace particle_index_internal {
+
+/// What one parallel pass over positions finds: the first non-finite one, and the box of the
+/// finite positions before it.
+struct PositionScan
+{
+    size_t firstNonFinite;  ///< index of the first non-finite position, or size() if none
+    openvdb::Vec3f min{std::numeric_limits<float>::max()};     ///< per axis, over the finite ones
+    openvdb::Vec3f max{-std::numeric_limits<float>::max()};    ///< (min > max when there are none)
+
+    /// The largest |coordinate| (0 when there are no finite positions).
+    float maxAbs() const
+    {
+        return min[0] > max[0] ? 0.0f : std::max({-min[0], -min[1], -min[2], max[0], max[1], max[2]});
+    }
+};
+
+/// PositionScan of @a positions, in parallel (unspecified after a stop of @a poll, which is
+/// asked every 4096 positions of a task). Cost: O(n), reads each position once.
+PositionScan scanPositions(const std::vector<openvdb::Vec3f>& positions, cancellation_internal::CancelPoll& poll);
 
 using IndexTree = openvdb::tools::PointIndexTree;
 using IndexLeaf = IndexTree::LeafNodeType;

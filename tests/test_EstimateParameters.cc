@@ -10,6 +10,9 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <limits>
+
 using namespace nonbloppy;
 using nonbloppy_test::latticeParticles;
 
@@ -36,6 +39,19 @@ TEST(EstimateParameters, AnInfiniteCoordinateIsNamedAsSuch)
         EXPECT_EQ(nonbloppy_test::messageOf<ParameterError>([&] { estimateSpacing(positions); }), message);
         EXPECT_EQ(nonbloppy_test::messageOf<ParameterError>([&] { buildSurface(positions); }), message);
     }
+}
+
+TEST(EstimateParameters, TheFirstOfSeveralNonFinitePositionsIsNamed)
+{
+    // The spacing's first guess scans the positions in parallel pieces: the first bad one
+    // is named wherever the pieces start, as the serial loop did.
+    std::vector<openvdb::Vec3f> many(200000);
+    for (size_t n = 0; n < many.size(); ++n) many[n] = openvdb::Vec3f(float(n % 100), float(n / 100 % 100), float(n / 10000));
+    for (size_t n : {size_t(199999), size_t(150000), size_t(64123), size_t(100001)}) {
+        many[n][n % 3] = n % 2 ? std::nanf("") : -std::numeric_limits<float>::infinity();
+    }
+    EXPECT_EQ(nonbloppy_test::messageOf<ParameterError>([&] { estimateSpacing(many); }),
+              "non-finite position of particle 64123");
 }
 
 TEST(EstimateParameters, LengthsWhoseSquareOverflowsAFloatAreRefused)
