@@ -14,6 +14,7 @@
 #include <nonbloppy/Error.h>
 
 #include "AtomicFile.h"
+#include "AttributeNames.h"
 #include "FileFormats.h"
 #include "PolygonIndices.h"
 
@@ -269,26 +270,28 @@ writeObj(const SurfaceMesh& mesh, const PolygonView& polygons, std::ostream& os)
     out.flush();
 }
 
-/// An attribute name as one header word: whitespace and non-printable bytes become '_'.
-std::string
-headerName(const std::string& name)
+/// The names the writer of extension @a ext (lower case, with the dot) gives the mesh's
+/// attributes, one per attribute in order: in the particle writers' alphabet, distinct from
+/// one another and from the format's own columns (PLY: x, y, z and, with normals, nx, ny,
+/// nz; VTK: the NORMALS array "normals"). Empty for `.obj`, which has no place for them.
+std::vector<std::string>
+attributeNamesFor(const SurfaceMesh& mesh, const std::string& ext)
 {
-    std::string word = name.empty() ? std::string("attribute") : name;
-    for (char& ch : word) {
-        if (static_cast<unsigned char>(ch) <= ' ' || static_cast<unsigned char>(ch) >= 0x7f) ch = '_';
+    using namespace attribute_names_internal;
+    std::vector<NamedAttribute> attributes;
+    for (const MeshAttribute& a : mesh.attributes) attributes.emplace_back(a.name, a.components);
+    const bool withNormals = !mesh.normals.empty();
+    if (ext == ".ply") {
+        return uniqueNames(attributes, headerWord, plyColumns, [withNormals](const std::string& column) {
+            return column == "x" || column == "y" || column == "z"
+                || (withNormals && (column == "nx" || column == "ny" || column == "nz"));
+        });
     }
-    return word;
-}
-
-/// PLY property names of component @a c of @a attribute: "velocity_x" for 3-vectors,
-/// "density" for scalars, "name_<c>" otherwise.
-std::string
-plyPropertyName(const MeshAttribute& attribute, int c)
-{
-    const std::string base = headerName(attribute.name);
-    if (attribute.components == 1) return base;
-    if (attribute.components == 3) return base + "_" + "xyz"[c];
-    return base + "_" + std::to_string(c);
+    if (ext == ".vtk") {
+        return uniqueNames(attributes, headerWord, wholeColumn,
+                           [withNormals](const std::string& column) { return withNormals && column == "normals"; });
+    }
+    return std::vector<std::string>(mesh.attributes.size());
 }
 
 void
@@ -310,9 +313,10 @@ writePly(const SurfaceMesh& mesh, const PolygonView& polygons, const std::string
     out.text("element vertex " + std::to_string(mesh.points.size()) + "\n");
     out.text("property float x\nproperty float y\nproperty float z\n");
     if (withNormals) out.text("property float nx\nproperty float ny\nproperty float nz\n");
-    for (const MeshAttribute& attribute : mesh.attributes) {
-        for (int c = 0; c < attribute.components; ++c) {
-            out.text("property float " + plyPropertyName(attribute, c) + "\n");
+    const std::vector<std::string> names = attributeNamesFor(mesh, ".ply");
+    for (size_t i = 0; i < mesh.attributes.size(); ++i) {
+        for (const std::string& column : attribute_names_internal::plyColumns(names[i], mesh.attributes[i].components)) {
+            out.text("property float " + column + "\n");
         }
     }
     out.text("element face " + std::to_string(polygons.polygonCount()) + "\n");
@@ -359,8 +363,10 @@ writeVtk(const SurfaceMesh& mesh, const PolygonView& polygons, const std::string
         out.text("\n");
     }
     // Vectors as VECTORS, 1, 2 and 4 components as SCALARS, anything else as a FIELD array.
-    for (const MeshAttribute& attribute : mesh.attributes) {
-        const std::string name = headerName(attribute.name);
+    const std::vector<std::string> names = attributeNamesFor(mesh, ".vtk");
+    for (size_t i = 0; i < mesh.attributes.size(); ++i) {
+        const MeshAttribute& attribute = mesh.attributes[i];
+        const std::string& name = names[i];
         if (attribute.components == 3) {
             out.text("VECTORS " + name + " float\n");
         } else if (attribute.components <= 4) {
@@ -377,10 +383,10 @@ writeVtk(const SurfaceMesh& mesh, const PolygonView& polygons, const std::string
     out.flush();
 }
 
-} // namespace
-
-void
-writeMesh(const SurfaceMesh& mesh, const std::string& path, const MeshWriteSettings& settings)
+/// The lower-case extension of @a path, which must be one writeMesh() writes.
+/// @throw FileError naming the extension (or its absence) and @a path
+std::string
+requireMeshOutput(const std::string& path)
 {
     const std::string ext = io_internal::lowerExtension(path);
     if (ext.empty()) {
@@ -391,6 +397,21 @@ writeMesh(const SurfaceMesh& mesh, const std::string& path, const MeshWriteSetti
         throw FileError("unknown mesh file extension '" + ext + "' (" + path +
             "); expected .obj, .ply or .vtk");
     }
+    return ext;
+}
+
+} // namespace
+
+std::vector<std::string>
+writtenAttributeNames(const SurfaceMesh& mesh, const std::string& path)
+{
+    return attributeNamesFor(mesh, requireMeshOutput(path));
+}
+
+void
+writeMesh(const SurfaceMesh& mesh, const std::string& path, const MeshWriteSettings& settings)
+{
+    const std::string ext = requireMeshOutput(path);
     validateMesh(mesh, path);
     const PolygonView polygons{mesh, settings.keepQuads};
     // A lower bound of every format's size: binary positions and corner indices.

@@ -10,6 +10,7 @@
 #include <nonbloppy/WriteVdb.h>
 
 #include "AtomicFile.h"
+#include "AttributeNames.h"
 #include "FileFormats.h"
 #include "OpenVdbScale.h"
 
@@ -32,36 +33,12 @@ namespace nonbloppy {
 
 namespace {
 
+using attribute_names_internal::headerWord;
+using attribute_names_internal::NamedAttribute;
+using attribute_names_internal::plyColumns;
+using attribute_names_internal::vdbWord;
+using attribute_names_internal::wholeColumn;
 using io_internal::lowerExtension;
-
-/// An attribute name as one header word.
-std::string
-headerWord(const std::string& name)
-{
-    std::string word = name.empty() ? std::string("attribute") : name;
-    for (char& ch : word) {
-        if (static_cast<unsigned char>(ch) <= ' ' || static_cast<unsigned char>(ch) >= 0x7f
-            || ch == ',' || ch == '"' || ch == '<' || ch == '>' || ch == '&') {
-            ch = '_';
-        }
-    }
-    return word;
-}
-
-/// An attribute name in OpenVDB's alphabet (letters, digits, '_', '|', ':'), which
-/// appendAttribute() enforces by throwing.
-std::string
-vdbWord(const std::string& name)
-{
-    std::string word = name.empty() ? std::string("attribute") : name;
-    for (char& ch : word) {
-        if (!std::isalnum(static_cast<unsigned char>(ch)) && ch != '_' && ch != '|' && ch != ':') ch = '_';
-    }
-    return word;
-}
-
-/// The columns (or arrays) an attribute called @a base is written as, in one format.
-using ColumnsOf = std::function<std::vector<std::string>(const std::string& base, int components)>;
 
 /// Whether a reader takes the column @a name for positions: x, y, z or P as they are.
 bool
@@ -77,58 +54,6 @@ bool
 isCsvPositionName(const std::string& name)
 {
     return io_internal::tablePositionAxis(name) >= 0;
-}
-
-/// The names the attributes are written under: @a word of each name (the format's
-/// alphabet), then, if any column it gives is taken (by the positions: @a isPosition, or
-/// by another attribute), the first of word_2, word_3, ... whose columns are all free.
-/// Names the format takes as they are claim theirs first, in order; renamed ones follow.
-/// Renaming "a b" to "a_b" beside an attribute "a_b" gave two columns of one name, which
-/// nonbloppy's own readers then refused ("duplicate column").
-std::vector<std::string>
-uniqueNames(const ParticleSet& particles, std::string (*word)(const std::string&), const ColumnsOf& columnsOf,
-            bool (*isPosition)(const std::string&) = isPositionName)
-{
-    std::set<std::string> taken;
-    std::vector<std::string> names(particles.attributes.size());
-    for (const bool renamed : {false, true}) {
-        for (size_t i = 0; i < particles.attributes.size(); ++i) {
-            const ParticleAttribute& a = particles.attributes[i];
-            const std::string base = word(a.name);
-            if ((base != a.name) != renamed) continue;
-            std::string name = base;
-            for (int suffix = 2;; ++suffix) {
-                const std::vector<std::string> columns = columnsOf(name, a.components);
-                if (std::none_of(columns.begin(), columns.end(),
-                                 [&](const std::string& c) { return taken.count(c) || isPosition(c); })) {
-                    taken.insert(columns.begin(), columns.end());
-                    break;
-                }
-                name = base + "_" + std::to_string(suffix);
-            }
-            names[i] = name;
-        }
-    }
-    return names;
-}
-
-/// One column per attribute (VTK and VTU arrays hold all components).
-std::vector<std::string>
-wholeColumn(const std::string& base, int)
-{
-    return {base};
-}
-
-/// PLY properties: name, name_x/_y/_z, or name_<c>.
-std::vector<std::string>
-plyColumns(const std::string& base, int components)
-{
-    if (components == 1) return {base};
-    std::vector<std::string> columns;
-    for (int c = 0; c < components; ++c) {
-        columns.push_back(components == 3 ? base + "_" + "xyz"[c] : base + "_" + std::to_string(c));
-    }
-    return columns;
 }
 
 /// CSV columns: name, or name:<c> as ParaView writes them.
@@ -149,6 +74,36 @@ vdbColumns(const std::string& base, int components)
     std::vector<std::string> columns;
     for (int c = 0; c < components; ++c) columns.push_back(base + "_" + std::to_string(c));
     return columns;
+}
+
+/// The lower-case extension of @a path, which must be one writeParticles() writes.
+/// @throw FileError naming the extension (or its absence) and @a path
+std::string
+requireParticleOutput(const std::string& path)
+{
+    const std::string ext = lowerExtension(path);
+    if (!isParticleOutputFile(path)) {
+        throw FileError((ext.empty() ? "particle file name has no extension ("
+                                     : "unknown particle output extension '" + ext + "' (") +
+                        path + "); expected .ply, .vtk, .vtu, .xyz, .csv or .vdb");
+    }
+    return ext;
+}
+
+/// The names the writer of extension @a ext (lower case, with the dot) gives the
+/// attributes, one per attribute in order (attribute_names_internal::uniqueNames(); a
+/// name nonbloppy's readers take for positions is taken); empty for `.xyz`, which drops them.
+std::vector<std::string>
+namesForExtension(const ParticleSet& particles, const std::string& ext)
+{
+    std::vector<NamedAttribute> attributes;
+    for (const ParticleAttribute& a : particles.attributes) attributes.emplace_back(a.name, a.components);
+    using attribute_names_internal::uniqueNames;
+    if (ext == ".ply") return uniqueNames(attributes, headerWord, plyColumns, isPositionName);
+    if (ext == ".vtk" || ext == ".vtu") return uniqueNames(attributes, headerWord, wholeColumn, isPositionName);
+    if (ext == ".csv") return uniqueNames(attributes, headerWord, csvColumns, isCsvPositionName);
+    if (ext == ".vdb") return uniqueNames(attributes, vdbWord, vdbColumns, isPositionName);
+    return std::vector<std::string>(particles.attributes.size());
 }
 
 void
@@ -216,7 +171,7 @@ writePly(const ParticleSet& particles, std::ostream& os)
     std::string header = "ply\nformat binary_little_endian 1.0\ncomment written by nonbloppy\n";
     header += "element vertex " + std::to_string(particles.size()) + "\n";
     header += "property float x\nproperty float y\nproperty float z\n";
-    const std::vector<std::string> names = uniqueNames(particles, headerWord, plyColumns);
+    const std::vector<std::string> names = namesForExtension(particles, ".ply");
     for (size_t i = 0; i < particles.attributes.size(); ++i) {
         const ParticleAttribute& a = particles.attributes[i];
         for (const std::string& column : plyColumns(names[i], a.components)) {
@@ -282,7 +237,7 @@ writeVtk(const ParticleSet& particles, std::ostream& os)
     if (!particles.attributes.empty()) {
         out += "POINT_DATA " + std::to_string(n) + "\nFIELD FieldData " +
                std::to_string(particles.attributes.size()) + "\n";
-        const std::vector<std::string> names = uniqueNames(particles, headerWord, wholeColumn);
+        const std::vector<std::string> names = namesForExtension(particles, ".vtk");
         for (size_t i = 0; i < particles.attributes.size(); ++i) {
             const ParticleAttribute& a = particles.attributes[i];
             out += names[i] + " " + std::to_string(a.components) + " " + std::to_string(n) +
@@ -341,7 +296,7 @@ writeVtu(const ParticleSet& particles, std::ostream& os)
     array("Int64", "offsets", 1, offsets);
     array("UInt8", "types", 1, types);
     xml += "      </Cells>\n      <PointData>\n";
-    const std::vector<std::string> names = uniqueNames(particles, headerWord, wholeColumn);
+    const std::vector<std::string> names = namesForExtension(particles, ".vtu");
     for (size_t i = 0; i < particles.attributes.size(); ++i) {
         const ParticleAttribute& a = particles.attributes[i];
         std::string bytes;
@@ -377,7 +332,7 @@ void
 writeCsv(const ParticleSet& particles, std::ostream& os)
 {
     std::string out = "x,y,z";
-    const std::vector<std::string> names = uniqueNames(particles, headerWord, csvColumns, isCsvPositionName);
+    const std::vector<std::string> names = namesForExtension(particles, ".csv");
     for (size_t i = 0; i < particles.attributes.size(); ++i) {
         for (const std::string& column : csvColumns(names[i], particles.attributes[i].components)) out += "," + column;
     }
@@ -479,7 +434,7 @@ makePointDataGrid(const ParticleSet& particles, double voxelSize)
     auto grid = openvdb::points::createPointDataGrid<openvdb::points::NullCodec, PointDataGrid>(
         *index, wrapper, *transform);
     grid->setName("points");
-    const std::vector<std::string> names = uniqueNames(particles, vdbWord, vdbColumns);
+    const std::vector<std::string> names = namesForExtension(particles, ".vdb");
     for (size_t i = 0; i < particles.attributes.size(); ++i) {
         const ParticleAttribute& a = particles.attributes[i];
         if (a.size() != particles.size()) continue;
@@ -518,12 +473,7 @@ makePointDataGrid(const ParticleSet& particles, double voxelSize)
 void
 writeParticles(const ParticleSet& particles, const std::string& path, const ParticleWriteSettings& settings)
 {
-    const std::string ext = lowerExtension(path);
-    if (!isParticleOutputFile(path)) {
-        throw FileError((ext.empty() ? "particle file name has no extension ("
-                                     : "unknown particle output extension '" + ext + "' (") +
-                        path + "); expected .ply, .vtk, .vtu, .xyz, .csv or .vdb");
-    }
+    const std::string ext = requireParticleOutput(path);
     requireSizes(particles, path);
     if (ext == ".vdb") {
         openvdb::MetaMap metadata;
@@ -538,6 +488,13 @@ writeParticles(const ParticleSet& particles, const std::string& path, const Part
         else if (ext == ".xyz") writeXyz(particles, os);
         else writeCsv(particles, os);
     }, /*expectedBytes=*/settings.directIo ? particles.positions.size() * sizeof(openvdb::Vec3f) : 0);
+}
+
+std::vector<std::string>
+writtenAttributeNames(const ParticleSet& particles, const std::string& path)
+{
+    const std::string ext = requireParticleOutput(path);
+    return namesForExtension(particles, ext);
 }
 
 bool

@@ -257,6 +257,63 @@ TEST_F(WriteMeshTest, BatchedParallelEncodingMatchesTheFormatAtAnyThreadCount)
     EXPECT_EQ(back.triangles.back(), openvdb::Vec3I(mesh.quads.back()[0], mesh.quads.back()[2], mesh.quads.back()[3]));
 }
 
+TEST_F(WriteMeshTest, AttributeNamesStayDistinctFromEachOtherAndFromTheFormatsColumns)
+{
+    // Before, names only lost their whitespace: "a b" beside "a_b" gave two properties
+    // a_b, and an attribute "nx" a second nx beside the normals, which readers resolve
+    // either way. Now they are written as the particle writers write them.
+    SurfaceMesh mesh = mixedMesh();  // with normals
+    const auto add = [&](const std::string& name, int components, float first) {
+        nonbloppy::MeshAttribute a;
+        a.name = name;
+        a.components = components;
+        for (size_t k = 0; k < mesh.points.size() * size_t(components); ++k) a.values.push_back(first + float(k));
+        mesh.attributes.push_back(a);
+    };
+    add("a b", 1, 10.0f);
+    add("a_b", 1, 20.0f);
+    add("nx", 1, 30.0f);
+    add("x", 3, 40.0f);      // x_x, x_y, x_z: free
+    add("y", 1, 60.0f);      // the positions' y
+    add("normals", 1, 70.0f);
+    add("", 1, 80.0f);
+    const std::vector<std::string> ply{"a_b_2", "a_b", "nx_2", "x", "y_2", "normals", "attribute"};
+    const std::vector<std::string> vtk{"a_b_2", "a_b", "nx", "x", "y", "normals_2", "attribute"};
+    EXPECT_EQ(nonbloppy::writtenAttributeNames(mesh, path("m.ply")), ply);
+    EXPECT_EQ(nonbloppy::writtenAttributeNames(mesh, path("m.vtk")), vtk);
+    EXPECT_EQ(nonbloppy::writtenAttributeNames(mesh, path("m.obj")), std::vector<std::string>(7, ""));
+    EXPECT_EQ(messageOf<FileError>([&] { nonbloppy::writtenAttributeNames(mesh, path("m.stl")); }),
+              "unknown mesh file extension '.stl' (" + path("m.stl") + "); expected .obj, .ply or .vtk");
+
+    writeMesh(mesh, path("m.ply"));
+    const std::string bytes = readBytes(path("m.ply"));
+    EXPECT_NE(bytes.find("property float nx\nproperty float ny\nproperty float nz\nproperty float a_b_2\n"
+                         "property float a_b\nproperty float nx_2\nproperty float x_x\nproperty float x_y\n"
+                         "property float x_z\nproperty float y_2\nproperty float normals\n"
+                         "property float attribute\nelement face"), std::string::npos);
+    // Read back as particles: every name once, each with its own values.
+    const nonbloppy::ParticleSet back = nonbloppy::readParticles(path("m.ply"));
+    ASSERT_EQ(back.size(), mesh.points.size());
+    for (size_t i = 0; i < ply.size(); ++i) {
+        if (mesh.attributes[i].components != 1) continue;
+        const nonbloppy::ParticleAttribute* a = back.findAttribute(ply[i]);
+        ASSERT_NE(a, nullptr) << ply[i];
+        for (size_t n = 0; n < back.size(); ++n) EXPECT_EQ(float(a->asDouble(n)), mesh.attributes[i].values[n]) << ply[i];
+    }
+    EXPECT_EQ(back.positions[1], mesh.points[1]);
+
+    writeMesh(mesh, path("m.vtk"));
+    const std::string vtkBytes = readBytes(path("m.vtk"));
+    EXPECT_NE(vtkBytes.find("NORMALS normals float\n"), std::string::npos);
+    EXPECT_NE(vtkBytes.find("SCALARS normals_2 float 1\n"), std::string::npos);
+    EXPECT_NE(vtkBytes.find("SCALARS a_b_2 float 1\n"), std::string::npos);
+    EXPECT_NE(vtkBytes.find("VECTORS x float\n"), std::string::npos);
+
+    // Without normals, nx, ny, nz are free in PLY.
+    mesh.normals.clear();
+    EXPECT_EQ(nonbloppy::writtenAttributeNames(mesh, path("m.ply"))[2], "nx");
+}
+
 TEST_F(WriteMeshTest, ObjTextIsExact)
 {
     SurfaceMesh mesh;

@@ -313,6 +313,8 @@ TEST_F(CliFormatsTest, RenamedAttributesStayDistinctAndReadBack)
         {".vdb", {"a_b_2", "a_b", "x_2", "my_attr", "X", "P_2"}}};
     for (const auto& [ext, names] : expected) {
         const std::string file = path("renamed" + ext);
+        // What the writer tells a caller beforehand is what it writes.
+        EXPECT_EQ(nonbloppy::writtenAttributeNames(particles, file), names) << ext;
         nonbloppy::writeParticles(particles, file);
         const ParticleSet back = nonbloppy::readParticles(file);
         for (size_t i = 0; i < names.size(); ++i) {
@@ -326,6 +328,58 @@ TEST_F(CliFormatsTest, RenamedAttributesStayDistinctAndReadBack)
             }
         }
     }
+}
+
+TEST_F(CliFormatsTest, RenamedAttributesAreNamedInAWarning)
+{
+    // .xyz drops attributes (named by its own warning); an unknown extension is the writer's
+    // error. Then the command line: attributes renamed for the output format got no word.
+    ParticleSet two;
+    two.positions = {{0.0f, 0.0f, 0.0f}, {1.0f, 0.0f, 0.0f}};
+    ParticleAttribute a;
+    a.name = "a b";
+    a.type = nonbloppy::ScalarType::Float32;
+    a.bytes.resize(2 * sizeof(float));
+    two.attributes.push_back(a);
+    EXPECT_EQ(nonbloppy::writtenAttributeNames(two, path("p.xyz")), std::vector<std::string>{""});
+    try {
+        nonbloppy::writtenAttributeNames(two, path("p.obj"));
+        ADD_FAILURE() << "no exception";
+    } catch (const nonbloppy::FileError& e) {
+        EXPECT_EQ(std::string(e.what()), "unknown particle output extension '.obj' (" + path("p.obj")
+                                             + "); expected .ply, .vtk, .vtu, .xyz, .csv or .vdb");
+    }
+
+    // A 6x6x6 block (spacing 0.05) with attributes "a b", a_b and nx.
+    std::string csv = "x,y,z,a b,a_b,nx\n";
+    for (int i = 0; i < 6; ++i)
+        for (int j = 0; j < 6; ++j)
+            for (int k = 0; k < 6; ++k)
+                csv += std::to_string(0.05 * i) + "," + std::to_string(0.05 * j) + "," + std::to_string(0.05 * k)
+                       + "," + std::to_string(i) + "," + std::to_string(j) + "," + std::to_string(k) + "\n";
+    const std::string source = path("named.csv");
+    writeText(source, csv);
+
+    RunResult r = run("convert -q " + quote(source) + " " + quote(path("c.ply")));
+    EXPECT_EQ(r.exitCode, 0);
+    EXPECT_EQ(r.err, "nonbloppy: warning: attribute 'a b' is written to " + path("c.ply") + " as 'a_b_2'\n");
+    r = run("convert -q " + quote(source) + " " + quote(path("c.vtu")));
+    EXPECT_EQ(r.err, "nonbloppy: warning: attribute 'a b' is written to " + path("c.vtu") + " as 'a_b_2'\n");
+
+    // On a mesh, nx also meets the normals' property (before: two properties "nx").
+    r = run("mesh -q " + quote(source) + " -o " + quote(path("m.ply")) + " --attributes all");
+    EXPECT_EQ(r.exitCode, 0);
+    EXPECT_EQ(r.err, "nonbloppy: warning: attribute 'a b' is written to " + path("m.ply") + " as 'a_b_2'\n"
+                     "nonbloppy: warning: attribute 'nx' is written to " + path("m.ply") + " as 'nx_2'\n");
+    const std::string header = readText(path("m.ply")).substr(0, 400);
+    EXPECT_NE(header.find("property float nz\nproperty float a_b_2\nproperty float a_b\nproperty float nx_2\n"
+                          "element face"), std::string::npos) << header;
+    // Only the renamed ones are named; OBJ keeps its own warning.
+    r = run("mesh -q " + quote(source) + " -o " + quote(path("m2.ply")) + " --attributes a_b");
+    EXPECT_EQ(r.err, "");
+    r = run("mesh -q " + quote(source) + " -o " + quote(path("m.obj")) + " --attributes all");
+    EXPECT_EQ(r.err, "nonbloppy: warning: OBJ cannot store vertex attributes; write .ply or .vtk to keep "
+                     "--attributes\n");
 }
 
 TEST_F(CliFormatsTest, InspectOfAPointsVdbCountsItsPointsAndNamesItsAttributes)

@@ -9,6 +9,7 @@
 #include <nonbloppy/Mesh.h>
 
 #include <string>
+#include <vector>
 
 namespace nonbloppy {
 
@@ -37,7 +38,11 @@ struct MeshWriteSettings
 /// Per-vertex attributes (mesh.attributes, see interpolateAttributes()) are written as PLY
 /// float vertex properties ("density"; a 3-vector "velocity" as velocity_x, velocity_y,
 /// velocity_z) and as VTK POINT_DATA (VECTORS for 3 components, SCALARS for 1, 2 or 4, a
-/// FIELD array otherwise). OBJ has no place for them: they are left out.
+/// FIELD array otherwise). OBJ has no place for them: they are left out. Names are written
+/// as writeParticles() writes them (whitespace, control and non-ASCII bytes, ',', '"', '<',
+/// '>' and '&' become '_') and kept distinct from one another and from the format's own
+/// columns (PLY x, y, z and, with normals, nx, ny, nz; the VTK normals array "normals"):
+/// such a name gets _2, _3, ... (writtenAttributeNames() tells which).
 /// Cost: one pass; output is formatted into multi-megabyte chunks.
 /// Thread-safety: reentrant; concurrent calls must write different paths.
 /// @throw FileError for an unknown extension or a file that cannot be written, e.g.
@@ -46,6 +51,14 @@ struct MeshWriteSettings
 ///        mesh.normals is non-empty but not one per vertex.
 NONBLOPPY_API void writeMesh(const SurfaceMesh& mesh, const std::string& path,
                const MeshWriteSettings& settings = MeshWriteSettings());
+
+/// The names writeMesh() gives @a mesh's attributes in @a path's format, one per attribute
+/// in order (a PLY vector's properties add _x, _y, _z, other multi-component ones _<c>);
+/// empty strings for `.obj`, which leaves attributes out. Compare with
+/// MeshAttribute::name to tell a caller what was renamed.
+/// Cost: O(A log A) for A attributes; reads no vertex data.
+/// @throw FileError for an unknown extension, as writeMesh().
+NONBLOPPY_API std::vector<std::string> writtenAttributeNames(const SurfaceMesh& mesh, const std::string& path);
 
 /// True if @a path has an extension writeMesh() understands.
 NONBLOPPY_API bool isMeshFile(const std::string& path);

@@ -12,6 +12,7 @@
 #include <openvdb/openvdb.h>
 
 #include <string>
+#include <vector>
 
 namespace nonbloppy {
 
@@ -49,6 +50,15 @@ struct ParticleWriteSettings
 ///        above 2^63 - 1.
 NONBLOPPY_API void writeParticles(const ParticleSet& particles, const std::string& path,
                                   const ParticleWriteSettings& settings = ParticleWriteSettings());
+
+/// The names writeParticles() gives @a particles' attributes in @a path's format, one per
+/// attribute in order (see the renaming rules above; a multi-component attribute's columns
+/// are derived from its name as described per format); empty strings for `.xyz`, which
+/// drops attributes. Compare with ParticleAttribute::name to tell a caller what was renamed.
+/// Cost: O(A log A) for A attributes; reads no particle data.
+/// @throw FileError for an unknown extension, as writeParticles().
+NONBLOPPY_API std::vector<std::string> writtenAttributeNames(const ParticleSet& particles,
+                                                             const std::string& path);
 
 /// True if @a path has an extension writeParticles() understands.
 NONBLOPPY_API bool isParticleOutputFile(const std::string& path);

@@ -19,6 +19,7 @@
 #include <functional>
 #include <sstream>
 #include <string>
+#include <vector>
 
 namespace nonbloppy_tool {
 
@@ -48,6 +49,13 @@ Command setupConvertCommand(CLI::App& parent);
 
 /// "nonbloppy 0.1.0 (OpenVDB 10.0.1)".
 std::string versionLine();
+
+/// Warn on stderr, one line per attribute, where a writer renamed one for @a path's format
+/// (@a original[i] written as @a written[i]; an empty written name is an attribute dropped,
+/// which the caller reports itself): "nonbloppy: warning: attribute 'a b' is written to
+/// out.ply as 'a_b_2'". Defined in main.cc.
+void warnRenamedAttributes(const std::vector<std::string>& original, const std::vector<std::string>& written,
+                           const std::string& path);
 
 /// A number as a person reads it: shortest of %g with 6 significant digits ("0.05", "1.5").
 /// This is also how the library spells numbers in its parameter errors.

@@ -15,6 +15,7 @@
 #include <iostream>
 #include <memory>
 #include <string>
+#include <vector>
 
 namespace nonbloppy_tool {
 
@@ -57,6 +58,11 @@ int runConvert(const ConvertOptions& o)
         for (const auto& a : particles.attributes) names += (names.empty() ? "" : ", ") + a.name;
         std::cerr << "nonbloppy: warning: .xyz holds positions only; attributes dropped: " << names
                   << std::endl;
+    }
+    if (!positionsOnly) {
+        std::vector<std::string> original;
+        for (const auto& a : particles.attributes) original.push_back(a.name);
+        warnRenamedAttributes(original, nonbloppy::writtenAttributeNames(particles, o.output), o.output);
     }
     nonbloppy::ParticleWriteSettings settings;
     settings.directIo = !o.noDirectIo;

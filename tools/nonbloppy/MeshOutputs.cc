@@ -9,6 +9,7 @@
 #include <nonbloppy/Error.h>
 #include <nonbloppy/InterpolateAttributes.h>
 #include <nonbloppy/MeshToLevelSet.h>
+#include <nonbloppy/WriteMesh.h>
 #include <nonbloppy/WriteParticles.h>
 
 #include <atomic>
@@ -37,6 +38,7 @@ std::vector<std::string> splitNames(const std::string& list)
 }
 
 std::atomic<bool> gObjWarningPrinted{false};
+std::atomic<bool> gRenameWarningPrinted{false};
 
 } // namespace
 
@@ -68,6 +70,12 @@ void addSurfaceAttributes(nonbloppy::SurfaceResult& result, const nonbloppy::Par
     if (ext == ".obj" && !result.mesh.attributes.empty() && !gObjWarningPrinted.exchange(true)) {
         std::cerr << "nonbloppy: warning: OBJ cannot store vertex attributes; write .ply or .vtk "
                      "to keep --attributes" << std::endl;
+    }
+    // Once per run: the frames of a sequence carry the same attributes.
+    if (ext != ".obj" && !result.mesh.attributes.empty() && !gRenameWarningPrinted.exchange(true)) {
+        std::vector<std::string> original;
+        for (const auto& a : result.mesh.attributes) original.push_back(a.name);
+        warnRenamedAttributes(original, nonbloppy::writtenAttributeNames(result.mesh, meshPath), meshPath);
     }
 }
 

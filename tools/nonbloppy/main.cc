@@ -38,6 +38,20 @@ std::string versionLine()
            + openvdb::getLibraryVersionString() + ")";
 }
 
+void warnRenamedAttributes(const std::vector<std::string>& original, const std::vector<std::string>& written,
+                           const std::string& path)
+{
+    for (size_t i = 0; i < original.size() && i < written.size(); ++i) {
+        if (written[i].empty() || written[i] == original[i]) continue;
+        std::string shown = original[i];  // control bytes would act on the terminal
+        for (char& c : shown) {
+            if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) c = '?';
+        }
+        std::cerr << "nonbloppy: warning: attribute '" << shown << "' is written to " << path << " as '"
+                  << written[i] << "'" << std::endl;
+    }
+}
+
 } // namespace nonbloppy_tool
 
 namespace {

@@ -1,0 +1,82 @@
+// SPDX-License-Identifier: Apache-2.0
+#include "AttributeNames.h"
+
+#include <algorithm>
+#include <cctype>
+#include <set>
+
+namespace nonbloppy {
+namespace attribute_names_internal {
+
+std::string
+headerWord(const std::string& name)
+{
+    std::string word = name.empty() ? std::string("attribute") : name;
+    for (char& ch : word) {
+        if (static_cast<unsigned char>(ch) <= ' ' || static_cast<unsigned char>(ch) >= 0x7f
+            || ch == ',' || ch == '"' || ch == '<' || ch == '>' || ch == '&') {
+            ch = '_';
+        }
+    }
+    return word;
+}
+
+std::string
+vdbWord(const std::string& name)
+{
+    std::string word = name.empty() ? std::string("attribute") : name;
+    for (char& ch : word) {
+        if (!std::isalnum(static_cast<unsigned char>(ch)) && ch != '_' && ch != '|' && ch != ':') ch = '_';
+    }
+    return word;
+}
+
+std::vector<std::string>
+wholeColumn(const std::string& base, int)
+{
+    return {base};
+}
+
+std::vector<std::string>
+plyColumns(const std::string& base, int components)
+{
+    if (components == 1) return {base};
+    std::vector<std::string> columns;
+    for (int c = 0; c < components; ++c) {
+        columns.push_back(components == 3 ? base + "_" + "xyz"[c] : base + "_" + std::to_string(c));
+    }
+    return columns;
+}
+
+// Renaming "a b" to "a_b" beside an attribute "a_b" gave two columns of one name, which
+// nonbloppy's own readers then refused ("duplicate column"); a mesh attribute "nx" beside
+// the normals gave a PLY with two properties "nx", which readers resolve either way.
+std::vector<std::string>
+uniqueNames(const std::vector<NamedAttribute>& attributes, std::string (*word)(const std::string&),
+            const ColumnsOf& columnsOf, const IsReserved& isReserved)
+{
+    std::set<std::string> taken;
+    std::vector<std::string> names(attributes.size());
+    for (const bool renamed : {false, true}) {
+        for (size_t i = 0; i < attributes.size(); ++i) {
+            const auto& [original, components] = attributes[i];
+            const std::string base = word(original);
+            if ((base != original) != renamed) continue;
+            std::string name = base;
+            for (int suffix = 2;; ++suffix) {
+                const std::vector<std::string> columns = columnsOf(name, components);
+                if (std::none_of(columns.begin(), columns.end(),
+                                 [&](const std::string& c) { return taken.count(c) || isReserved(c); })) {
+                    taken.insert(columns.begin(), columns.end());
+                    break;
+                }
+                name = base + "_" + std::to_string(suffix);
+            }
+            names[i] = name;
+        }
+    }
+    return names;
+}
+
+} // namespace attribute_names_internal
+} // namespace nonbloppy
