@@ -276,6 +276,24 @@ TEST_F(CliSequenceTest, KeepGoingListsFailedFrames)
     EXPECT_NE(log.find("\"failed\": [2]"), std::string::npos) << log;
 }
 
+TEST_F(CliSequenceTest, ALogThatCannotBeWrittenIsSaidAtOnceAndFailsTheRunAtItsEnd)
+{
+    // /dev/full fails every write with ENOSPC, as a full disk. Before, the run said nothing
+    // until its end, and then only "cannot write /dev/full", without the cause.
+    if (!fs::exists("/dev/full")) GTEST_SKIP() << "no /dev/full";
+    makeFrames({kFree, kFree, kFree});
+    const RunResult r = meshSequence(dir() + "/out", "--log /dev/full");
+    EXPECT_EQ(r.exitCode, 1);
+    EXPECT_EQ(lines(r.err), (std::vector<std::string>{
+        "nonbloppy: warning: cannot write /dev/full: No space left on device; the log stops here, the frames go on",
+        "nonbloppy: cannot write /dev/full: No space left on device"}));
+    // The frames went on: every mesh is there, and each frame and the summary were printed.
+    EXPECT_EQ(listDir(dir() + "/out"),
+              (std::vector<std::string>{"density_0001.vdb", "density_0002.vdb", "density_0003.vdb",
+                                        "mesh_0001.obj", "mesh_0002.obj", "mesh_0003.obj"}));
+    EXPECT_EQ(lines(r.out).size(), 4u) << r.out;
+}
+
 TEST_F(CliSequenceTest, ARunWithoutFramesReplacesAnEarlierLog)
 {
     // A resubmitted farm task that found none of its frames left the earlier attempt's log,

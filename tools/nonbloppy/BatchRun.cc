@@ -213,10 +213,15 @@ public:
                 + ", \"particles_per_second\": " + jsonNumber(rate)
                 + ", \"peak_rss_bytes\": " + std::to_string(peakResidentBytes()) + "}");
         if (mLog) {
-            const bool ok = std::fflush(mLog) == 0 && !std::ferror(mLog);
-            std::fclose(mLog);
+            const bool warned = !mLogError.empty();
+            if (!warned && (std::fflush(mLog) != 0 || std::ferror(mLog))) mLogError = std::strerror(errno);
+            if (std::fclose(mLog) != 0 && mLogError.empty()) mLogError = std::strerror(errno);
             mLog = nullptr;
-            if (!ok) throw nonbloppy::FileError("cannot write " + mSettings.logPath);
+            // Said now if the last lines failed; the run fails below, after the summary.
+            if (!warned && !mLogError.empty() && (wasInterrupted || !failedFrames.empty())) {
+                std::cerr << "nonbloppy: warning: cannot write " << mSettings.logPath << ": " << mLogError
+                          << std::endl;
+            }
         }
 
         if (!mSettings.quiet) {
@@ -247,16 +252,25 @@ public:
                                    + std::to_string(requested) + " frames failed: "
                                    + formatFrameList(failedFrames));
         }
+        if (!mLogError.empty()) throw nonbloppy::FileError("cannot write " + mSettings.logPath + ": " + mLogError);
         return 0;
     }
 
 private:
     void logLine(const std::string& line)
     {
-        if (!mLog) return;
+        if (!mLog || !mLogError.empty()) return;
         std::fputs(line.c_str(), mLog);
         std::fputc('\n', mLog);
-        std::fflush(mLog); // a farm may kill the job at any moment
+        // Flushed per line: a farm may kill the job at any moment. A line that cannot be
+        // written (a full disk) is said at once, not only at the end of a long run; the
+        // frames go on, and the run fails at the end naming the cause.
+        if (std::fflush(mLog) != 0 || std::ferror(mLog)) {
+            mLogError = std::strerror(errno);
+            clearBar();
+            std::cerr << "nonbloppy: warning: cannot write " << mSettings.logPath << ": " << mLogError
+                      << "; the log stops here, the frames go on" << std::endl;
+        }
     }
 
     /// A frame has finished (one way or another): a line or a new bar.
@@ -310,6 +324,7 @@ private:
     const bool mTerminal;
     const Clock::time_point mStart;
     std::FILE* mLog = nullptr;
+    std::string mLogError;    ///< why the log could not be written (strerror), or empty
     std::string mFirstError;  ///< "frame N: message" of the first frame that failed
     size_t mFinished = 0;
     uint64_t mParticles = 0;
