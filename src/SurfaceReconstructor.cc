@@ -33,6 +33,11 @@ SurfaceReconstructor::positionBuffer(size_t count)
         auto& sorted = const_cast<ParticleIndex::Impl&>(mIndex.impl()).sortedPositions;
         if (sorted.capacity() > mPositions.capacity()) mPositions.swap(sorted);
     }
+    // The old index is now without its positions (or about to be replaced): empty it, so
+    // that particleIndex() is a valid, empty index if this frame throws before indexing.
+    // Before, a failed frame left the old grid pointing past the swapped-out array, and
+    // relaxVertices() against particleIndex() read out of bounds.
+    mIndex = ParticleIndex();
     mPositions.resize(count);
     return mPositions;
 }
@@ -48,11 +53,18 @@ SurfaceReconstructor::reconstructBuffered(openvdb::util::NullInterrupter* interr
     // once the frame is done: a frame that throws or is stopped after resolving them must
     // leave the next frame as a fresh object would (the header's promise).
     const bool reuse = mKeepParameters && mHaveKeptParameters;
-    surface_stages_internal::resolveAndIndex(mParams, reuse ? &mKeptParameters : nullptr, mPositions, mIndex,
-                                             result, interrupter);
-    surface_stages_internal::runSurfaceStages(mIndex, mParams.keepDensity, result, mUnrelaxed,
-                                              surface_stages_internal::UnrelaxedBuffer::Keep,
-                                              interrupter);
+    try {
+        surface_stages_internal::resolveAndIndex(mParams, reuse ? &mKeptParameters : nullptr, mPositions,
+                                                 mIndex, result, interrupter);
+        surface_stages_internal::runSurfaceStages(mIndex, mParams.keepDensity, result, mUnrelaxed,
+                                                  surface_stages_internal::UnrelaxedBuffer::Keep,
+                                                  interrupter);
+    } catch (...) {
+        // A frame that throws leaves no index behind (see particleIndex()): the positions
+        // were moved into a half-built or complete index of a frame that has no result.
+        mIndex = ParticleIndex();
+        throw;
+    }
     if (!reuse) {
         mKeptParameters = result.parameters;
         mHaveKeptParameters = true;

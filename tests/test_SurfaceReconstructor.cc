@@ -4,9 +4,16 @@
 #include <nonbloppy/BuildSurface.h>
 #include <nonbloppy/Error.h>
 #include <nonbloppy/Particles.h>
+#include <nonbloppy/RasterizeDensity.h>
+#include <nonbloppy/RelaxVertices.h>
 #include <nonbloppy/SurfaceReconstructor.h>
 
 #include <gtest/gtest.h>
+
+#include <functional>
+#include <limits>
+#include <stdexcept>
+#include <string>
 
 using namespace nonbloppy;
 using nonbloppy_test::latticeParticles;
@@ -44,6 +51,19 @@ struct StopInStage : openvdb::util::NullInterrupter
     bool wasInterrupted(int = -1) override { return stopping; }
     std::string stage;
     bool stopping = false;
+};
+
+/// A ParticleList whose getPos() throws at one particle, as a caller's cache reader may.
+struct ThrowingParticles
+{
+    const std::vector<openvdb::Vec3f>* positions;
+    size_t failAt;
+    size_t size() const { return positions->size(); }
+    void getPos(size_t n, openvdb::Vec3R& xyz) const
+    {
+        if (n == failAt) throw std::runtime_error("cache read failed");
+        xyz = (*positions)[n];
+    }
 };
 
 } // namespace
@@ -115,4 +135,56 @@ TEST(SurfaceReconstructor, BadParametersThrowParameterError)
     params.blend = 2.0;
     SurfaceReconstructor reconstructor(params);
     EXPECT_THROW(reconstructor.reconstruct(ParticleSet{ballFrame(0.5, 1), {}}), ParameterError);
+}
+
+TEST(SurfaceReconstructor, AFrameThatThrowsLeavesAnEmptyUsableIndex)
+{
+    // A failed frame used to leave particleIndex() with the old grid but without its
+    // positions (their storage had been recycled for the new frame): relaxing a mesh
+    // against it read out of bounds. Every way of failing now leaves an empty index.
+    const auto small = ballFrame(0.5, 1);
+    const auto large = ballFrame(0.9, 2);  // more particles: the position buffer is recycled
+    auto withNaN = large;
+    withNaN[7][1] = std::numeric_limits<float>::quiet_NaN();
+    const auto nanFrame = [&](SurfaceReconstructor& r) { r.reconstruct(ParticleSet{withNaN, {}}); };
+    const auto stoppedFrame = [&](SurfaceReconstructor& r) {
+        StopInStage stop("relax vertices");
+        r.reconstruct(ParticleSet{large, {}}, &stop);
+    };
+    const auto readerFails = [&](SurfaceReconstructor& r) { r.reconstruct(ThrowingParticles{&large, 11}); };
+    const std::vector<std::function<void(SurfaceReconstructor&)>> failures{nanFrame, stoppedFrame, readerFails};
+    const std::vector<std::string> messages{"non-finite position of particle 7",
+                                            "interrupted during relax vertices", "cache read failed"};
+    for (size_t k = 0; k < failures.size(); ++k) {
+        SCOPED_TRACE(messages[k]);
+        SurfaceReconstructor reconstructor;
+        const SurfaceResult& first = reconstructor.reconstruct(ParticleSet{small, {}});
+        ASSERT_EQ(reconstructor.particleIndex().size(), small.size());
+        SurfaceMesh probe = first.mesh;
+        try {
+            failures[k](reconstructor);
+            FAIL() << "no exception";
+        } catch (const std::exception& error) {
+            EXPECT_EQ(std::string(error.what()), messages[k]);
+        }
+        EXPECT_EQ(reconstructor.particleIndex().size(), 0u);
+        EXPECT_EQ(reconstructor.particleIndex().sortedPositions().size(), 0u);
+
+        // Relaxing against an empty index leaves the vertices where they are.
+        RelaxSettings relax;
+        relax.effectiveRadius = 0.25;
+        const std::vector<openvdb::Vec3s> before = probe.points;
+        relaxVertices(probe, reconstructor.particleIndex(), relax);
+        EXPECT_EQ(probe.points, before);
+        DensitySettings density;
+        density.effectiveRadius = 0.25;
+        density.voxelSize = 0.05;
+        EXPECT_EQ(rasterizeDensity(reconstructor.particleIndex(), density)->activeVoxelCount(), 0u);
+
+        // And the next frame is a fresh object's.
+        const SurfaceResult& next = reconstructor.reconstruct(ParticleSet{large, {}});
+        EXPECT_EQ(reconstructor.particleIndex().size(), large.size());
+        SurfaceReconstructor fresh;
+        expectSameMesh(next.mesh, fresh.reconstruct(ParticleSet{large, {}}).mesh);
+    }
 }

@@ -83,7 +83,8 @@ public:
     /// The result of the last reconstruct() (empty before the first; unspecified after a
     /// call that threw).
     const SurfaceResult& result() const { return mResult; }
-    /// The particle index of the last frame, e.g. to relax another mesh against it.
+    /// The particle index of the last frame, e.g. to relax another mesh against it; an
+    /// empty index (no particles) before the first frame and after a call that threw.
     const ParticleIndex& particleIndex() const { return mIndex; }
     /// Number of frames reconstructed so far.
     size_t frameCount() const { return mFrames; }
