@@ -1,7 +1,9 @@
 // SPDX-License-Identifier: Apache-2.0
 #include <nonbloppy/ComputeNormals.h>
+#include <nonbloppy/Error.h>
 
 #include "Cancellation.h"
+#include "PolygonIndices.h"
 #include "VectorArea.h"
 
 #include <tbb/parallel_for.h>
@@ -28,9 +30,18 @@ void computeNormals(SurfaceMesh& mesh, CancelPoll& poll)
             }
         });
     poll.throwIfStopped();
-    for (size_t n = 0; n < mesh.triangles.size(); ++n) {
+    // Corners are checked as they are read, in the order firstBadIndex() numbers polygons:
+    // free in this serial pass, and mesh.normals is only written once all have passed.
+    const size_t vertexCount = p.size(), triangleCount = mesh.triangles.size();
+    const auto requireCorner = [&](size_t polygon, uint32_t corner) {
+        if (corner >= vertexCount) {
+            throw ParameterError(polygon_indices_internal::badIndexMessage(polygon, corner, vertexCount));
+        }
+    };
+    for (size_t n = 0; n < triangleCount; ++n) {
         if (poll.stoppedAt(n)) poll.throwIfStopped();
         const openvdb::Vec3I& t = mesh.triangles[n];
+        for (int k = 0; k < 3; ++k) requireCorner(n, t[k]);
         const openvdb::Vec3d a(p[t[0]]), b(p[t[1]]), c(p[t[2]]);
         const openvdb::Vec3d normal = twiceVectorArea(a, b, c);
         sums[t[0]] += normal; sums[t[1]] += normal; sums[t[2]] += normal;
@@ -38,6 +49,7 @@ void computeNormals(SurfaceMesh& mesh, CancelPoll& poll)
     for (size_t n = 0; n < mesh.quads.size(); ++n) {
         if (poll.stoppedAt(n)) poll.throwIfStopped();
         const openvdb::Vec4I& q = mesh.quads[n];
+        for (int k = 0; k < 4; ++k) requireCorner(triangleCount + n, q[k]);
         const openvdb::Vec3d a(p[q[0]]), b(p[q[1]]), c(p[q[2]]), d(p[q[3]]);
         const openvdb::Vec3d normal = twiceVectorArea(a, b, c, d);
         sums[q[0]] += normal; sums[q[1]] += normal; sums[q[2]] += normal; sums[q[3]] += normal;

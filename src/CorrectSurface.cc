@@ -10,6 +10,8 @@
 #include <nonbloppy/ComputeNormals.h>
 
 #include "Cancellation.h"
+#include "PolygonIndices.h"
+#include "SurfaceStages.h"
 #include "VectorArea.h"
 
 #include <tbb/enumerable_thread_specific.h>
@@ -319,6 +321,7 @@ double cancellation_internal::calibrateRelaxedThreshold(double effectiveRadiusOv
 size_t countFoldedTriangles(const SurfaceMesh& mesh, const std::vector<openvdb::Vec3s>& before)
 {
     requireSameSize(mesh, before);
+    polygon_indices_internal::requireValidIndices(mesh);
     std::vector<char> marked(mesh.points.size());
     CancelPoll never(nullptr, "correct surface");
     return markFolded(mesh, before, marked, never);
@@ -326,6 +329,13 @@ size_t countFoldedTriangles(const SurfaceMesh& mesh, const std::vector<openvdb::
 
 size_t repairFolds(SurfaceMesh& mesh, const std::vector<openvdb::Vec3s>& before, int maxRounds,
                    openvdb::util::NullInterrupter* interrupter)
+{
+    polygon_indices_internal::requireValidIndices(mesh);
+    return surface_stages_internal::repairFoldsUnchecked(mesh, before, maxRounds, interrupter);
+}
+
+size_t surface_stages_internal::repairFoldsUnchecked(SurfaceMesh& mesh, const std::vector<openvdb::Vec3s>& before,
+                                                     int maxRounds, openvdb::util::NullInterrupter* interrupter)
 {
     requireSameSize(mesh, before);
     CancelPoll poll(interrupter, "correct surface");
@@ -396,6 +406,13 @@ double preserveVolume(SurfaceMesh& mesh, double targetVolume, double maxDistance
 
 double preserveVolume(SurfaceMesh& mesh, const VolumeSettings& settings,
                       openvdb::util::NullInterrupter* interrupter)
+{
+    polygon_indices_internal::requireValidIndices(mesh);
+    return surface_stages_internal::preserveVolumeUnchecked(mesh, settings, interrupter);
+}
+
+double surface_stages_internal::preserveVolumeUnchecked(SurfaceMesh& mesh, const VolumeSettings& settings,
+                                                        openvdb::util::NullInterrupter* interrupter)
 {
     if (!(settings.convexityFloor >= 0.0) || !std::isfinite(settings.convexityFloor)) {
         std::ostringstream msg;

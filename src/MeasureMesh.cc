@@ -90,6 +90,13 @@ polygon_indices_internal::firstBadIndex(const SurfaceMesh& mesh)
     return badIndexMessage(bad, *std::find_if(corners, corners + count, outOfRange), vertexCount);
 }
 
+void
+polygon_indices_internal::requireValidIndices(const SurfaceMesh& mesh)
+{
+    const std::string badIndex = firstBadIndex(mesh);
+    if (!badIndex.empty()) throw ParameterError(badIndex);
+}
+
 AreaAndVolume
 measureAreaAndVolume(const SurfaceMesh& mesh)
 {

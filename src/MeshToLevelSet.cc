@@ -28,8 +28,7 @@ meshToLevelSet(const SurfaceMesh& mesh, double voxelSize, float halfWidth,
     // Below it OpenVDB throws its own ArithmeticError, not a nonbloppy::Error.
     openvdb_scale_internal::requireOpenVdbScale(voxelSize, kMinCellSize, "--voxel-size");
     // meshToVolume reads the corners unchecked: an index out of range crashed.
-    const std::string badIndex = polygon_indices_internal::firstBadIndex(mesh);
-    if (!badIndex.empty()) throw ParameterError(badIndex);
+    polygon_indices_internal::requireValidIndices(mesh);
     openvdb::initialize();
     const auto transform = openvdb::math::Transform::createLinearTransform(voxelSize);
     // meshToVolume wants index-space points.

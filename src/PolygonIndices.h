@@ -23,6 +23,11 @@ std::string badIndexMessage(size_t polygon, uint32_t index, size_t vertexCount);
 /// 2.4M quads). Defined in MeasureMesh.cc.
 std::string firstBadIndex(const SurfaceMesh& mesh);
 
+/// Throw ParameterError(firstBadIndex(mesh)) if a polygon of @a mesh has a corner out of
+/// range: the check every public mesh stage makes before it reads a corner. Cost: as
+/// firstBadIndex().
+void requireValidIndices(const SurfaceMesh& mesh);
+
 } // namespace polygon_indices_internal
 } // namespace nonbloppy
 

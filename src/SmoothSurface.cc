@@ -4,6 +4,8 @@
 #include <nonbloppy/Error.h>
 
 #include "Cancellation.h"
+#include "PolygonIndices.h"
+#include "SurfaceStages.h"
 #include "VectorArea.h"
 
 #include <tbb/parallel_for.h>
@@ -167,6 +169,13 @@ void measurePolygons(const Polygons& polygons, const std::vector<Vec3s>& points,
 } // namespace
 
 void smoothSurface(SurfaceMesh& mesh, const SmoothSettings& settings, openvdb::util::NullInterrupter* interrupter)
+{
+    polygon_indices_internal::requireValidIndices(mesh);
+    surface_stages_internal::smoothSurfaceUnchecked(mesh, settings, interrupter);
+}
+
+void surface_stages_internal::smoothSurfaceUnchecked(SurfaceMesh& mesh, const SmoothSettings& settings,
+                                                     openvdb::util::NullInterrupter* interrupter)
 {
     std::ostringstream msg;
     if (!(settings.spatialWidth > 0.0) || !std::isfinite(settings.spatialWidth)) {

@@ -98,7 +98,7 @@ void runSurfaceStages(const ParticleIndex& index, bool keepDensity, SurfaceResul
     }
     if (p.repairFolds) {
         StageScope scope(result.timings, interrupter, "correct surface");
-        repairFolds(result.mesh, unrelaxed, kDefaultRepairRounds, interrupter);
+        repairFoldsUnchecked(result.mesh, unrelaxed, kDefaultRepairRounds, interrupter);
         // Large frames peak while the normals are computed: give the copy back first.
         if (whenRepaired == UnrelaxedBuffer::Release) std::vector<openvdb::Vec3s>().swap(unrelaxed);
         checkCancelled(interrupter, "correct surface");
@@ -118,7 +118,7 @@ void runSurfaceStages(const ParticleIndex& index, bool keepDensity, SurfaceResul
         volume.convexityFloor = kConvexityFloorOverSpacing * s;
         volume.maxDistance = (p.volumeOffset == VolumeOffset::Convex ? kMaxConvexOffsetOverSpacing
                                                                      : kMaxVolumeOffsetOverSpacing) * s;
-        preserveVolume(result.mesh, volume, interrupter);
+        preserveVolumeUnchecked(result.mesh, volume, interrupter);
         checkCancelled(interrupter, "correct surface");
     }
     if (p.smoothSurface) {
@@ -127,7 +127,7 @@ void runSurfaceStages(const ParticleIndex& index, bool keepDensity, SurfaceResul
         StageScope scope(result.timings, interrupter, "smooth surface");
         SmoothSettings settings;
         settings.spatialWidth = kDefaultSmoothWidthOverSpacing * p.spacing;
-        smoothSurface(result.mesh, settings, interrupter);
+        smoothSurfaceUnchecked(result.mesh, settings, interrupter);
         computeNormals(result.mesh, interrupter);
         checkCancelled(interrupter, "smooth surface");
     }

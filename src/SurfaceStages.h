@@ -8,6 +8,8 @@
 #define NONBLOPPY_SURFACE_STAGES_H
 
 #include <nonbloppy/BuildSurface.h>
+#include <nonbloppy/CorrectSurface.h>
+#include <nonbloppy/SmoothSurface.h>
 #include <nonbloppy/ParticleIndex.h>
 
 #include <openvdb/openvdb.h>
@@ -89,6 +91,18 @@ enum class UnrelaxedBuffer
 void runSurfaceStages(const ParticleIndex& index, bool keepDensity, SurfaceResult& result,
                       std::vector<openvdb::Vec3s>& unrelaxed, UnrelaxedBuffer whenRepaired,
                       openvdb::util::NullInterrupter* interrupter);
+
+/// repairFolds(), preserveVolume(mesh, VolumeSettings) and smoothSurface() without the check
+/// that every polygon corner is a vertex of the mesh, which the public functions make first
+/// (polygon_indices_internal::requireValidIndices(): 3.5 ms per call on two threads for the
+/// 2.6M polygons of the 64x benchmark mesh): the chain's mesh comes from extractSurface(),
+/// valid by construction, and passes through all three. Same results, same other checks.
+size_t repairFoldsUnchecked(SurfaceMesh& mesh, const std::vector<openvdb::Vec3s>& before, int maxRounds,
+                            openvdb::util::NullInterrupter* interrupter);
+double preserveVolumeUnchecked(SurfaceMesh& mesh, const VolumeSettings& settings,
+                               openvdb::util::NullInterrupter* interrupter);
+void smoothSurfaceUnchecked(SurfaceMesh& mesh, const SmoothSettings& settings,
+                            openvdb::util::NullInterrupter* interrupter);
 
 /// Leaf layers (8 voxels each) per region at least, along each axis it is cut on. Each region
 /// also meshes three voxel planes beyond each cut face, but volumeToMesh scans whole leaves,

@@ -16,13 +16,15 @@ namespace nonbloppy {
 /// around vertex i (a quad's normal is half the cross product of its diagonals).
 /// A vertex no polygon uses, or whose normals cancel, gets (0,0,0).
 /// Cost: O(P + V); deterministic (sums in polygon order). Memory: 24 bytes per vertex scratch.
-/// @param mesh         normals written; polygon indices must be valid (see measureMesh())
+/// @param mesh         normals written
 /// @param interrupter  optional; asked every 4096 polygons of the serial sum and every 4096
 ///                     vertices of each parallel task (no start()/end(): buildSurface()
 ///                     announces the stage); a stop leaves mesh.normals unspecified
 /// Thread-safety: reentrant; concurrent calls on different meshes are safe.
-/// @throw CancelledError("interrupted during compute normals") when @a interrupter says
-///        stop; otherwise nothing but std::bad_alloc.
+/// @throw ParameterError("polygon P references vertex I but the mesh has N vertices") for
+///        the first polygon (triangles first, then quads) with a corner out of range, and
+///        mesh.normals is then untouched; CancelledError("interrupted during compute
+///        normals") when @a interrupter says stop; otherwise nothing but std::bad_alloc.
 NONBLOPPY_API void computeNormals(SurfaceMesh& mesh,
                                   openvdb::util::NullInterrupter* interrupter = nullptr);
 

@@ -56,7 +56,9 @@ NONBLOPPY_API double calibrateRelaxedThreshold(double effectiveRadiusOverSpacing
 /// against the normal the same triangle had with the vertex positions @a before (same
 /// polygons): the triangles relaxation folded over.
 /// Cost: O(P). Thread-safety: reentrant.
-/// @throw ParameterError if @a before and mesh.points differ in size.
+/// @throw ParameterError if @a before and mesh.points differ in size, or naming the first
+///        polygon with a corner out of range ("polygon P references vertex I but the mesh
+///        has N vertices"; triangles are numbered first, then quads, as the writers do).
 NONBLOPPY_API size_t countFoldedTriangles(const SurfaceMesh& mesh, const std::vector<openvdb::Vec3s>& before);
 
 /// Rounds of halving that repairFolds() tries before moving vertices all the way back.
@@ -76,7 +78,8 @@ constexpr int kDefaultRepairRounds = 4;
 ///                     leaves the vertices partly repaired
 /// Cost: O(rounds · P), parallel over polygons. Deterministic. Normals are not updated.
 /// Thread-safety: reentrant; the mesh is written.
-/// @throw ParameterError if @a before and mesh.points differ in size;
+/// @throw ParameterError if @a before and mesh.points differ in size or a polygon has a
+///        corner out of range (as countFoldedTriangles(); checked before anything moves);
 ///        CancelledError("interrupted during correct surface") when @a interrupter says stop.
 NONBLOPPY_API size_t repairFolds(SurfaceMesh& mesh, const std::vector<openvdb::Vec3s>& before,
                                  int maxRounds = kDefaultRepairRounds,
@@ -120,7 +123,8 @@ struct VolumeSettings
 /// Only meaningful for a closed mesh whose target is known (e.g. N·s³ for an incompressible
 /// fluid of N particles at spacing s); a wrong target shifts the whole surface.
 /// @return the total distance moved along the normals (world units)
-/// @throw ParameterError if targetVolume or maxDistance is not > 0 or normals are missing;
+/// @throw ParameterError if targetVolume or maxDistance is not > 0, normals are missing or
+///        a polygon has a corner out of range (as countFoldedTriangles());
 ///        CancelledError("interrupted during correct surface") when @a interrupter says stop.
 /// @param mesh         closed mesh with normals; vertices moved, normals recomputed
 /// @param targetVolume volume to enclose, world units³, > 0
@@ -144,9 +148,11 @@ NONBLOPPY_API double preserveVolume(SurfaceMesh& mesh, double targetVolume,
 /// kConvexityFloorOverSpacing·s: on the fidelity shapes it brings the mean distance to the
 /// true surface 1.3–1.5x closer than Uniform (docs/fidelity.md).
 /// @return the signed distance of the vertex that moved farthest (world units, < 0 inwards)
-/// @throw ParameterError if the target is not > 0, the floor is < 0, maxDistance is not > 0
-///        or normals are missing; CancelledError("interrupted during correct surface") when
-///        @a interrupter says stop (asked every 4096 polygons of each serial pass and inside
+/// @throw ParameterError if the target is not > 0, the floor is < 0, maxDistance is not > 0,
+///        normals are missing or a polygon has a corner out of range (as
+///        countFoldedTriangles(); checked before anything moves);
+///        CancelledError("interrupted during correct surface") when @a interrupter says
+///        stop (asked every 4096 polygons of each serial pass and inside
 ///        computeNormals(); a stop leaves the mesh partly offset).
 /// Cost: Convex: one serial pass over the polygons for the convexity, then per pass
 /// measureAreaAndVolume() and vertex areas (serial, O(P)), the offset and computeNormals(); scratch

@@ -76,8 +76,11 @@ struct SmoothSettings
 ///                     start()/end(): buildSurface() announces "smooth surface"); a stop
 ///                     leaves the vertices where the last finished round put them
 /// Thread-safety: reentrant; the mesh is written.
-/// @throw ParameterError naming the setting if a width is not > 0 or finite, or a round count
-///        is < 0; CancelledError("interrupted during smooth surface") when @a interrupter says stop.
+/// @throw ParameterError("polygon P references vertex I but the mesh has N vertices") for
+///        the first polygon with a corner out of range (triangles first, then quads; checked
+///        before anything moves), or naming the setting if a width is not > 0 or finite,
+///        or a round count is < 0; CancelledError("interrupted during smooth surface")
+///        when @a interrupter says stop.
 NONBLOPPY_API void smoothSurface(SurfaceMesh& mesh, const SmoothSettings& settings,
                                  openvdb::util::NullInterrupter* interrupter = nullptr);
 
