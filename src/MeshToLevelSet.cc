@@ -3,32 +3,101 @@
 /// @brief The surface mesh as a narrow-band level set, via tools::meshToLevelSet.
 
 #include <nonbloppy/Error.h>
+#include <nonbloppy/MeasureMesh.h>
 #include <nonbloppy/MeshToLevelSet.h>
 #include <nonbloppy/ParticleIndex.h>
 
 #include "OpenVdbScale.h"
 #include "ParameterChecks.h"
-#include "PolygonIndices.h"
 
 #pragma GCC visibility push(default)  // OpenVDB templates: see src/VisibilityPrelude.h
 #include <openvdb/tools/MeshToVolume.h>
 #pragma GCC visibility pop
 
+#include <unistd.h>
+
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
 namespace nonbloppy {
+
+namespace {
+
+/// Peak memory per voxel of the narrow band while meshToVolume runs (the distance grid, its
+/// polygon-index grid and scratch): 19–30 bytes measured on the dam-break surface at h/2 and
+/// h/4 with half widths 3 and 10, rounded up.
+constexpr double kPeakBytesPerBandVoxel = 32.0;
+
+/// Index coordinates are 32-bit and meshToVolume works on float index coordinates: beyond
+/// this a mesh's voxels overflow or its float corners stop resolving voxels (a mesh moved
+/// 5e7 from the origin at h = 0.02 hung, unheard by the interrupter).
+constexpr double kMaxIndexCoordinate = 1.0e9;
+
+/// The machine's physical memory in bytes, or 0 if unknown.
+double physicalMemoryBytes()
+{
+    const long pages = sysconf(_SC_PHYS_PAGES), pageSize = sysconf(_SC_PAGE_SIZE);
+    return pages > 0 && pageSize > 0 ? double(pages) * double(pageSize) : 0.0;
+}
+
+/// @throw ParameterError naming the first vertex that is not finite, or the largest
+///        coordinate if it is too far from the origin for 32-bit voxel coordinates.
+void requireVerticesInRange(const SurfaceMesh& mesh, double voxelSize, float halfWidth)
+{
+    float largest = 0.0f;
+    for (size_t i = 0; i < mesh.points.size(); ++i) {
+        const openvdb::Vec3s& p = mesh.points[i];
+        if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2])) {
+            throw ParameterError("non-finite position of vertex " + std::to_string(i));
+        }
+        largest = std::max({largest, std::abs(p[0]), std::abs(p[1]), std::abs(p[2])});
+    }
+    if (double(largest) / voxelSize + double(halfWidth) > kMaxIndexCoordinate) {
+        std::ostringstream msg;
+        msg << "mesh coordinates up to " << double(largest) << " are too far from the origin for a voxel size of "
+            << voxelSize << " (32-bit index space)";
+        throw ParameterError(msg.str());
+    }
+}
+
+/// @throw ParameterError if the narrow band (the surface's area in voxels times 2·halfWidth,
+///        within 8% of the active voxels counted on the dam-break surface) would need more
+///        memory than the machine has: meshToVolume's std::bad_alloc ends the process.
+void requireBandFitsInMemory(double area, double voxelSize, float halfWidth)
+{
+    const double bandVoxels = area / (voxelSize * voxelSize) * 2.0 * double(halfWidth);
+    const double needed = bandVoxels * kPeakBytesPerBandVoxel, available = physicalMemoryBytes();
+    if (available > 0.0 && needed > available) {
+        std::ostringstream msg;
+        msg.precision(2);
+        msg << "the level set's narrow band would hold about " << bandVoxels << " voxels, about "
+            << needed / 1e9 << " GB at its peak, more than the " << available / 1e9
+            << " GB of memory: use a voxel size larger than " << voxelSize << " or a half width below "
+            << halfWidth;
+        throw ParameterError(msg.str());
+    }
+}
+
+} // namespace
 
 openvdb::FloatGrid::Ptr
 meshToLevelSet(const SurfaceMesh& mesh, double voxelSize, float halfWidth,
                openvdb::util::NullInterrupter* interrupter)
 {
     parameter_checks_internal::requirePositive(voxelSize, "--voxel-size");
-    if (!(halfWidth >= 1.0f)) throw ParameterError("level set half width must be >= 1 voxel");
+    if (!(halfWidth >= 1.0f) || !std::isfinite(halfWidth)) {
+        // An infinite band gave an empty grid.
+        std::ostringstream msg;
+        msg << "level set half width must be >= 1 voxel and finite, got " << halfWidth;
+        throw ParameterError(msg.str());
+    }
     // Below it OpenVDB throws its own ArithmeticError, not a nonbloppy::Error.
     openvdb_scale_internal::requireOpenVdbScale(voxelSize, kMinCellSize, "--voxel-size");
-    // meshToVolume reads the corners unchecked: an index out of range crashed.
-    polygon_indices_internal::requireValidIndices(mesh);
+    requireVerticesInRange(mesh, voxelSize, halfWidth);
+    // meshToVolume reads the corners unchecked (an index out of range crashed): the area's
+    // serial pass checks them, triangles first, with polygon_indices_internal's message.
+    requireBandFitsInMemory(measureAreaAndVolume(mesh).area, voxelSize, halfWidth);
     openvdb::initialize();
     const auto transform = openvdb::math::Transform::createLinearTransform(voxelSize);
     // meshToVolume wants index-space points.

@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include <limits>
+#include <string>
 
 #include <atomic>
 
@@ -60,6 +61,49 @@ TEST(MeshToLevelSet, BadInputIsAParameterError)
     EXPECT_EQ(nonbloppy_test::messageOf<ParameterError>(
                   [&] { nonbloppy::meshToLevelSet(unitCube(), std::numeric_limits<double>::infinity()); }),
               "--voxel-size must be finite, got inf");
+}
+
+TEST(MeshToLevelSet, VerticesAndBandsItCannotHoldAreRefusedBeforeAnyGridIsMade)
+{
+    // Each of these ended the process (std::bad_alloc escaping OpenVDB's tasks), hung where
+    // no interrupter was asked, or gave an empty grid.
+    SurfaceMesh cube = unitCube();
+    cube.points[3][1] = std::numeric_limits<float>::quiet_NaN();
+    EXPECT_EQ(nonbloppy_test::messageOf<ParameterError>([&] { nonbloppy::meshToLevelSet(cube, 0.1); }),
+              "non-finite position of vertex 3");
+    cube.points[3][1] = std::numeric_limits<float>::infinity();
+    EXPECT_EQ(nonbloppy_test::messageOf<ParameterError>([&] { nonbloppy::meshToLevelSet(cube, 0.1); }),
+              "non-finite position of vertex 3");
+
+    // Moved 5e7 from the origin: 2.5e9 voxels out at h = 0.02, beyond 32-bit coordinates.
+    SurfaceMesh far = unitCube();
+    for (openvdb::Vec3s& p : far.points) p[0] += 5.0e7f;
+    EXPECT_EQ(nonbloppy_test::messageOf<ParameterError>([&] { nonbloppy::meshToLevelSet(far, 0.02); }),
+              "mesh coordinates up to 5e+07 are too far from the origin for a voxel size of 0.02 (32-bit "
+              "index space)");
+    // 1e7 out (5e8 voxels) still works, and gives the cube's band as at the origin.
+    SurfaceMesh near = unitCube();
+    for (openvdb::Vec3s& p : near.points) p[0] += 1.0e7f;
+    EXPECT_GT(nonbloppy::meshToLevelSet(near, 0.02)->activeVoxelCount(), 0u);
+
+    EXPECT_EQ(nonbloppy_test::messageOf<ParameterError>(
+                  [&] { nonbloppy::meshToLevelSet(unitCube(), 0.1, std::numeric_limits<float>::infinity()); }),
+              "level set half width must be >= 1 voxel and finite, got inf");
+    EXPECT_EQ(nonbloppy_test::messageOf<ParameterError>([&] { nonbloppy::meshToLevelSet(unitCube(), 0.1, 0.5f); }),
+              "level set half width must be >= 1 voxel and finite, got 0.5");
+
+    // One triangle of 5e5 m² at h = 0.01: 3e10 band voxels, about 1e3 GB, more than any
+    // machine this runs on (the probe's 8 GB limit was hit after 38 s).
+    SurfaceMesh sail;
+    sail.points = {{0, 0, 0}, {1000, 0, 0}, {0, 1000, 0}};
+    sail.triangles = {{0, 1, 2}};
+    const std::string message =
+        nonbloppy_test::messageOf<ParameterError>([&] { nonbloppy::meshToLevelSet(sail, 0.01); });
+    EXPECT_EQ(message.rfind("the level set's narrow band would hold about 3e+10 voxels, about 9.6e+02 GB at its "
+                            "peak, more than the ", 0), 0u) << message;
+    const std::string advice = " GB of memory: use a voxel size larger than 0.01 or a half width below 3";
+    ASSERT_GT(message.size(), advice.size());
+    EXPECT_EQ(message.substr(message.size() - advice.size()), advice) << message;
 }
 
 TEST(MeshToLevelSet, AnInterrupterStopsItAndOneThatDoesNotChangesNothing)

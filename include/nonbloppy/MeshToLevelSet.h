@@ -25,9 +25,13 @@ namespace nonbloppy {
 /// @param interrupter  optional; handed to OpenVDB's meshToVolume, which asks it per
 ///                     polygon batch and between its passes (wasInterrupted(percent)) and
 ///                     then returns early; this function then throws. No start()/end().
-/// @throw ParameterError if voxelSize ≤ 0 or below kMinCellSize, halfWidth < 1, or a
+/// @throw ParameterError, before any grid is made, if voxelSize ≤ 0 or below kMinCellSize;
+///        if halfWidth < 1 or is not finite; if a vertex is not finite ("non-finite position
+///        of vertex I") or lies beyond 1e9 voxels of the origin (32-bit index space); if a
 ///        polygon references a vertex the mesh does not have ("polygon P references vertex
 ///        I but the mesh has N vertices", polygons numbered triangles first, then quads);
+///        or if the band (area/h² · 2·halfWidth voxels, at about 32 bytes each at the peak)
+///        would need more than the machine's physical memory;
 ///        CancelledError("interrupted during mesh to level set") if @a interrupter says so.
 NONBLOPPY_API openvdb::FloatGrid::Ptr meshToLevelSet(const SurfaceMesh& mesh, double voxelSize,
                                        float halfWidth = 3.0f,
