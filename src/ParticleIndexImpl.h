@@ -13,6 +13,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -55,6 +56,25 @@ PositionScan scanPositions(const std::vector<openvdb::Vec3f>& positions, cancell
 
 using IndexTree = openvdb::tools::PointIndexTree;
 using IndexLeaf = IndexTree::LeafNodeType;
+
+/// Throw ParameterError("particle index cells of C are too small for --radius R: at most 8
+/// cells per radius (...)") or "... too large ...: at least 0.25 ..." unless
+/// kMinCellsPerRadius ≤ r_e / cell ≤ kMaxCellsPerRadius. An index without particles passes:
+/// its searches find nothing whatever its cells.
+inline void requireCellsPerRadius(const ParticleIndex& index, double effectiveRadius)
+{
+    const double cellsPerRadius = effectiveRadius / index.cellSize();
+    if (index.size() == 0 || (cellsPerRadius >= kMinCellsPerRadius && cellsPerRadius <= kMaxCellsPerRadius)) {
+        return;
+    }
+    const bool small = cellsPerRadius > kMaxCellsPerRadius;
+    std::ostringstream msg;
+    msg << "particle index cells of " << index.cellSize() << " are too " << (small ? "small" : "large")
+        << " for --radius " << effectiveRadius << ": at " << (small ? "most " : "least ")
+        << (small ? kMaxCellsPerRadius : kMinCellsPerRadius)
+        << " cells per radius (build the index with cells of r_e/2, " << effectiveRadius / 2.0 << ")";
+    throw ParameterError(msg.str());
+}
 
 /// "non-finite position of particle N": how ParticleIndex::build() and the spacing estimate
 /// (which meets the positions first when no --radius is given) refuse a NaN or infinity.

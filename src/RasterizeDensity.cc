@@ -381,6 +381,7 @@ openvdb::FloatGrid::Ptr instruction_set_internal::rasterizeDensity(const Particl
     }
     const double voxelSize = transform->voxelSize()[0];
     surface_stages_internal::requireVoxelsPerRadius(settings.effectiveRadius, voxelSize);
+    particle_index_internal::requireCellsPerRadius(particles, settings.effectiveRadius);
 
     if (interrupter) interrupter->start("rasterize density");
     CancelPoll poll(interrupter, "rasterize density");

@@ -515,6 +515,7 @@ void instruction_set_internal::relaxVertices(SurfaceMesh& mesh, const ParticleIn
         msg << "--max-step must be >= 0, got " << settings.maxStep;
         throw ParameterError(msg.str());
     }
+    particle_index_internal::requireCellsPerRadius(particles, settings.effectiveRadius);
     if (settings.iterations == 0 || settings.blend == 0.0 || mesh.points.empty()) return;
 
     if (interrupter) interrupter->start("relax vertices");

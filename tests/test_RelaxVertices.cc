@@ -13,6 +13,7 @@
 #include <atomic>
 #include <cmath>
 #include <limits>
+#include <string>
 
 using namespace nonbloppy;
 
@@ -312,4 +313,43 @@ TEST(RelaxVertices, VerticesThatAreNotFiniteStayPutAndTheOthersRelaxAsWithoutThe
             EXPECT_TRUE(std::isnan(vertex[a]) ? std::isnan(kept[a]) : kept[a] == vertex[a]) << "axis " << a;
         }
     }
+}
+
+TEST(RelaxVertices, AnIndexWhoseCellsAreFarFromTheRadiusIsRefusedHereAndByRasterize)
+{
+    // Cells of 1e-4 for r_e = 0.2 (a unit mistake) made a relaxation of minutes that no
+    // interrupter could stop: a search box probed 16 million cell columns.
+    OneParticle one;
+    DensitySettings density;
+    density.effectiveRadius = 1.0;
+    density.voxelSize = 0.1;
+    const RelaxSettings relax = relaxSettings(0.3, 2);
+    const auto expectRefused = [&](double cellSize, const std::string& message) {
+        SCOPED_TRACE(cellSize);
+        const ParticleIndex index = ParticleIndex::build({kCentre}, cellSize);
+        SurfaceMesh mesh = one.mesh;
+        EXPECT_EQ(nonbloppy_test::messageOf<ParameterError>([&] { relaxVertices(mesh, index, relax); }), message);
+        EXPECT_EQ(mesh.points, one.mesh.points);
+        EXPECT_EQ(nonbloppy_test::messageOf<ParameterError>([&] { rasterizeDensity(index, density); }), message);
+    };
+    expectRefused(0.01, "particle index cells of 0.01 are too small for --radius 1: at most 8 cells per radius "
+                        "(build the index with cells of r_e/2, 0.5)");
+    expectRefused(5.0, "particle index cells of 5 are too large for --radius 1: at least 0.25 cells per radius "
+                       "(build the index with cells of r_e/2, 0.5)");
+
+    // The bounds themselves are accepted, and give the same vertices as cells of r_e/2.
+    SurfaceMesh expected = one.mesh;
+    relaxVertices(expected, one.index, relax);
+    for (const double cellSize : {1.0 / kMaxCellsPerRadius, 1.0 / kMinCellsPerRadius}) {
+        SCOPED_TRACE(cellSize);
+        const ParticleIndex index = ParticleIndex::build({kCentre}, cellSize);
+        SurfaceMesh mesh = one.mesh;
+        relaxVertices(mesh, index, relax);
+        EXPECT_EQ(mesh.points, expected.points);
+        EXPECT_GT(rasterizeDensity(index, density)->activeVoxelCount(), 0u);
+    }
+    // An index without particles finds nothing whatever its cells: it passes.
+    SurfaceMesh mesh = one.mesh;
+    relaxVertices(mesh, ParticleIndex::build({}, 0.001), relax);
+    EXPECT_EQ(mesh.points, one.mesh.points);
 }
