@@ -20,6 +20,7 @@
 #include <algorithm>
 #include <cmath>
 #include <sstream>
+#include <string>
 
 namespace nonbloppy {
 
@@ -338,6 +339,9 @@ size_t surface_stages_internal::repairFoldsUnchecked(SurfaceMesh& mesh, const st
                                                      int maxRounds, openvdb::util::NullInterrupter* interrupter)
 {
     requireSameSize(mesh, before);
+    if (maxRounds < 0) {
+        throw ParameterError("fold repair rounds must be >= 0, got " + std::to_string(maxRounds));
+    }
     CancelPoll poll(interrupter, "correct surface");
     std::vector<char> marked(mesh.points.size()), moved(mesh.points.size());
     const size_t first = markFolded(mesh, before, marked, poll);
@@ -420,6 +424,9 @@ double surface_stages_internal::preserveVolumeUnchecked(SurfaceMesh& mesh, const
         throw ParameterError(msg.str());
     }
     requireMaxDistance(settings.maxDistance);
+    if (settings.offset != VolumeOffset::Uniform && settings.offset != VolumeOffset::Convex) {
+        throw ParameterError("volume offset must be Uniform or Convex, got " + std::to_string(int(settings.offset)));
+    }
     if (settings.offset == VolumeOffset::Uniform) {
         return preserveVolume(mesh, settings.targetVolume, settings.maxDistance, interrupter);
     }

@@ -350,6 +350,16 @@ void checkParameters(const SurfaceParameters& params)
     if (!(params.adaptivity >= 0.0 && params.adaptivity <= 1.0)) {
         throw ParameterError("--adaptivity must lie in [0,1], got " + formatNumber(params.adaptivity));
     }
+    // An out-of-range enumerator (a cast integer, memory from another build) ran as neither
+    // variant: the Paper mesh without its threshold calibration.
+    if (params.method != Method::Paper && params.method != Method::Faithful) {
+        throw ParameterError("method must be Paper or Faithful, got " + std::to_string(int(params.method)));
+    }
+    if (params.volumeOffset && *params.volumeOffset != VolumeOffset::Uniform &&
+        *params.volumeOffset != VolumeOffset::Convex) {
+        throw ParameterError("volume offset must be Uniform or Convex, got " +
+                             std::to_string(int(*params.volumeOffset)));
+    }
     if (params.method == Method::Faithful && params.maxStep &&
         (!(*params.maxStep >= 0.0) || !std::isfinite(*params.maxStep))) {
         throw ParameterError("--max-step must be >= 0, got " + formatNumber(*params.maxStep));

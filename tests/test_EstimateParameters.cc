@@ -308,3 +308,19 @@ TEST(EstimateParameters, ResolveReportsWhatWasGivenAndChecksRanges)
         EXPECT_STREQ(e.what(), "no particles to mesh");
     }
 }
+
+TEST(EstimateParameters, EnumeratorsOutOfRangeAreRefused)
+{
+    // An integer cast to Method ran as neither variant (the Paper mesh without the Paper
+    // threshold); one cast to VolumeOffset ran as Convex.
+    SurfaceParameters params;
+    params.method = static_cast<Method>(7);
+    EXPECT_EQ(nonbloppy_test::messageOf<ParameterError>([&] { checkParameters(params); }),
+              "method must be Paper or Faithful, got 7");
+    params.method = Method::Faithful;
+    params.volumeOffset = static_cast<VolumeOffset>(-1);
+    EXPECT_EQ(nonbloppy_test::messageOf<ParameterError>([&] { checkParameters(params); }),
+              "volume offset must be Uniform or Convex, got -1");
+    params.volumeOffset = VolumeOffset::Uniform;
+    EXPECT_NO_THROW(checkParameters(params));
+}

@@ -238,6 +238,12 @@ TEST(Fidelity, FoldedTrianglesAreFoundAndUnfolded)
     // Vertices of unfolded triangles only: vertex 0 is not in the folded triangle.
     EXPECT_EQ(mesh.points[0], before[0]);
     EXPECT_THROW(repairFolds(mesh, {}), ParameterError);
+    // A negative round count moved every folded vertex all the way back, as 0 does.
+    mesh.points[3] = openvdb::Vec3s(-0.2f, -0.2f, 0.0f);
+    const std::vector<openvdb::Vec3s> folded = mesh.points;
+    EXPECT_EQ(nonbloppy_test::messageOf<ParameterError>([&] { repairFolds(mesh, before, -5); }),
+              "fold repair rounds must be >= 0, got -5");
+    EXPECT_EQ(mesh.points, folded);
 }
 
 TEST(Fidelity, DeepFoldsTakeSeveralHalvingRounds)
@@ -360,6 +366,10 @@ TEST(Fidelity, VolumeSettingsAreChecked)
     settings.targetVolume = 0.0;
     EXPECT_EQ(message(settings), "target volume must be > 0, got 0");
     settings.targetVolume = 64.0;
+    // An integer cast to VolumeOffset ran as Convex.
+    settings.offset = static_cast<VolumeOffset>(7);
+    EXPECT_EQ(message(settings), "volume offset must be Uniform or Convex, got 7");
+    settings.offset = VolumeOffset::Convex;
     // The plain overload took a negative limit and moved the surface the wrong way (by -1:
     // inside out); the mesh is left as it was.
     const SurfaceMesh before = mesh;

@@ -78,8 +78,8 @@ constexpr int kDefaultRepairRounds = 4;
 ///                     leaves the vertices partly repaired
 /// Cost: O(rounds · P), parallel over polygons. Deterministic. Normals are not updated.
 /// Thread-safety: reentrant; the mesh is written.
-/// @throw ParameterError if @a before and mesh.points differ in size or a polygon has a
-///        corner out of range (as countFoldedTriangles(); checked before anything moves);
+/// @throw ParameterError if @a before and mesh.points differ in size, maxRounds < 0
+///        ("fold repair rounds must be >= 0, got -5") or a polygon has a corner out of range (as countFoldedTriangles(); checked before anything moves);
 ///        CancelledError("interrupted during correct surface") when @a interrupter says stop.
 NONBLOPPY_API size_t repairFolds(SurfaceMesh& mesh, const std::vector<openvdb::Vec3s>& before,
                                  int maxRounds = kDefaultRepairRounds,
@@ -149,8 +149,8 @@ NONBLOPPY_API double preserveVolume(SurfaceMesh& mesh, double targetVolume,
 /// true surface 1.3–1.5x closer than Uniform (docs/fidelity.md).
 /// @return the signed distance of the vertex that moved farthest (world units, < 0 inwards)
 /// @throw ParameterError if the target is not > 0, the floor is < 0, maxDistance is not > 0,
-///        normals are missing or a polygon has a corner out of range (as
-///        countFoldedTriangles(); checked before anything moves);
+///        the offset is not a VolumeOffset enumerator, normals are missing or a polygon has
+///        a corner out of range (as countFoldedTriangles(); checked before anything moves);
 ///        CancelledError("interrupted during correct surface") when @a interrupter says
 ///        stop (asked every 4096 polygons of each serial pass and inside
 ///        computeNormals(); a stop leaves the mesh partly offset).
