@@ -13,6 +13,8 @@
 #include <limits>
 #include <string_view>
 
+#include <unistd.h>
+
 namespace nonbloppy {
 
 namespace {
@@ -169,6 +171,9 @@ public:
             pos += length + 1;
             ++mLineNumber;
             const std::string_view line(begin, length);
+            // OBJ is text: a NUL byte means another kind of file, which the statements it
+            // does not know would otherwise read as an empty mesh.
+            if (std::memchr(line.data(), '\0', line.size())) failAtLine("binary data, not OBJ text,");
             if (line.size() < 2) continue;
             if (line[0] == 'v' && (line[1] == ' ' || line[1] == '\t')) {
                 mMesh.points.push_back(readVector(line));
@@ -289,8 +294,12 @@ bool
 declaresPolygons(const std::string& path)
 {
     const std::string ext = lowerExtension(path);
-    if (ext == ".obj") return true;
-    if (ext != ".ply" && ext != ".vtk") return false;
+    if (ext != ".ply" && ext != ".vtk") {
+        // Nothing to read, but a file that cannot be opened is said to be so (a missing
+        // .obj was declared a mesh).
+        ::close(openFile(path).fd);
+        return ext == ".obj";
+    }
     // A PLY header says it all: the vertex data after it (gigabytes, maybe) is not read.
     const std::vector<char> file = ext == ".ply" ? loadFileThrough(path, "end_header") : loadFile(path);
     return ext == ".ply" ? plyDeclaresFaces(file.data(), file.size(), path)

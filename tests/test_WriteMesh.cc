@@ -607,6 +607,14 @@ TEST_F(WriteMeshTest, ReadObjWithEveryCornerFormAndNegativeIndices)
         "expected three coordinates at line 1 (" + path("bad.obj") + ")");
     EXPECT_EQ(messageOf<FileError>([&] { readMesh(path("none.obj")); }),
         "cannot open " + path("none.obj") + ": No such file or directory");
+    // Another kind of file named .obj (a PNG; its NUL is on line 4) read as an empty mesh:
+    // its lines matched no statement.
+    writeBytes(path("bad.obj"), std::string("v 0 0 0\n\x89PNG\r\n\x1a\n\0\0\0\rIHDR", 21));
+    EXPECT_EQ(messageOf<FileError>([&] { readMesh(path("bad.obj")); }),
+        "binary data, not OBJ text, at line 4 (" + path("bad.obj") + ")");
+    // An empty OBJ file is an empty mesh, as writeMesh() writes one.
+    writeBytes(path("empty.obj"), "");
+    EXPECT_TRUE(readMesh(path("empty.obj")).points.empty());
 }
 
 TEST_F(WriteMeshTest, ReadAsciiPlyAndVtkMeshes)
@@ -705,6 +713,9 @@ TEST_F(WriteMeshTest, MeshFilesDeclareTheirPolygonsHoweverBrokenTheRestIs)
                                     "end_header\n0 0 0\n");
     EXPECT_FALSE(declaresPolygons(path("noFaces.ply")));
     EXPECT_EQ(messageOf<FileError>([&] { declaresPolygons(path("missing.ply")); }).rfind("cannot open ", 0), 0u);
+    // A missing OBJ file was declared a mesh.
+    EXPECT_EQ(messageOf<FileError>([&] { declaresPolygons(path("missing.obj")); }),
+              "cannot open " + path("missing.obj") + ": No such file or directory");
 }
 
 TEST_F(WriteMeshTest, MeasuresSurviveARoundTrip)

@@ -18,6 +18,8 @@ namespace nonbloppy {
 /// NORMALS, OBJ vn (OBJ normals belong to face corners; each vertex gets the normal of the
 /// last corner naming it). OBJ faces may use v, v/vt, v//vn and v/vt/vn, and negative
 /// (relative) indices.
+/// An OBJ file without statements (an empty file) is an empty mesh, as writeMesh() writes
+/// one; an OBJ file holding a NUL byte is refused as binary.
 /// @throw FileError for a missing, truncated or corrupt file, an unknown extension, a
 ///        polygon with fewer than three vertices or a vertex index out of range.
 /// Cost: one pass over the file. Thread-safety: reentrant, no shared state.
