@@ -416,10 +416,30 @@ addVectorAttribute(PointDataGrid& grid, const PointIndexGrid& index, const Parti
 
 } // namespace
 
+namespace {
+
+/// "non-finite position of particle N, which a .vdb points grid cannot hold", or "" if all
+/// are finite: OpenVDB's point partitioning silently dropped such particles (the other
+/// formats write them as they are).
+std::string firstUnplaceablePosition(const ParticleSet& particles)
+{
+    for (size_t n = 0; n < particles.positions.size(); ++n) {
+        const openvdb::Vec3f& p = particles.positions[n];
+        if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2])) {
+            return "non-finite position of particle " + std::to_string(n) + ", which a .vdb points grid cannot hold";
+        }
+    }
+    return std::string();
+}
+
+} // namespace
+
 openvdb::GridBase::Ptr
 makePointDataGrid(const ParticleSet& particles, double voxelSize)
 {
     openvdb::initialize();
+    const std::string unplaceable = firstUnplaceablePosition(particles);
+    if (!unplaceable.empty()) throw ParameterError(unplaceable);
     std::vector<openvdb::Vec3R> positions(particles.positions.begin(), particles.positions.end());
     const openvdb::points::PointAttributeVector<openvdb::Vec3R> wrapper(positions);
     if (!(voxelSize > 0.0)) {
@@ -476,6 +496,8 @@ writeParticles(const ParticleSet& particles, const std::string& path, const Part
     const std::string ext = requireParticleOutput(path);
     requireSizes(particles, path);
     if (ext == ".vdb") {
+        const std::string unplaceable = firstUnplaceablePosition(particles);
+        if (!unplaceable.empty()) throw ParameterError(unplaceable + " (" + path + ")");
         openvdb::MetaMap metadata;
         metadata.insertMeta("creator", openvdb::StringMetadata(std::string("nonbloppy ") + version()));
         writeVdb({makePointDataGrid(particles)}, path, metadata);

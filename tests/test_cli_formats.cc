@@ -17,6 +17,7 @@
 #include <gtest/gtest.h>
 
 #include "CliTestUtil.h"
+#include "TestUtil.h"
 
 #include <cmath>
 #include <cstring>
@@ -455,4 +456,33 @@ TEST_F(CliFormatsTest, WideIntegersSurviveAVdbOrAreRefused)
     EXPECT_EQ(message, "attribute 'h' holds 18446744073709551615, above 9223372036854775807, the largest integer "
                        "a .vdb stores");
     EXPECT_FALSE(std::filesystem::exists(path("huge.vdb")));
+}
+
+TEST_F(CliFormatsTest, AVdbCannotHoldANonFinitePositionAndSaysSo)
+{
+    // OpenVDB's partitioning dropped such a particle without a word; the other formats
+    // write it as it is, so a round trip through .vdb lost particles.
+    nonbloppy::ParticleSet particles;
+    particles.positions = {{0, 0, 0}, {0.1f, 0, 0}, {0, std::numeric_limits<float>::quiet_NaN(), 0}, {0, 0, 0.1f}};
+    const std::string file = path("nan.vdb");
+    std::string message;
+    try {
+        nonbloppy::writeParticles(particles, file);
+    } catch (const nonbloppy::ParameterError& e) {
+        message = e.what();
+    }
+    EXPECT_EQ(message, "non-finite position of particle 2, which a .vdb points grid cannot hold (" + file + ")");
+    EXPECT_FALSE(std::filesystem::exists(file));
+    particles.positions[2][1] = std::numeric_limits<float>::infinity();
+    try {
+        nonbloppy::makePointDataGrid(particles);
+        message.clear();
+    } catch (const nonbloppy::ParameterError& e) {
+        message = e.what();
+    }
+    EXPECT_EQ(message, "non-finite position of particle 2, which a .vdb points grid cannot hold");
+    // The other formats write it as it is (readParticles() then names it).
+    nonbloppy::writeParticles(particles, path("inf.ply"));
+    EXPECT_EQ(nonbloppy_test::messageOf<nonbloppy::ParameterError>([&] { nonbloppy::readParticles(path("inf.ply")); }),
+              "non-finite position of particle 2 (" + path("inf.ply") + ")");
 }

@@ -37,6 +37,7 @@ constexpr size_t kSpacingSamples = 8192;
 /// Cost: O(N) to bucket the particles plus O(samples) neighbour searches.
 /// @param positions    particle positions, world units (only read)
 /// @param maxSamples   how many particles' nearest neighbours to search, evenly spread
+///                     (0 counts as 1)
 /// @param interrupter  optional; asked every 4096 particles of the bounding box, as in
 ///                     ParticleIndex::build() while bucketing, and every 16 samples of each
 ///                     parallel search task; no start()/end()

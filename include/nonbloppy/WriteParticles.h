@@ -47,7 +47,8 @@ struct ParticleWriteSettings
 /// writer and always uses the page cache).
 /// @throw FileError for an unknown extension or an unwritable path; ParameterError for an
 ///        attribute that does not hold one value per particle, or (`.vdb`) a uint64 value
-///        above 2^63 - 1.
+///        above 2^63 - 1 or a non-finite position ("non-finite position of particle N,
+///        which a .vdb points grid cannot hold (PATH)"; other formats write it as it is).
 NONBLOPPY_API void writeParticles(const ParticleSet& particles, const std::string& path,
                                   const ParticleWriteSettings& settings = ParticleWriteSettings());
 
@@ -70,8 +71,8 @@ NONBLOPPY_API bool isParticleOutputFile(const std::string& path);
 /// component counts become one scalar attribute per component, "name_<c>"). The grid
 /// holds the particles in voxel order: readParticles() gives them back in that order.
 /// @a voxelSize ≤ 0 picks one with about 8 points per voxel (points::computeVoxelSize).
-/// @throw ParameterError for an infinite @a voxelSize or one below kMinCellSize, or a
-///        uint64 value above 2^63 - 1.
+/// @throw ParameterError for an infinite @a voxelSize or one below kMinCellSize, a uint64
+///        value above 2^63 - 1, or a non-finite position (as writeParticles()).
 /// Returned as GridBase so this header stays light (cast with
 /// openvdb::gridPtrCast<openvdb::points::PointDataGrid>).
 NONBLOPPY_API openvdb::GridBase::Ptr makePointDataGrid(const ParticleSet& particles, double voxelSize = 0.0);
