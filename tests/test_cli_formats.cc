@@ -24,6 +24,7 @@
 #include <filesystem>
 #include <limits>
 #include <map>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -485,4 +486,29 @@ TEST_F(CliFormatsTest, AVdbCannotHoldANonFinitePositionAndSaysSo)
     nonbloppy::writeParticles(particles, path("inf.ply"));
     EXPECT_EQ(nonbloppy_test::messageOf<nonbloppy::ParameterError>([&] { nonbloppy::readParticles(path("inf.ply")); }),
               "non-finite position of particle 2 (" + path("inf.ply") + ")");
+}
+
+TEST_F(CliFormatsTest, ParticlesFarFromTheOriginAreWarnedOfTheirFloatStep)
+{
+    // The cube of particles moved 1e5 out: float positions there step by 1/128, more than
+    // 1/16 of the spacing 0.05, and the surface came out quantized without a word.
+    nonbloppy::ParticleSet particles = nonbloppy::readParticles(kData + "/cube_2366_particles.vtk");
+    for (openvdb::Vec3f& p : particles.positions) p[0] += 1.0e5f;
+    const std::string far = path("far.ply"), mesh = path("far_mesh.ply");
+    nonbloppy::writeParticles(particles, far);
+    const RunResult r = run("mesh " + quote(far) + " -q -o " + quote(mesh) + " --spacing 0.05");
+    EXPECT_EQ(r.exitCode, 0) << r.err;
+    float farthest = 0.0f;
+    for (const openvdb::Vec3s& p : nonbloppy::readMesh(mesh).points) {
+        for (int k = 0; k < 3; ++k) farthest = std::max(farthest, std::abs(p[k]));
+    }
+    ASSERT_GT(farthest, 1.0e5f);
+    std::ostringstream shown;  // as the tool prints numbers: %g, 6 significant digits
+    shown << double(farthest);
+    EXPECT_EQ(r.err, "nonbloppy: warning: the surface reaches " + shown.str() +
+                         " from the origin, where float positions step by 0.0078125, more than 1/16 of the "
+                         "spacing 0.05: the surface is quantized; move the particles nearer the origin\n");
+    // At the origin, no warning.
+    EXPECT_EQ(run("mesh " + quote(kData + "/cube_2366_particles.vtk") + " -q -o " + quote(mesh) + " --spacing 0.05").err,
+              "");
 }

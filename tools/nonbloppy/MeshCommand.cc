@@ -18,7 +18,9 @@
 #include <nonbloppy/WriteVdb.h>
 
 #include <openvdb/util/NullInterrupter.h>
+#include <tbb/blocked_range.h>
 #include <tbb/global_control.h>
+#include <tbb/parallel_reduce.h>
 
 #include <algorithm>
 #include <array>
@@ -32,6 +34,7 @@
 #include <cstring>
 #include <filesystem>
 #include <iostream>
+#include <limits>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -629,6 +632,33 @@ void warnIfFacesEndInside(const MeshOptions& o, const nonbloppy::ResolvedParamet
               << std::endl;
 }
 
+/// Once per run: positions are floats, whose step grows with the distance from the origin;
+/// a scene placed far out (georeferenced, say) meshes to a surface quantized to that step,
+/// and nothing else tells why it looks rough. Warned when the step at the mesh's farthest
+/// coordinate exceeds 1/16 of the spacing (from 8192 units out for s = 0.01).
+void warnIfCoarseFloats(const nonbloppy::SurfaceResult& result)
+{
+    static std::atomic<bool> printed{false};
+    const std::vector<openvdb::Vec3s>& points = result.mesh.points;
+    const float farthest = tbb::parallel_reduce(tbb::blocked_range<size_t>(0, points.size()), 0.0f,
+        [&](const tbb::blocked_range<size_t>& range, float found) {
+            for (size_t i = range.begin(); i < range.end(); ++i) {
+                for (int k = 0; k < 3; ++k) {
+                    if (std::isfinite(points[i][k])) found = std::max(found, std::abs(points[i][k]));
+                }
+            }
+            return found;
+        },
+        [](float a, float b) { return std::max(a, b); });
+    const double step = double(std::nextafter(farthest, std::numeric_limits<float>::infinity())) - double(farthest);
+    const double spacing = result.parameters.spacing;
+    if (!(spacing > 0.0) || !(step > spacing / 16.0) || printed.exchange(true)) return;
+    std::cerr << "nonbloppy: warning: the surface reaches " << formatNumber(double(farthest))
+              << " from the origin, where float positions step by " << formatNumber(step)
+              << ", more than 1/16 of the spacing " << formatNumber(spacing)
+              << ": the surface is quantized; move the particles nearer the origin" << std::endl;
+}
+
 /// An empty mesh from particles is written (a frame of spray may have none), but said: an
 /// out-of-scale --threshold (1e308) gave 0 vertices and exit 0 without a word.
 void warnIfEmpty(const nonbloppy::SurfaceResult& result, const std::string& output)
@@ -811,6 +841,7 @@ int runSequence(const MeshOptions& o)
         if (o.verbose) sampler = std::make_unique<ResidentSampler>();
         const FrameOutcome outcome = meshFrame(f, interrupter);
         warnIfFacesEndInside(o, outcome.result.parameters);
+        warnIfCoarseFloats(outcome.result);
         warnIfEmpty(outcome.result, f.output);
 
         FrameReport report;
@@ -866,6 +897,7 @@ int runMesh(const MeshOptions& o)
         const FrameOutcome outcome = meshFrame(o, interrupter);
         interrupter.clearLine();
         warnIfFacesEndInside(o, outcome.result.parameters);
+        warnIfCoarseFloats(outcome.result);
         warnIfEmpty(outcome.result, o.output);
         if (sampler) {
             sampler->stop();
