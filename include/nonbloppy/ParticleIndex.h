@@ -32,13 +32,15 @@ namespace nonbloppy {
 /// of particles spaced a micrometre apart need a smaller unit (millimetres) to be meshed.
 constexpr double kMinCellSize = 1.5e-5;
 
-/// The cells per effective radius (r_e / cell size) that rasterizeDensity() and
-/// relaxVertices() accept from the index they search; buildSurface() uses 2. Measured on the
-/// dam-break frame against 2 cells per radius: relaxation is 14× slower at 8 cells per
-/// radius, 130× at 16 and 4500× at 64 (a search box probes (2·r_e/cell)² cell columns), and
-/// 22× slower at 1/4 (each cell holds (cell/s)³ particles); outside these bounds a mistaken
-/// unit made an uncancellable run of minutes.
+/// The fewest cells per effective radius (r_e / cell size) that rasterizeDensity() and
+/// relaxVertices() accept from the index they search (the most: kMaxCellsPerRadius);
+/// buildSurface() uses 2. Measured on the dam-break frame against 2 cells per radius:
+/// relaxation is 14× slower at 8 cells per radius, 130× at 16 and 4500× at 64 (a search
+/// box probes (2·r_e/cell)² cell columns), and 22× slower at 1/4 (each cell holds
+/// (cell/s)³ particles); outside these bounds a mistaken unit made an uncancellable run of
+/// minutes.
 constexpr double kMinCellsPerRadius = 0.25;
+/// The most cells per effective radius; see kMinCellsPerRadius.
 constexpr double kMaxCellsPerRadius = 8.0;
 
 /// Particles bucketed into cubic cells of a PointIndexGrid.
