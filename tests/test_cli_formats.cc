@@ -512,3 +512,24 @@ TEST_F(CliFormatsTest, ParticlesFarFromTheOriginAreWarnedOfTheirFloatStep)
     EXPECT_EQ(run("mesh " + quote(kData + "/cube_2366_particles.vtk") + " -q -o " + quote(mesh) + " --spacing 0.05").err,
               "");
 }
+
+TEST_F(CliFormatsTest, AttributesOfTheWrongShapeAreNamedAndNothingIsWritten)
+{
+    nonbloppy::ParticleSet particles;
+    particles.positions = {{0, 0, 0}, {0.1f, 0, 0}};
+    nonbloppy::ParticleAttribute attribute;
+    attribute.name = "speed";
+    attribute.type = nonbloppy::ScalarType::Float32;
+    attribute.components = 0;  // was reported as "does not hold one value per particle"
+    attribute.bytes.resize(8);
+    particles.attributes.push_back(attribute);
+    const std::string file = path("shape.ply");
+    const auto message = [&] {
+        return nonbloppy_test::messageOf<nonbloppy::ParameterError>([&] { nonbloppy::writeParticles(particles, file); });
+    };
+    EXPECT_EQ(message(), "attribute 'speed' has 0 components, at least 1 needed (" + file + ")");
+    particles.attributes[0].components = 1;
+    particles.attributes[0].bytes.resize(4);  // one float for two particles
+    EXPECT_EQ(message(), "attribute 'speed' does not hold one value per particle (" + file + ")");
+    EXPECT_FALSE(std::filesystem::exists(file));
+}
