@@ -10,6 +10,7 @@
 #include <nonbloppy/ComputeNormals.h>
 
 #include "Cancellation.h"
+#include "ParameterChecks.h"
 #include "PolygonIndices.h"
 #include "SurfaceStages.h"
 #include "VectorArea.h"
@@ -424,9 +425,7 @@ double surface_stages_internal::preserveVolumeUnchecked(SurfaceMesh& mesh, const
         throw ParameterError(msg.str());
     }
     requireMaxDistance(settings.maxDistance);
-    if (settings.offset != VolumeOffset::Uniform && settings.offset != VolumeOffset::Convex) {
-        throw ParameterError("volume offset must be Uniform or Convex, got " + std::to_string(int(settings.offset)));
-    }
+    parameter_checks_internal::requireVolumeOffset(settings.offset);
     if (settings.offset == VolumeOffset::Uniform) {
         return preserveVolume(mesh, settings.targetVolume, settings.maxDistance, interrupter);
     }

@@ -355,11 +355,7 @@ void checkParameters(const SurfaceParameters& params)
     if (params.method != Method::Paper && params.method != Method::Faithful) {
         throw ParameterError("method must be Paper or Faithful, got " + std::to_string(int(params.method)));
     }
-    if (params.volumeOffset && *params.volumeOffset != VolumeOffset::Uniform &&
-        *params.volumeOffset != VolumeOffset::Convex) {
-        throw ParameterError("volume offset must be Uniform or Convex, got " +
-                             std::to_string(int(*params.volumeOffset)));
-    }
+    if (params.volumeOffset) parameter_checks_internal::requireVolumeOffset(*params.volumeOffset);
     if (params.method == Method::Faithful && params.maxStep &&
         (!(*params.maxStep >= 0.0) || !std::isfinite(*params.maxStep))) {
         throw ParameterError("--max-step must be >= 0, got " + formatNumber(*params.maxStep));

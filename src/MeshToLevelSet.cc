@@ -29,11 +29,6 @@ namespace {
 /// h/4 with half widths 3 and 10, rounded up.
 constexpr double kPeakBytesPerBandVoxel = 32.0;
 
-/// Index coordinates are 32-bit and meshToVolume works on float index coordinates: beyond
-/// this a mesh's voxels overflow or its float corners stop resolving voxels (a mesh moved
-/// 5e7 from the origin at h = 0.02 hung, unheard by the interrupter).
-constexpr double kMaxIndexCoordinate = 1.0e9;
-
 /// The machine's physical memory in bytes, or 0 if unknown.
 double physicalMemoryBytes()
 {
@@ -53,7 +48,7 @@ void requireVerticesInRange(const SurfaceMesh& mesh, double voxelSize, float hal
         }
         largest = std::max({largest, std::abs(p[0]), std::abs(p[1]), std::abs(p[2])});
     }
-    if (double(largest) / voxelSize + double(halfWidth) > kMaxIndexCoordinate) {
+    if (double(largest) / voxelSize + double(halfWidth) > openvdb_scale_internal::kMaxIndexCoordinate) {
         std::ostringstream msg;
         msg << "mesh coordinates up to " << double(largest) << " are too far from the origin for a voxel size of "
             << voxelSize << " (32-bit index space)";

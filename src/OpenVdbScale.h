@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: Apache-2.0
 /// @file OpenVdbScale.h
 /// @brief Private: the one check, and the one message, for lengths below the smallest voxel
-///        or cell OpenVDB's linear transforms accept (kMinCellSize). Only src/ includes it.
+///        or cell OpenVDB's linear transforms accept (kMinCellSize), and the largest index
+///        coordinate accepted. Only src/ includes it.
 
 #ifndef NONBLOPPY_OPENVDB_SCALE_H
 #define NONBLOPPY_OPENVDB_SCALE_H
@@ -12,6 +13,12 @@
 
 namespace nonbloppy {
 namespace openvdb_scale_internal {
+
+/// The largest index-space coordinate (world coordinate / cell or voxel size) accepted for
+/// particles and mesh vertices: OpenVDB's coordinates are 32-bit, and meshToVolume works on
+/// float index coordinates that stop resolving voxels far beyond this (a mesh 5e7 out at
+/// h = 0.02 hung, unheard by the interrupter).
+constexpr double kMaxIndexCoordinate = 1.0e9;
 
 /// Throw ParameterError("<name> <value> is below <least>, the smallest OpenVDB accepts: give
 /// the positions in a smaller unit") if @a value < @a least. Called before any grid is made:

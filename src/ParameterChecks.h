@@ -1,8 +1,10 @@
 // SPDX-License-Identifier: Apache-2.0
 /// @file ParameterChecks.h
-/// @brief One wording, across the library, for a length that must be positive and finite.
+/// @brief One wording, across the library, for a length that must be positive and finite,
+///        and for an enumerator out of range.
 #pragma once
 
+#include <nonbloppy/CorrectSurface.h>
 #include <nonbloppy/Error.h>
 
 #include <cmath>
@@ -22,6 +24,15 @@ inline void requirePositive(double value, const std::string& name)
     std::ostringstream msg;
     msg << name << (std::isfinite(value) ? " must be > 0, got " : " must be finite, got ") << value;
     throw ParameterError(msg.str());
+}
+
+/// @throw ParameterError("volume offset must be Uniform or Convex, got 7") for a value that
+///        is neither (an integer cast to VolumeOffset), which ran as Convex: the one check
+///        of checkParameters() and preserveVolume().
+inline void requireVolumeOffset(VolumeOffset offset)
+{
+    if (offset == VolumeOffset::Uniform || offset == VolumeOffset::Convex) return;
+    throw ParameterError("volume offset must be Uniform or Convex, got " + std::to_string(int(offset)));
 }
 
 } // namespace parameter_checks_internal

@@ -9,8 +9,8 @@
 
 #include <nonbloppy/BuildSurface.h>
 #include <nonbloppy/CorrectSurface.h>
-#include <nonbloppy/SmoothSurface.h>
 #include <nonbloppy/ParticleIndex.h>
+#include <nonbloppy/SmoothSurface.h>
 
 #include <openvdb/openvdb.h>
 #include <openvdb/util/NullInterrupter.h>
@@ -94,8 +94,8 @@ void runSurfaceStages(const ParticleIndex& index, bool keepDensity, SurfaceResul
 
 /// repairFolds(), preserveVolume(mesh, VolumeSettings) and smoothSurface() without the check
 /// that every polygon corner is a vertex of the mesh, which the public functions make first
-/// (polygon_indices_internal::requireValidIndices(): 3.5 ms per call on two threads for the
-/// 2.6M polygons of the 64x benchmark mesh): the chain's mesh comes from extractSurface(),
+/// (polygon_indices_internal::requireValidIndices(): 3.5 ms per call on two threads for a
+/// synthetic mesh of 2.66M polygons, the 64x benchmark mesh's size): the chain's mesh comes from extractSurface(),
 /// valid by construction, and passes through all three. Same results, same other checks.
 size_t repairFoldsUnchecked(SurfaceMesh& mesh, const std::vector<openvdb::Vec3s>& before, int maxRounds,
                             openvdb::util::NullInterrupter* interrupter);

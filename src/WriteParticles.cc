@@ -11,8 +11,10 @@
 
 #include "AtomicFile.h"
 #include "AttributeNames.h"
+#include "Cancellation.h"
 #include "FileFormats.h"
 #include "OpenVdbScale.h"
+#include "ParticleIndexImpl.h"
 
 // OpenVDB's point templates must keep default visibility (see src/VisibilityPrelude.h).
 #pragma GCC visibility push(default)
@@ -422,28 +424,24 @@ addVectorAttribute(PointDataGrid& grid, const PointIndexGrid& index, const Parti
 
 namespace {
 
-/// "non-finite position of particle N, which a .vdb points grid cannot hold", or "" if all
-/// are finite: OpenVDB's point partitioning silently dropped such particles (the other
-/// formats write them as they are).
-std::string firstUnplaceablePosition(const ParticleSet& particles)
+/// @throw ParameterError("non-finite position of particle N, which a .vdb points grid cannot
+///        hold" + @a suffix): OpenVDB's point partitioning silently dropped such particles
+///        (the other formats write them as they are). Cost: one parallel pass.
+void requirePlaceablePositions(const ParticleSet& particles, const std::string& suffix)
 {
-    for (size_t n = 0; n < particles.positions.size(); ++n) {
-        const openvdb::Vec3f& p = particles.positions[n];
-        if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2])) {
-            return "non-finite position of particle " + std::to_string(n) + ", which a .vdb points grid cannot hold";
-        }
+    cancellation_internal::CancelPoll never(nullptr, "write particles");
+    const size_t bad = particle_index_internal::scanPositions(particles.positions, never).firstNonFinite;
+    if (bad < particles.positions.size()) {
+        throw ParameterError(particle_index_internal::nonFinitePositionMessage(bad) +
+                             ", which a .vdb points grid cannot hold" + suffix);
     }
-    return std::string();
 }
 
-} // namespace
-
+/// makePointDataGrid() of positions requirePlaceablePositions() has passed.
 openvdb::GridBase::Ptr
-makePointDataGrid(const ParticleSet& particles, double voxelSize)
+pointDataGridOfFinitePositions(const ParticleSet& particles, double voxelSize)
 {
     openvdb::initialize();
-    const std::string unplaceable = firstUnplaceablePosition(particles);
-    if (!unplaceable.empty()) throw ParameterError(unplaceable);
     std::vector<openvdb::Vec3R> positions(particles.positions.begin(), particles.positions.end());
     const openvdb::points::PointAttributeVector<openvdb::Vec3R> wrapper(positions);
     if (!(voxelSize > 0.0)) {
@@ -494,17 +492,25 @@ makePointDataGrid(const ParticleSet& particles, double voxelSize)
     return grid;
 }
 
+} // namespace
+
+openvdb::GridBase::Ptr
+makePointDataGrid(const ParticleSet& particles, double voxelSize)
+{
+    requirePlaceablePositions(particles, "");
+    return pointDataGridOfFinitePositions(particles, voxelSize);
+}
+
 void
 writeParticles(const ParticleSet& particles, const std::string& path, const ParticleWriteSettings& settings)
 {
     const std::string ext = requireParticleOutput(path);
     requireSizes(particles, path);
     if (ext == ".vdb") {
-        const std::string unplaceable = firstUnplaceablePosition(particles);
-        if (!unplaceable.empty()) throw ParameterError(unplaceable + " (" + path + ")");
+        requirePlaceablePositions(particles, " (" + path + ")");
         openvdb::MetaMap metadata;
         metadata.insertMeta("creator", openvdb::StringMetadata(std::string("nonbloppy ") + version()));
-        writeVdb({makePointDataGrid(particles)}, path, metadata);
+        writeVdb({pointDataGridOfFinitePositions(particles, 0.0)}, path, metadata);
         return;
     }
     writeFileAtomically(path, [&](std::ostream& os) {

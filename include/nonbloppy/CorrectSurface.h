@@ -79,7 +79,8 @@ constexpr int kDefaultRepairRounds = 4;
 /// Cost: O(rounds · P), parallel over polygons. Deterministic. Normals are not updated.
 /// Thread-safety: reentrant; the mesh is written.
 /// @throw ParameterError if @a before and mesh.points differ in size, maxRounds < 0
-///        ("fold repair rounds must be >= 0, got -5") or a polygon has a corner out of range (as countFoldedTriangles(); checked before anything moves);
+///        ("fold repair rounds must be >= 0, got -5") or a polygon has a corner out of
+///        range (as countFoldedTriangles(); checked before anything moves);
 ///        CancelledError("interrupted during correct surface") when @a interrupter says stop.
 NONBLOPPY_API size_t repairFolds(SurfaceMesh& mesh, const std::vector<openvdb::Vec3s>& before,
                                  int maxRounds = kDefaultRepairRounds,

@@ -639,6 +639,7 @@ void warnIfFacesEndInside(const MeshOptions& o, const nonbloppy::ResolvedParamet
 void warnIfCoarseFloats(const nonbloppy::SurfaceResult& result)
 {
     static std::atomic<bool> printed{false};
+    if (printed.load()) return;  // said once: later frames need no scan
     const std::vector<openvdb::Vec3s>& points = result.mesh.points;
     const float farthest = tbb::parallel_reduce(tbb::blocked_range<size_t>(0, points.size()), 0.0f,
         [&](const tbb::blocked_range<size_t>& range, float found) {
