@@ -58,6 +58,14 @@ TEST_F(CliTest, MeshWritesObjAndVdbAndSummary)
     EXPECT_NE(r.out.find("smoothing            off            (needs --spacing)"), std::string::npos) << r.out;
     EXPECT_NE(r.out.find("region leaves        1024           (default)"), std::string::npos) << r.out;
     EXPECT_NE(r.out.find("rasterize density"), std::string::npos) << r.out;
+    // Each timing line ends with the cores the stage kept busy, its CPU over wall-clock time.
+    EXPECT_NE(r.out.find("timings                    wall             cores\n"), std::string::npos) << r.out;
+    const size_t total = r.out.find("\n  total ");
+    ASSERT_NE(total, std::string::npos) << r.out;
+    double totalSeconds = 0.0, totalCores = 0.0;
+    ASSERT_EQ(std::sscanf(r.out.c_str() + total, " total %lf s %lf", &totalSeconds, &totalCores), 2) << r.out;
+    EXPECT_GT(totalSeconds, 0.0);
+    EXPECT_GT(totalCores, 0.0) << r.out;
     EXPECT_EQ(listDir(dir() + "/out"), (std::vector<std::string>{"cube.obj", "cube.vdb"}));
     EXPECT_GT(fs::file_size(out("cube.obj")), 1000u);
     EXPECT_GT(fs::file_size(out("cube.vdb")), 1000u);

@@ -465,14 +465,19 @@ void printSummary(const MeshOptions& o, const nonbloppy::SurfaceResult& result,
     row("mesh", o.output, "");
     if (!o.vdbPath.empty()) row("density grid", o.vdbPath, "");
 
-    out << "timings\n";
+    // Wall-clock time, its share, and the cores the stage kept busy (process CPU time over
+    // wall-clock time): a stage far below the thread count waits on something serial.
+    out << "timings" << std::string(20, ' ') << "wall" << std::string(13, ' ') << "cores\n";
     const double total = timings.total();
+    const auto cores = [](double cpuSeconds, double seconds) { return seconds > 0 ? cpuSeconds / seconds : 0.0; };
     for (const auto& entry : timings.entries) {
-        std::snprintf(line, sizeof(line), "  %-20s %8.3f s  (%4.1f%%)", entry.stage.c_str(),
-                      entry.seconds, total > 0 ? 100.0 * entry.seconds / total : 0.0);
+        std::snprintf(line, sizeof(line), "  %-20s %8.3f s  (%4.1f%%)  %5.2f", entry.stage.c_str(),
+                      entry.seconds, total > 0 ? 100.0 * entry.seconds / total : 0.0,
+                      cores(entry.cpuSeconds, entry.seconds));
         out << line << "\n";
     }
-    std::snprintf(line, sizeof(line), "  %-20s %8.3f s", "total", total);
+    std::snprintf(line, sizeof(line), "  %-20s %8.3f s           %5.2f", "total", total,
+                  cores(timings.cpuTotal(), total));
     out << line << "\n";
     out.flush();
 }
@@ -616,8 +621,8 @@ FrameOutcome meshFrame(const MeshOptions& o, ProgressInterrupter& interrupter)
     cleanup.keep();
 
     outcome.timings = before;
-    for (const auto& entry : result.timings.entries) outcome.timings.add(entry.stage, entry.seconds);
-    for (const auto& entry : after.entries) outcome.timings.add(entry.stage, entry.seconds);
+    outcome.timings.add(result.timings);
+    outcome.timings.add(after);
     return outcome;
 }
 
