@@ -173,8 +173,12 @@ for ((r = 0; r < thread_pairs; ++r)); do
   order=(1 2); ((r % 2)) && order=(2 1)
   for threads in "${order[@]}"; do
     scan_once "threads$threads" "${nb_args[@]}" --threads "$threads"
+    # threads, pair, stage, wall seconds, cores busy (the summary's last column)
     sed -n '/^timings/,$p' "$out/scan_threads$threads.out" | grep ' s ' \
-      | sed -E 's/^ +//; s/ +([0-9.]+) s .*/\t\1/' | awk -v t="$threads" -v r="$r" -F'\t' '{print t "\t" r "\t" $1 "\t" $2}' \
+      | awk -v t="$threads" -v r="$r" '{
+          for (i = 2; i <= NF; ++i) if ($i == "s") break
+          name = $1; for (k = 2; k < i - 1; ++k) name = name " " $k
+          print t "\t" r "\t" name "\t" $(i - 1) "\t" $NF}' \
       >> "$out/scan_threads_stages"
   done
 done
@@ -210,13 +214,17 @@ thread_ratios() {
 median_of() { sort -g | awk -v f="${1:-%.2f}" '{v[NR] = $1} END {if (NR) printf f, (NR % 2 ? v[(NR + 1) / 2] : (v[NR / 2] + v[NR / 2 + 1]) / 2)}'; }
 say "Two threads against one, median of the $thread_pairs pairs' ratios: $(thread_ratios wall | median_of)x (pairs: $(thread_ratios wall | awk '{printf "%s%.2f", (NR > 1 ? " " : ""), $1}')). Per stage:"
 say ""
-say "| stage | 1 thread s | 2 threads s | ratio (median of pairs) |"
-say "| --- | --- | --- | --- |"
+# Cores busy: the stage's process CPU time over its wall time, as nonbloppy prints it. Below 2
+# at two threads, a stage waits on something serial; at ~2 with a ratio below 2, each core
+# does its work more slowly when both run (shared caches, memory, clock).
+say "| stage | 1 thread s | 2 threads s | ratio (median of pairs) | cores busy at 2 threads |"
+say "| --- | --- | --- | --- | --- |"
 while IFS= read -r stage; do
   one=$(awk -F'\t' -v name="$stage" '$1 == 1 && $3 == name {print $4}' "$out/scan_threads_stages" | median_of %.3f)
   two=$(awk -F'\t' -v name="$stage" '$1 == 2 && $3 == name {print $4}' "$out/scan_threads_stages" | median_of %.3f)
-  say "| $stage | $one | $two | $(thread_ratios "$stage" | median_of) |"
-done < <(awk -F'\t' '$1 == 1 && $2 == 0 && $3 != "total" {print $3}' "$out/scan_threads_stages")
+  cores=$(awk -F'\t' -v name="$stage" '$1 == 2 && $3 == name {print $5}' "$out/scan_threads_stages" | median_of)
+  say "| $stage | $one | $two | $(thread_ratios "$stage" | median_of) | $cores |"
+done < <(awk -F'\t' '$1 == 1 && $2 == 0 {print $3}' "$out/scan_threads_stages")
 
 # The paper's figure: 14,272 particles, t = 2, about 15 s on a 2008 desktop. Compute time of the
 # 1x frame (24,389 particles; stages without reading and writing) scaled to 14,272 particles.
