@@ -150,9 +150,11 @@ protected:
 
     /// Starts `nonbloppy ARGS` (unquoted arguments) with stdout to /dev/null and stderr to
     /// stderr.txt; waits until @a ready holds for that stderr (at most 30 s), sends @a signal
-    /// and waits for the exit. Returns how it ended and the stderr text.
+    /// @a times times, @a gap apart, and waits for the exit. Returns how it ended and the
+    /// stderr text.
     RunResult interruptWhen(const std::vector<std::string>& args,
-                            const std::function<bool(const std::string& err)>& ready, int signal) const
+                            const std::function<bool(const std::string& err)>& ready, int signal,
+                            int times = 1, std::chrono::milliseconds gap = std::chrono::milliseconds(0)) const
     {
         const std::string errFile = mDir + "/stderr.txt";
         std::vector<std::string> full = {kCli};
@@ -177,7 +179,10 @@ protected:
         while (!ready(readText(errFile)) && std::chrono::steady_clock::now() < deadline) {
             std::this_thread::sleep_for(std::chrono::milliseconds(5));
         }
-        ::kill(pid, signal);
+        for (int n = 0; n < times; ++n) {
+            if (n > 0) std::this_thread::sleep_for(gap);
+            ::kill(pid, signal);
+        }
         int status = 0;
         if (::waitpid(pid, &status, 0) != pid) ADD_FAILURE() << "waitpid failed";
         result.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);

@@ -16,6 +16,8 @@
 #include <string>
 #include <vector>
 
+#include <sys/stat.h>
+
 namespace {
 
 namespace fs = std::filesystem;
@@ -544,6 +546,40 @@ TEST_F(CliTest, SigintSigtermAndSighupCancelWithoutLeavingFiles)
         EXPECT_EQ(errLines.back(), "nonbloppy: interrupted");
         EXPECT_TRUE(listDir(dir() + "/out").empty()) << "output files left behind";
     }
+}
+
+TEST_F(CliTest, RepeatedSignalsWithinASecondAreOneRequest)
+{
+    // timeout(1) signals its child and then its whole process group: two SIGINTs at once. The
+    // second used to end the process mid clean-up, leaving the new mesh beside the previous
+    // run's .vdb and a backup of the old mesh.
+    writeText(out("dam.obj"), "old mesh\n");
+    writeText(out("dam.vdb"), "old grid\n");
+    const RunResult r = interruptWhen(
+        {"mesh", kData + "/dam_break_frame_23_24389_particles.vtk", "-o", out("dam.obj"), "--vdb",
+         out("dam.vdb"), "--voxel-size", "0.005", "-v"},
+        [](const std::string& err) { return err.find("[progress] rasterize density") != std::string::npos; },
+        SIGINT, 2);
+    ASSERT_EQ(r.killedBy, 0) << "killed by the second signal instead of handling the first";
+    EXPECT_EQ(r.exitCode, 130);
+    EXPECT_EQ(lines(r.err).back(), "nonbloppy: interrupted");
+    EXPECT_EQ(listDir(dir() + "/out"), (std::vector<std::string>{"dam.obj", "dam.vdb"}));
+    EXPECT_EQ(readText(out("dam.obj")), "old mesh\n");
+    EXPECT_EQ(readText(out("dam.vdb")), "old grid\n");
+}
+
+TEST_F(CliTest, ASignalASecondAfterTheFirstEndsAStuckRun)
+{
+    // Reading a FIFO that nobody writes blocks in open(), where the first signal cannot stop
+    // it; a second one, a second or more later, ends the process (the signal's default action).
+    const std::string fifo = in("fifo.vtk");
+    ASSERT_EQ(::mkfifo(fifo.c_str(), 0644), 0);
+    const RunResult r = interruptWhen(
+        {"mesh", fifo, "-o", out("x.obj"), "-v"},
+        [](const std::string& err) { return err.find("[progress] read particles") != std::string::npos; },
+        SIGTERM, 2, std::chrono::milliseconds(1300));
+    EXPECT_EQ(r.killedBy, SIGTERM);
+    EXPECT_TRUE(listDir(dir() + "/out").empty());
 }
 
 TEST_F(CliTest, VersionAndHelp)

@@ -43,6 +43,7 @@
 #include <vector>
 
 #include <sys/stat.h>
+#include <time.h>
 #ifdef __GLIBC__
 #include <malloc.h>
 #endif
@@ -62,10 +63,29 @@ namespace fs = std::filesystem;
 std::atomic<bool> gInterruptRequested{false};
 static_assert(std::atomic<bool>::is_always_lock_free, "the signal handler needs a lock-free flag");
 
+/// When the first stop signal of the run arrived (CLOCK_MONOTONIC nanoseconds, never 0), or 0.
+std::atomic<int64_t> gFirstStopSignalAt{0};
+static_assert(std::atomic<int64_t>::is_always_lock_free, "the signal handler needs a lock-free clock");
+
+/// Repeats of a stop signal within this time of the first are the same request: timeout(1)
+/// signals its child and then its whole process group, and a double key press sends two
+/// SIGINTs. Ending the run at once on the second of those cut short the clean-up and left this
+/// run's mesh beside the previous run's .vdb (and a stray backup of the old mesh).
+constexpr int64_t kRepeatedSignalNanoseconds = 1'000'000'000;
+
 extern "C" void onInterruptSignal(int signalNumber)
 {
-    // A second signal means "stop now": fall back to the default action.
-    if (gInterruptRequested.exchange(true)) {
+    timespec now{};
+    ::clock_gettime(CLOCK_MONOTONIC, &now);  // async-signal-safe
+    const int64_t at = std::max<int64_t>(1, int64_t(now.tv_sec) * 1'000'000'000 + now.tv_nsec);
+    int64_t first = 0;
+    if (gFirstStopSignalAt.compare_exchange_strong(first, at)) {
+        gInterruptRequested = true;
+        return;
+    }
+    // A signal a second or more after the first means "stop now": the run has not stopped on
+    // its own (it may be blocked, say reading a FIFO that nobody writes). Default action.
+    if (at - first >= kRepeatedSignalNanoseconds) {
         std::signal(signalNumber, SIG_DFL);
         std::raise(signalNumber);
     }
@@ -73,7 +93,8 @@ extern "C" void onInterruptSignal(int signalNumber)
 
 /// For the command's duration: SIGINT, SIGTERM and SIGHUP (a closed terminal or ssh session)
 /// stop the run cleanly, as an interrupt (exit 130, no partial files, the log's summary
-/// written); a SIGHUP that was ignored (nohup) stays ignored. SIGPIPE is ignored: a reader
+/// written); repeats within a second are absorbed, a later one ends the process at once (the
+/// signal's default action); a SIGHUP that was ignored (nohup) stays ignored. SIGPIPE is ignored: a reader
 /// of stdout that went away ('| head -1') used to end the run silently with exit 141 and
 /// the log unfinished; now only the lost stdout lines are lost. The previous handlers are
 /// restored at the end.
@@ -83,6 +104,7 @@ public:
     SignalHandlerScope()
     {
         gInterruptRequested = false;
+        gFirstStopSignalAt = 0;
         for (size_t n = 0; n < kStopSignals.size(); ++n) {
             mOld[n] = std::signal(kStopSignals[n], onInterruptSignal);
             if (kStopSignals[n] == SIGHUP && mOld[n] == SIG_IGN) std::signal(SIGHUP, SIG_IGN);
