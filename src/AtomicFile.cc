@@ -340,11 +340,23 @@ std::string temporaryPattern(const std::string& target)
     return (slash == std::string::npos ? std::string() : target.substr(0, slash + 1)) + kSuffix;
 }
 
+/// @throw FileError unless @a target (symbolic links followed) is missing or a regular file:
+/// renaming over a device, FIFO or socket would replace the node itself (as root, /dev/null
+/// or /dev/full), and over a directory fails only after all the work.
+void requireRegularOrMissing(const std::string& path, const std::string& target)
+{
+    struct stat status{};
+    if (::stat(target.c_str(), &status) != 0 || S_ISREG(status.st_mode)) return;
+    if (S_ISDIR(status.st_mode)) throwWriteError(path, EISDIR);
+    throw FileError("cannot write " + path + ": not a regular file");
+}
+
 } // namespace
 
 AtomicFile::AtomicFile(const std::string& path)
     : mPath(path), mTarget(followSymlinks(path))
 {
+    requireRegularOrMissing(mPath, mTarget);
     std::string pattern = temporaryPattern(mTarget);
     std::vector<char> name(pattern.begin(), pattern.end());
     name.push_back('\0');

@@ -461,6 +461,27 @@ TEST_F(WriteMeshTest, WritingThroughASymlinkUpdatesItsTargetAndKeepsTheLink)
     EXPECT_TRUE(fs::is_symlink(path("loopA.ply")));
 }
 
+TEST_F(WriteMeshTest, AFifoOrADirectoryInPlaceOfTheFileIsRefusedAndKept)
+{
+    // Renaming over a FIFO or device replaced the node itself: as root, through a link to
+    // /dev/full, the system's /dev/full became a mesh file.
+    namespace fs = std::filesystem;
+    const SurfaceMesh mesh = mixedMesh();
+    ASSERT_EQ(::mkfifo(path("pipe.ply").c_str(), 0644), 0);
+    fs::create_symlink("pipe.ply", path("link.ply"));
+    fs::create_directory(path("dir.ply"));
+    EXPECT_EQ(messageOf<FileError>([&] { writeMesh(mesh, path("pipe.ply")); }),
+              "cannot write " + path("pipe.ply") + ": not a regular file");
+    EXPECT_EQ(messageOf<FileError>([&] { writeMesh(mesh, path("link.ply")); }),
+              "cannot write " + path("link.ply") + ": not a regular file");
+    EXPECT_EQ(messageOf<FileError>([&] { writeMesh(mesh, path("dir.ply")); }),
+              "cannot write " + path("dir.ply") + ": Is a directory");
+    EXPECT_TRUE(fs::is_fifo(path("pipe.ply")));
+    EXPECT_TRUE(fs::is_symlink(path("link.ply")));
+    EXPECT_TRUE(fs::is_directory(path("dir.ply")));
+    EXPECT_EQ(listDirectory(dir()), (std::set<std::string>{"dir.ply", "link.ply", "pipe.ply"}));
+}
+
 TEST_F(WriteMeshTest, NamesUpToTheFileSystemLimitCanBeWritten)
 {
     // 255 bytes is ext4's and tmpfs's limit; "name.tmp-XXXXXX" would exceed it from 245 on.

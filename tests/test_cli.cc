@@ -582,6 +582,25 @@ TEST_F(CliTest, ASignalASecondAfterTheFirstEndsAStuckRun)
     EXPECT_TRUE(listDir(dir() + "/out").empty());
 }
 
+TEST_F(CliTest, AnOutputThatIsNotARegularFileIsRefusedBeforeAnyWork)
+{
+    // A FIFO (or a device, or a link to one) in place of the mesh or the .vdb: refused before
+    // the input is read, and left as it was.
+    ASSERT_EQ(::mkfifo(out("pipe.obj").c_str(), 0644), 0);
+    ASSERT_EQ(::mkfifo(out("pipe.vdb").c_str(), 0644), 0);
+    const RunResult mesh = run("mesh " + quote(kCube) + " -o " + quote(out("pipe.obj")));
+    EXPECT_EQ(mesh.exitCode, 1);
+    EXPECT_EQ(mesh.err, "nonbloppy: cannot write " + out("pipe.obj") + ": not a regular file\n");
+    const RunResult vdb = run("mesh " + quote(kCube) + " -o " + quote(out("cube.obj")) + " --vdb " + quote(out("pipe.vdb")));
+    EXPECT_EQ(vdb.exitCode, 1);
+    EXPECT_EQ(vdb.err, "nonbloppy: cannot write " + out("pipe.vdb") + ": not a regular file\n");
+    const RunResult convert = run("convert " + quote(kCube) + " " + quote(out("pipe.vdb")));
+    EXPECT_EQ(convert.exitCode, 1);
+    EXPECT_EQ(convert.err, "nonbloppy: cannot write " + out("pipe.vdb") + ": not a regular file\n");
+    EXPECT_EQ(listDir(dir() + "/out"), (std::vector<std::string>{"pipe.obj", "pipe.vdb"}));
+    EXPECT_TRUE(fs::is_fifo(out("pipe.obj")));
+}
+
 TEST_F(CliTest, VersionAndHelp)
 {
     const RunResult version = run("--version");

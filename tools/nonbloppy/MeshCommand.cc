@@ -323,7 +323,6 @@ std::string lowerExtension(const std::string& path)
     return ext;
 }
 
-/// Fail now, before any work, if @a path's directory does not exist or cannot be written.
 /// True if @a a and @a b name one file: the same name (which need not exist yet), or
 /// existing paths to one file (hard links, symbolic links, "./").
 bool sameFile(const std::string& a, const std::string& b)
@@ -332,8 +331,19 @@ bool sameFile(const std::string& a, const std::string& b)
     return a == b || fs::equivalent(a, b, ec);
 }
 
+/// Fail now, before any work, if @a path's directory does not exist or cannot be written, or
+/// @a path is something other than a regular file (a directory, a device such as /dev/null, a
+/// FIFO; symbolic links followed), which the writers refuse only once the mesh is made.
 void requireWritableDirectory(const std::string& path)
 {
+    std::error_code statusError;
+    const fs::file_status existing = fs::status(path, statusError);
+    if (fs::is_directory(existing)) {
+        throw nonbloppy::FileError("cannot write " + path + ": " + std::strerror(EISDIR));
+    }
+    if (fs::exists(existing) && !fs::is_regular_file(existing)) {
+        throw nonbloppy::FileError("cannot write " + path + ": not a regular file");
+    }
     fs::path dir = fs::path(path).parent_path();
     if (dir.empty()) dir = ".";
     std::error_code ec;
