@@ -601,6 +601,32 @@ TEST_F(CliTest, AnOutputThatIsNotARegularFileIsRefusedBeforeAnyWork)
     EXPECT_TRUE(fs::is_fifo(out("pipe.obj")));
 }
 
+TEST_F(CliTest, AReportThatCannotBeWrittenIsAFailure)
+{
+    // 'inspect --json > info.json' on a full disk used to exit 0 with an empty file.
+    if (!fs::exists("/dev/full")) GTEST_SKIP() << "no /dev/full";
+    const std::string errFile = dir() + "/stderr.txt";
+    const auto runTo = [&](const std::string& args, const std::string& redirect) {
+        const int status = std::system((quote(kCli) + " " + args + " " + redirect + " 2>" + quote(errFile)).c_str());
+        return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+    };
+    EXPECT_EQ(runTo("inspect " + quote(kCube) + " --json", ">/dev/full"), 1);
+    EXPECT_EQ(readText(errFile), "nonbloppy: cannot write standard output: No space left on device\n");
+    EXPECT_EQ(runTo("help mesh", ">&-"), 1);
+    EXPECT_EQ(readText(errFile), "nonbloppy: cannot write standard output: Bad file descriptor\n");
+    // A command that failed says why, not that its report was lost too.
+    EXPECT_EQ(runTo("inspect " + quote(in("missing.vtk")), ">/dev/full"), 1);
+    EXPECT_EQ(readText(errFile), "nonbloppy: cannot open " + in("missing.vtk") + ": No such file or directory\n");
+    // A reader that went away ('| true' is gone before the report) asked for the rest to be
+    // dropped: the mesh is written, exit 0, nothing said.
+    const std::string statusFile = dir() + "/status.txt";
+    ASSERT_EQ(std::system(("{ " + quote(kCli) + " mesh " + quote(kCube) + " -o " + quote(out("cube.obj")) + " 2>"
+                           + quote(errFile) + "; echo $? >" + quote(statusFile) + "; } | true").c_str()), 0);
+    EXPECT_EQ(readText(statusFile), "0\n");
+    EXPECT_EQ(readText(errFile), "");
+    EXPECT_TRUE(fs::exists(out("cube.obj")));
+}
+
 TEST_F(CliTest, VersionAndHelp)
 {
     const RunResult version = run("--version");

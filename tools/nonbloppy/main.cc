@@ -19,6 +19,9 @@
 #include <openvdb/version.h>
 
 #include <algorithm>
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
 #include <exception>
 #include <iostream>
 #if defined(__GLIBC__)
@@ -29,6 +32,10 @@
 #include <sstream>
 #include <string>
 #include <vector>
+
+#include <fcntl.h>
+#include <poll.h>
+#include <unistd.h>
 
 namespace nonbloppy_tool {
 
@@ -192,22 +199,33 @@ int run(int argc, char** argv)
     return fail("no command given; run 'nonbloppy --help'", kExitUsage);
 }
 
-} // namespace
-
-int main(int argc, char** argv)
+/// @a status, or kExitError after one line on stderr if what the command printed on stdout
+/// could not all be written (a full disk, a closed descriptor): a script reading
+/// `inspect --json > info.json` must not take an empty file for success. A reader that went
+/// away (EPIPE, '| head -1') asked for the rest to be dropped, and a failed command has
+/// already said why it failed.
+int finishStandardOutput(int status)
 {
-#if defined(__GLIBC__)
-    // The program's allocator policy (the library leaves a host application's alone): blocks
-    // up to 32 MB come from the heap, and up to 256 MB freed at its top stay there, so the
-    // stages reuse each other's memory instead of mapping fresh zeroed pages and unmapping
-    // them, which also stalls the other threads (TLB shootdowns). The extraction still hands
-    // its freed leaves back (malloc_trim), so peak memory is unchanged. 64x benchmark input,
-    // two threads: page faults 140k -> 110k, system time 0.41-0.47 -> 0.26-0.33 s, wall
-    // -0.13 s median over 8 alternating pairs (-0.09 s in an earlier set of 8, with the same
-    // settings as GLIBC_TUNABLES); peak RSS 322 MB either way.
-    mallopt(M_MMAP_THRESHOLD, 32 << 20);
-    mallopt(M_TRIM_THRESHOLD, 256 << 20);
-#endif
+    errno = 0;
+    std::cout.flush();
+    const bool lost = !std::cout || std::fflush(stdout) != 0 || std::ferror(stdout);
+    int error = errno;
+    if (!lost || status != 0) return status;
+    // errno is that of the last write; an earlier failed one (the buffer filled mid-run) left
+    // only stdout's error flag. A closed descriptor and a pipe without a reader (POLLERR) can
+    // still be told; other causes cannot.
+    if (error == 0) {
+        pollfd output{STDOUT_FILENO, 0, 0};
+        if (::fcntl(STDOUT_FILENO, F_GETFD) == -1) error = errno;
+        else if (::poll(&output, 1, 0) == 1 && (output.revents & POLLERR)) error = EPIPE;
+    }
+    if (error == EPIPE) return status;
+    return fail(std::string("cannot write standard output") + (error ? std::string(": ") + std::strerror(error) : ""),
+                kExitError);
+}
+
+int runCommand(int argc, char** argv)
+{
     try {
         return run(argc, argv);
     } catch (const nonbloppy::CancelledError&) {
@@ -225,4 +243,23 @@ int main(int argc, char** argv)
     } catch (...) {
         return fail("unknown error", kExitError);
     }
+}
+
+} // namespace
+
+int main(int argc, char** argv)
+{
+#if defined(__GLIBC__)
+    // The program's allocator policy (the library leaves a host application's alone): blocks
+    // up to 32 MB come from the heap, and up to 256 MB freed at its top stay there, so the
+    // stages reuse each other's memory instead of mapping fresh zeroed pages and unmapping
+    // them, which also stalls the other threads (TLB shootdowns). The extraction still hands
+    // its freed leaves back (malloc_trim), so peak memory is unchanged. 64x benchmark input,
+    // two threads: page faults 140k -> 110k, system time 0.41-0.47 -> 0.26-0.33 s, wall
+    // -0.13 s median over 8 alternating pairs (-0.09 s in an earlier set of 8, with the same
+    // settings as GLIBC_TUNABLES); peak RSS 322 MB either way.
+    mallopt(M_MMAP_THRESHOLD, 32 << 20);
+    mallopt(M_TRIM_THRESHOLD, 256 << 20);
+#endif
+    return finishStandardOutput(runCommand(argc, argv));
 }
