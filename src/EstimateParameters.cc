@@ -15,6 +15,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <sstream>
 
 namespace nonbloppy {
@@ -330,6 +331,22 @@ void requireRadiusBelowMaximum(double effectiveRadius)
     }
 }
 
+/// The limits of the lengths that are known: each against OpenVDB's smallest (voxel, index
+/// cell), and against each other when both are.
+void requireLengthLimits(std::optional<double> effectiveRadius, std::optional<double> voxelSize)
+{
+    using openvdb_scale_internal::requireOpenVdbScale;
+    if (voxelSize) requireOpenVdbScale(*voxelSize, kMinCellSize, "--voxel-size");
+    if (effectiveRadius) {
+        requireOpenVdbScale(*effectiveRadius, kMinCellSize / surface_stages_internal::kCellOverRadius, "--radius");
+        if (voxelSize) {
+            surface_stages_internal::requireVoxelsPerRadius(*effectiveRadius, *voxelSize);
+            requireVoxelWithinRadius(*effectiveRadius, *voxelSize);
+        }
+        requireRadiusBelowMaximum(*effectiveRadius);
+    }
+}
+
 } // namespace
 
 void checkParameters(const SurfaceParameters& params)
@@ -362,16 +379,34 @@ void checkParameters(const SurfaceParameters& params)
     }
     // The limits between lengths, where the lengths are given; resolveParameters() checks
     // them again once the others are derived.
-    using openvdb_scale_internal::requireOpenVdbScale;
-    if (params.voxelSize) requireOpenVdbScale(*params.voxelSize, kMinCellSize, "--voxel-size");
-    if (params.effectiveRadius) {
-        requireOpenVdbScale(*params.effectiveRadius, kMinCellSize / surface_stages_internal::kCellOverRadius,
-                            "--radius");
-        if (params.voxelSize) {
-            surface_stages_internal::requireVoxelsPerRadius(*params.effectiveRadius, *params.voxelSize);
-            requireVoxelWithinRadius(*params.effectiveRadius, *params.voxelSize);
+    requireLengthLimits(params.effectiveRadius, params.voxelSize);
+    // A float density grid compares its values with float(r_0): 1e-46 became 0 (an empty mesh,
+    // blamed on the particles) and 1e39 infinity.
+    if (params.threshold && !(float(*params.threshold) > 0.0f && std::isfinite(float(*params.threshold)))) {
+        throw ParameterError("--threshold must be a positive number within float's range (the density grid's values), got " +
+                             formatNumber(*params.threshold));
+    }
+    // Lengths that a given spacing alone sets (r_e = 2 s, h = s/2) meet the same limits
+    // whatever the particles: checked now and said of --spacing. "--voxel-size 5e-07 is
+    // below ..." named an option never given, and only once the input had been read.
+    if (params.spacing && !(params.effectiveRadius && params.voxelSize)) {
+        const double spacing = *params.spacing;
+        const double radius = params.effectiveRadius.value_or(kDefaultRadiusOverSpacing * spacing);
+        const double voxelSize = params.voxelSize.value_or(kDefaultVoxelOverSpacing * spacing);
+        try {
+            if (!params.effectiveRadius) requireRadiusBelowMaximum(radius);
+            requireLengthLimits(radius, voxelSize);
+        } catch (const ParameterError& e) {
+            std::string message = e.what();
+            const auto rename = [&](const std::string& option, const std::string& derived) {
+                for (size_t at = message.find(option); at != std::string::npos; at = message.find(option, at + 1)) {
+                    message.replace(at, option.size(), derived);
+                }
+            };
+            if (!params.effectiveRadius) rename("--radius ", "the radius " + formatNumber(kDefaultRadiusOverSpacing) + " s = ");
+            if (!params.voxelSize) rename("--voxel-size ", "the voxel size " + formatNumber(kDefaultVoxelOverSpacing) + " s = ");
+            throw ParameterError("--spacing " + formatNumber(spacing) + ": " + message);
         }
-        requireRadiusBelowMaximum(*params.effectiveRadius);
     }
 }
 

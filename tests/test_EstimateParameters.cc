@@ -69,8 +69,8 @@ TEST(EstimateParameters, LengthsWhoseSquareOverflowsAFloatAreRefused)
     SurfaceParameters params;
     params.spacing = 1e20;
     EXPECT_EQ(nonbloppy_test::messageOf<ParameterError>([&] { buildSurface(lattice(1e20), params); }),
-              "--radius 2e+20 is too large: at most 1e+18 (lengths are squared in single precision); give the "
-              "positions in a larger unit");
+              "--spacing 1e+20: the radius 2 s = 2e+20 is too large: at most 1e+18 (lengths are squared in single "
+              "precision); give the positions in a larger unit");
 }
 
 TEST(EstimateParameters, SpacingOfAJitteredLatticeIsItsStep)
@@ -260,23 +260,31 @@ TEST(EstimateParameters, ResolveReportsWhatWasGivenAndChecksRanges)
     bad = SurfaceParameters();
     bad.spacing = 0.05;
     bad.voxelSize = 0.0001;
-    expectMessage(bad, "--voxel-size 0.0001 is too small for --radius 0.1: at most 32 voxels per radius");
+    // Lengths set by the given spacing are named as such, and checked before the particles.
+    expectMessage(bad, "--spacing 0.05: --voxel-size 0.0001 is too small for the radius 2 s = 0.1: at most 32 "
+                       "voxels per radius");
     // Checked before r_0 is calibrated, which at r_e = 1000 s would take hours.
     bad = SurfaceParameters();
     bad.spacing = 0.05;
     bad.effectiveRadius = 50.0;
-    expectMessage(bad, "--voxel-size 0.025 is too small for --radius 50: at most 32 voxels per radius");
+    expectMessage(bad, "--spacing 0.05: the voxel size 0.5 s = 0.025 is too small for --radius 50: at most 32 "
+                       "voxels per radius");
     // Wider than r_e: particles between voxel centres would be lost (at 64 r_e, all of them).
     SurfaceParameters wide;
     wide.spacing = 0.05;
     wide.voxelSize = 6.4;
-    expectMessage(wide, "--voxel-size 6.4 is too large for --radius 0.1: at least one voxel per radius");
-    // The voxel size derived (s/2), the radius given: the radius is named.
+    expectMessage(wide, "--spacing 0.05: --voxel-size 6.4 is too large for the radius 2 s = 0.1: at least one "
+                        "voxel per radius");
+    // The voxel size derived (s/2), the radius given: both are named.
     SurfaceParameters narrow;
     narrow.spacing = 0.05;
     narrow.effectiveRadius = 0.001;
-    expectMessage(narrow, "--radius 0.001 is smaller than the voxel size 0.025 (derived: half the particle spacing): "
-                          "at least one voxel per radius");
+    expectMessage(narrow, "--spacing 0.05: the voxel size 0.5 s = 0.025 is too large for --radius 0.001: at least "
+                          "one voxel per radius");
+    // The spacing estimated, the voxel size derived from it: the radius is named.
+    narrow.spacing.reset();
+    expectMessage(narrow, "--radius 0.001 is smaller than the voxel size 0.0249191 (derived: half the particle "
+                          "spacing): at least one voxel per radius");
     wide.voxelSize = 0.1;  // one voxel per radius: accepted
     EXPECT_NO_THROW(resolveParameters(wide, ball));
     bad.voxelSize = 2.0;
@@ -288,15 +296,19 @@ TEST(EstimateParameters, ResolveReportsWhatWasGivenAndChecksRanges)
                        "spacings; give --threshold");
     bad.threshold = 1.0;  // given: nothing to calibrate, any width
     EXPECT_DOUBLE_EQ(resolveParameters(bad, ball).threshold, 1.0);
-    // The volume correction's target N·s³ overflows.
+    // The volume correction's target N·s³ overflows (radius, voxel size and threshold given:
+    // a spacing that large would set a radius beyond 1e18, and calibrate nothing).
     bad = SurfaceParameters();
     bad.spacing = 1e300;
+    bad.effectiveRadius = 1.0;
+    bad.voxelSize = 0.5;
+    bad.threshold = 1.0;
     expectMessage(bad, "--spacing 1e+300 is too large: the fluid's volume N s^3 (N = 485) is not a finite number");
     // Below OpenVDB's smallest voxel and index cell (positions in metres, spacing 1 µm).
     bad = SurfaceParameters();
     bad.spacing = 1e-6;
-    expectMessage(bad, "--voxel-size 5e-07 is below 1.5e-05, the smallest OpenVDB accepts: give the positions "
-                       "in a smaller unit");
+    expectMessage(bad, "--spacing 1e-06: the voxel size 0.5 s = 5e-07 is below 1.5e-05, the smallest OpenVDB "
+                       "accepts: give the positions in a smaller unit");
     bad.voxelSize = 2e-5;
     bad.effectiveRadius = 2e-5;
     expectMessage(bad, "--radius 2e-05 is below 3e-05, the smallest OpenVDB accepts: give the positions in a "

@@ -187,12 +187,15 @@ struct ResolvedParameters
     bool thresholdReachesSurface = true;
 };
 
-/// Check what @a params fixes without looking at particles: each value's range, and where
-/// the lengths are given, the limits between them (r_e and h at least OpenVDB's smallest
-/// cell, r_e/h in [1, kMaxVoxelsPerRadius], r_e ≤ 1e18). resolveParameters() makes the same
-/// checks first; the command line calls this before reading a file, so a mistake costs
-/// nothing. Cost: O(1).
-/// @throw ParameterError naming the parameter, as resolveParameters().
+/// Check what @a params fixes without looking at particles: each value's range (r_0 also
+/// within float's, the density grid's type), and where the lengths are given or set by a
+/// given spacing (r_e = 2 s, h = s/2), the limits between them (r_e and h at least OpenVDB's
+/// smallest cell, r_e/h in [1, kMaxVoxelsPerRadius], r_e ≤ 1e18). resolveParameters() makes
+/// the same checks first; the command line calls this before reading a file, so a mistake
+/// costs nothing. Cost: O(1).
+/// @throw ParameterError naming the parameter, as resolveParameters(); a length set by the
+///        spacing is named as such: "--spacing 1e-06: the voxel size 0.5 s = 5e-07 is below
+///        1.5e-05, the smallest OpenVDB accepts: give the positions in a smaller unit".
 NONBLOPPY_API void checkParameters(const SurfaceParameters& params);
 
 /// Check @a params and fill in what is missing. @a positions is only read when the spacing
