@@ -161,6 +161,16 @@ TEST_F(CliSequenceTest, SequenceOptionsNeedASequence)
     EXPECT_EQ(r.err, "nonbloppy: --frames needs a frame sequence as IN (a name with {}, #### or "
                      "%04d), got '" + kFree + "'\n");
     EXPECT_TRUE(listDir(dir() + "/out").empty());
+    // And outputs named for a sequence: a file literally named 'm_{}.obj' was written.
+    expectUsageError("mesh " + quote(kFree) + " -o " + quote(out("m_{}.obj")),
+                     "--output: a frame placeholder ({}, #### or %04d) in '" + out("m_{}.obj")
+                         + "', but IN is the single file '" + kFree + "'");
+    expectUsageError("mesh " + quote(kFree) + " -o " + quote(out("m.obj")) + " --vdb " + quote(out("g_####.vdb")),
+                     "--vdb: a frame placeholder ({}, #### or %04d) in '" + out("g_####.vdb")
+                         + "', but IN is the single file '" + kFree + "'");
+    // An empty --vdb (a variable left unset) wrote no grid without a word.
+    expectUsageError("mesh " + quote(kFree) + " -o " + quote(out("m.obj")) + " --vdb ''",
+                     "--vdb needs a file name, got ''");
 }
 
 TEST_F(CliSequenceTest, FramesSelectsAndListsMissingOnce)

@@ -362,6 +362,8 @@ void requireWritableDirectory(const std::string& path)
 /// validateParameters() checks the numbers, validatePaths() the files of one frame.
 void validateParameters(const MeshOptions& o)
 {
+    // An empty --vdb ('--vdb ""', a variable left unset) wrote no grid without a word.
+    if (o.vdbOpt->count() > 0 && o.vdbPath.empty()) throw UsageError("--vdb needs a file name, got ''");
     // CLI11 reads an empty value ('--blend ""') as 0 without a word.
     for (const CLI::Option* option : {o.spacingOpt, o.radiusOpt, o.thresholdOpt, o.voxelSizeOpt, o.blendOpt,
                                       o.iterationsOpt, o.adaptivityOpt, o.regionLeavesOpt, o.threadsOpt,
@@ -740,6 +742,22 @@ void requirePlaceholder(const std::string& path, const std::string& option, cons
     }
 }
 
+/// A single IN with a frame placeholder in @a path (-o or --vdb) wrote a file literally
+/// named 'm_{}.obj'.
+void requireNoPlaceholder(const std::string& path, const std::string& option, const MeshOptions& o)
+{
+    bool placeholder = false;
+    try {
+        placeholder = parseFramePattern(path, option).hasPlaceholder();
+    } catch (const UsageError&) {
+        placeholder = true;  // more than one
+    }
+    if (placeholder) {
+        throw UsageError(option + ": a frame placeholder ({}, #### or %04d) in '" + path + "', but IN is the single file '"
+                         + o.input + "'");
+    }
+}
+
 /// What names one file: its device and inode when it exists (hard links, symbolic links and
 /// "./" all agree), else its path made absolute and normal ("./m_0002.obj" and m_0002.obj).
 std::string fileIdentity(const std::string& path)
@@ -915,6 +933,8 @@ int runMesh(const MeshOptions& o)
                                             "(a name with {}, #### or %04d), got '" + o.input + "'");
         }
     }
+    requireNoPlaceholder(o.output, "--output", o);
+    if (!o.vdbPath.empty()) requireNoPlaceholder(o.vdbPath, "--vdb", o);
     validate(o);
 
     std::unique_ptr<tbb::global_control> threadLimit;
