@@ -249,6 +249,14 @@ TEST_F(CliTest, TruncatedInput)
     writeText(path, readText(kCube).substr(0, 300));
     expectFailure("mesh " + quote(path) + " -o " + quote(out("x.obj")),
                   "truncated POINTS section (" + path + ")");
+    // -v: the stage that threw is not said to be done.
+    const RunResult verbose = run("mesh " + quote(path) + " -o " + quote(out("x.obj")) + " -v");
+    EXPECT_EQ(verbose.exitCode, 1);
+    const std::vector<std::string> errLines = lines(verbose.err);
+    ASSERT_EQ(errLines.size(), 3u) << verbose.err;
+    EXPECT_EQ(errLines[0], "[progress] read particles ...");
+    EXPECT_EQ(errLines[1].rfind("[progress] read particles failed (", 0), 0u) << errLines[1];
+    EXPECT_EQ(errLines[2], "nonbloppy: truncated POINTS section (" + path + ")");
 }
 
 TEST_F(CliTest, NanCoordinate)

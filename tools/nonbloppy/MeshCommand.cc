@@ -32,6 +32,7 @@
 #include <csignal>
 #include <cstdio>
 #include <cstring>
+#include <exception>
 #include <filesystem>
 #include <iostream>
 #include <limits>
@@ -169,8 +170,10 @@ public:
                 std::chrono::steady_clock::now() - mStages.back().start;
             char seconds[32];
             std::snprintf(seconds, sizeof(seconds), "%.3f", elapsed.count());
-            // A stage a signal cut short ends too (its scope unwinds): not "done".
-            const char* how = gInterruptRequested.load() ? " stopped (" : " done (";
+            // A stage a signal cut short, or an error, ends too (its scope unwinds): not
+            // "done" just before "truncated POINTS section". The error's own line follows.
+            const char* how = gInterruptRequested.load() ? " stopped ("
+                              : std::uncaught_exceptions() > 0 ? " failed (" : " done (";
             std::cerr << ("[progress] " + mFrame + mStages.back().name + how + seconds + " s)\n") << std::flush;
         }
         mStages.pop_back();
