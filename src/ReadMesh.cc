@@ -161,6 +161,12 @@ public:
         std::vector<int64_t> cornerNormals;
         std::vector<size_t> faceOffsets{0};
         bool anyCornerNormal = false;
+        struct ForwardReference
+        {
+            size_t line;
+            int64_t vertex;  ///< 0-based
+        };
+        std::vector<ForwardReference> forwardReferences;  // in file order
 
         size_t pos = 0;
         while (pos < mFile.size()) {
@@ -182,15 +188,27 @@ public:
                 fileNormals.push_back(readVector(line));
             } else if (line[0] == 'f' && (line[1] == ' ' || line[1] == '\t')) {
                 const std::vector<std::string_view> words = splitLine(line.substr(1));
+                int64_t highest = -1;
                 for (std::string_view word : words) {
                     ObjCorner corner = readCorner(word, mMesh.points.size(), fileNormals.size());
                     cornerVertices.push_back(uint32_t(corner.vertex));
                     cornerNormals.push_back(corner.normal);
                     anyCornerNormal = anyCornerNormal || corner.normal >= 0;
+                    highest = std::max(highest, corner.vertex);
                 }
                 faceOffsets.push_back(cornerVertices.size());
+                // A vertex not yet read may still come later in the file; if it never does,
+                // the face's line is named (polygon numbers mean nothing to an OBJ's reader).
+                if (highest >= int64_t(mMesh.points.size())) forwardReferences.push_back({mLineNumber, highest});
             }
             // vt, o, g, s, usemtl, mtllib, comments: nothing a SurfaceMesh keeps.
+        }
+
+        for (const ForwardReference& reference : forwardReferences) {
+            if (reference.vertex < int64_t(mMesh.points.size())) continue;
+            mLineNumber = reference.line;
+            failAtLine("vertex index " + std::to_string(reference.vertex + 1) + " out of range (the file has " +
+                       std::to_string(mMesh.points.size()) + " vertices)");
         }
 
         // OBJ normals belong to face corners; SurfaceMesh has one normal per vertex.

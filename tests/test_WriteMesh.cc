@@ -617,9 +617,13 @@ TEST_F(WriteMeshTest, ReadObjWithEveryCornerFormAndNegativeIndices)
     EXPECT_EQ(mesh.normals[0], openvdb::Vec3s(0, 0, 1));
     EXPECT_EQ(mesh.normals[4], openvdb::Vec3s(0, 0, 1));
 
-    writeBytes(path("bad.obj"), "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n");
+    // An index past the last vertex: the line and the index as written (1-based), not the
+    // polygon's number. Vertices may still follow the face that names them.
+    writeBytes(path("bad.obj"), "v 0 0 0\nv 1 0 0\nv 0 1 0\n# a comment\nf 1 2 4\nf 1 2 3\n");
     EXPECT_EQ(messageOf<FileError>([&] { readMesh(path("bad.obj")); }),
-        "polygon 0 references vertex 3 but the file has 3 vertices (" + path("bad.obj") + ")");
+        "vertex index 4 out of range (the file has 3 vertices) at line 5 (" + path("bad.obj") + ")");
+    writeBytes(path("ahead.obj"), "f 1 2 3\nv 0 0 0\nv 1 0 0\nv 0 1 0\n");
+    EXPECT_EQ(readMesh(path("ahead.obj")).triangles, std::vector<openvdb::Vec3I>{openvdb::Vec3I(0, 1, 2)});
     writeBytes(path("bad.obj"), "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 x\n");
     EXPECT_EQ(messageOf<FileError>([&] { readMesh(path("bad.obj")); }),
         "bad vertex index 'x' at line 4 (" + path("bad.obj") + ")");
