@@ -381,8 +381,9 @@ void checkParameters(const SurfaceParameters& params)
     // them again once the others are derived.
     requireLengthLimits(params.effectiveRadius, params.voxelSize);
     // A float density grid compares its values with float(r_0): 1e-46 became 0 (an empty mesh,
-    // blamed on the particles) and 1e39 infinity.
-    if (params.threshold && !(float(*params.threshold) > 0.0f && std::isfinite(float(*params.threshold)))) {
+    // blamed on the particles) and 1e39 infinity. Range first: only then is the cast defined.
+    if (params.threshold && !(*params.threshold <= double(std::numeric_limits<float>::max()) &&
+                              float(*params.threshold) > 0.0f)) {
         throw ParameterError("--threshold must be a positive number within float's range (the density grid's values), got " +
                              formatNumber(*params.threshold));
     }

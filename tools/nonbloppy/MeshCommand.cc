@@ -95,10 +95,10 @@ extern "C" void onInterruptSignal(int signalNumber)
 /// For the command's duration: SIGINT, SIGTERM and SIGHUP (a closed terminal or ssh session)
 /// stop the run cleanly, as an interrupt (exit 130, no partial files, the log's summary
 /// written); repeats within a second are absorbed, a later one ends the process at once (the
-/// signal's default action); a SIGHUP that was ignored (nohup) stays ignored. SIGPIPE is ignored: a reader
-/// of stdout that went away ('| head -1') used to end the run silently with exit 141 and
-/// the log unfinished; now only the lost stdout lines are lost. The previous handlers are
-/// restored at the end.
+/// signal's default action); a SIGHUP that was ignored (nohup) stays ignored. SIGPIPE is
+/// ignored: a reader of stdout that went away ('| head -1') used to end the run silently with
+/// exit 141 and the log unfinished; now only the lost stdout lines are lost. The previous
+/// handlers are restored at the end.
 class SignalHandlerScope
 {
 public:
