@@ -95,8 +95,9 @@ void runSurfaceStages(const ParticleIndex& index, bool keepDensity, SurfaceResul
 /// repairFolds(), preserveVolume(mesh, VolumeSettings) and smoothSurface() without the check
 /// that every polygon corner is a vertex of the mesh, which the public functions make first
 /// (polygon_indices_internal::requireValidIndices(): 3.5 ms per call on two threads for a
-/// synthetic mesh of 2.66M polygons, the 64x benchmark mesh's size): the chain's mesh comes from extractSurface(),
-/// valid by construction, and passes through all three. Same results, same other checks.
+/// synthetic mesh of 2.66M polygons, the 64x benchmark mesh's size): the chain's mesh comes
+/// from extractSurface(), valid by construction, and passes through all three. Same results,
+/// same other checks.
 size_t repairFoldsUnchecked(SurfaceMesh& mesh, const std::vector<openvdb::Vec3s>& before, int maxRounds,
                             openvdb::util::NullInterrupter* interrupter);
 double preserveVolumeUnchecked(SurfaceMesh& mesh, const VolumeSettings& settings,
