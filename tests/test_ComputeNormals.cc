@@ -97,9 +97,17 @@ TEST(ComputeNormals, UnusedVertexGetsZeroAndFlatPatchGetsItsPlaneNormal)
 
 TEST(ComputeNormals, SameBitsAsThePlainSumForAnyThreadCount)
 {
-    // 400 × 400 vertices: several vertex ranges at two or more threads.
-    for (bool shuffled : {false, true}) {
-        const SurfaceMesh patch = bumpyPatch(400, shuffled);
+    // 600 × 600 vertices: eleven ranges of vertex numbers in order, one sum when shuffled.
+    // The third case adds triangles whose corners lie 30,000 vertices apart: their block of
+    // polygons touches every range, more than computeNormals() lists one by one.
+    for (int variant = 0; variant < 3; ++variant) {
+        const bool shuffled = variant == 1;
+        SurfaceMesh patch = bumpyPatch(600, shuffled);
+        if (variant == 2) {
+            for (uint32_t i = 0; i + 2 * 30000 < 600 * 600; i += 30000) {
+                patch.triangles.emplace_back(i, i + 30000, i + 2 * 30000);
+            }
+        }
         const std::vector<openvdb::Vec3s> expected = referenceNormals(patch);
         for (int threads : {1, 2, 3, 8}) {
             SurfaceMesh mesh = patch;
@@ -107,7 +115,7 @@ TEST(ComputeNormals, SameBitsAsThePlainSumForAnyThreadCount)
             ASSERT_EQ(mesh.normals.size(), expected.size());
             size_t differing = 0;
             for (size_t i = 0; i < expected.size(); ++i) differing += mesh.normals[i] != expected[i];
-            EXPECT_EQ(differing, 0u) << threads << " threads, shuffled " << shuffled;
+            EXPECT_EQ(differing, 0u) << threads << " threads, variant " << variant;
         }
     }
 }

@@ -15,10 +15,14 @@ namespace nonbloppy {
 /// Set mesh.normals[i] to the normalized sum of the area-weighted normals of the polygons
 /// around vertex i (a quad's normal is half the cross product of its diagonals).
 /// A vertex no polygon uses, or whose normals cancel, gets (0,0,0).
-/// Cost: O(P + V); deterministic (sums in polygon order). Memory: 24 bytes per vertex scratch.
+/// Cost: O(P + V), in parallel over ranges of 32,768 vertex numbers, each summing the
+/// polygons that touch it; deterministic (each vertex sums its polygons in polygon order, so
+/// the bits do not depend on the ranges or the thread count). When polygon order and vertex
+/// order do not follow each other (a polygon block would reach more than three ranges on
+/// average), one serial sum. Memory: the normals, plus 768 KB scratch per thread (24 bytes
+/// per vertex in the serial case).
 /// @param mesh         normals written
-/// @param interrupter  optional; asked every 4096 polygons of the serial sum and every 4096
-///                     vertices of each parallel task (no start()/end(): buildSurface()
+/// @param interrupter  optional; asked every 1024 polygons (no start()/end(): buildSurface()
 ///                     announces the stage); a stop leaves mesh.normals unspecified
 /// Thread-safety: reentrant; concurrent calls on different meshes are safe.
 /// @throw ParameterError("polygon P references vertex I but the mesh has N vertices") for
