@@ -23,6 +23,7 @@ namespace nonbloppy {
 namespace {
 
 using cancellation_internal::CancelPoll;
+using surface_stages_internal::LengthNames;
 
 std::string formatNumber(double value)
 {
@@ -310,40 +311,42 @@ namespace {
 /// @throw ParameterError if a voxel of @a voxelSize is wider than @a effectiveRadius (both
 /// given): particles whose support holds no voxel centre would be lost (with h = 64 r_e,
 /// every one: an empty mesh). At h ≤ r_e the nearest centre is at most (√3/2) h < r_e away.
-void requireVoxelWithinRadius(double effectiveRadius, double voxelSize)
+void requireVoxelWithinRadius(double effectiveRadius, double voxelSize, const LengthNames& names = {})
 {
     if (voxelSize > effectiveRadius) {
-        throw ParameterError("--voxel-size " + formatNumber(voxelSize) + " is too large for --radius " +
-                             formatNumber(effectiveRadius) + ": at least one voxel per radius");
+        throw ParameterError(names.voxelSize + " " + formatNumber(voxelSize) + " is too large for " + names.radius +
+                             " " + formatNumber(effectiveRadius) + ": at least one voxel per radius");
     }
 }
 
 /// @throw ParameterError if r_e > 1e18: the kernel squares lengths in single precision, so
 /// beyond it r_e² overflows to +inf and the mesh came out wrong or empty (a lattice scaled
 /// by 1e20 kept 2.6% of its volume).
-void requireRadiusBelowMaximum(double effectiveRadius)
+void requireRadiusBelowMaximum(double effectiveRadius, const LengthNames& names = {})
 {
     constexpr double kMaxRadius = 1.0e18;
     if (effectiveRadius > kMaxRadius) {
-        throw ParameterError("--radius " + formatNumber(effectiveRadius) + " is too large: at most " +
+        throw ParameterError(names.radius + " " + formatNumber(effectiveRadius) + " is too large: at most " +
                              formatNumber(kMaxRadius) + " (lengths are squared in single precision); give the "
                              "positions in a larger unit");
     }
 }
 
 /// The limits of the lengths that are known: each against OpenVDB's smallest (voxel, index
-/// cell), and against each other when both are.
-void requireLengthLimits(std::optional<double> effectiveRadius, std::optional<double> voxelSize)
+/// cell), and against each other when both are; messages name the lengths as @a names says.
+void requireLengthLimits(std::optional<double> effectiveRadius, std::optional<double> voxelSize,
+                         const LengthNames& names = {})
 {
     using openvdb_scale_internal::requireOpenVdbScale;
-    if (voxelSize) requireOpenVdbScale(*voxelSize, kMinCellSize, "--voxel-size");
+    if (voxelSize) requireOpenVdbScale(*voxelSize, kMinCellSize, names.voxelSize.c_str());
     if (effectiveRadius) {
-        requireOpenVdbScale(*effectiveRadius, kMinCellSize / surface_stages_internal::kCellOverRadius, "--radius");
+        requireOpenVdbScale(*effectiveRadius, kMinCellSize / surface_stages_internal::kCellOverRadius,
+                            names.radius.c_str());
         if (voxelSize) {
-            surface_stages_internal::requireVoxelsPerRadius(*effectiveRadius, *voxelSize);
-            requireVoxelWithinRadius(*effectiveRadius, *voxelSize);
+            surface_stages_internal::requireVoxelsPerRadius(*effectiveRadius, *voxelSize, names);
+            requireVoxelWithinRadius(*effectiveRadius, *voxelSize, names);
         }
-        requireRadiusBelowMaximum(*effectiveRadius);
+        requireRadiusBelowMaximum(*effectiveRadius, names);
     }
 }
 
@@ -394,19 +397,14 @@ void checkParameters(const SurfaceParameters& params)
         const double spacing = *params.spacing;
         const double radius = params.effectiveRadius.value_or(kDefaultRadiusOverSpacing * spacing);
         const double voxelSize = params.voxelSize.value_or(kDefaultVoxelOverSpacing * spacing);
+        LengthNames names;
+        if (!params.effectiveRadius) names.radius = "the radius " + formatNumber(kDefaultRadiusOverSpacing) + " s =";
+        if (!params.voxelSize) names.voxelSize = "the voxel size " + formatNumber(kDefaultVoxelOverSpacing) + " s =";
         try {
-            if (!params.effectiveRadius) requireRadiusBelowMaximum(radius);
-            requireLengthLimits(radius, voxelSize);
+            if (!params.effectiveRadius) requireRadiusBelowMaximum(radius, names);
+            requireLengthLimits(radius, voxelSize, names);
         } catch (const ParameterError& e) {
-            std::string message = e.what();
-            const auto rename = [&](const std::string& option, const std::string& derived) {
-                for (size_t at = message.find(option); at != std::string::npos; at = message.find(option, at + 1)) {
-                    message.replace(at, option.size(), derived);
-                }
-            };
-            if (!params.effectiveRadius) rename("--radius ", "the radius " + formatNumber(kDefaultRadiusOverSpacing) + " s = ");
-            if (!params.voxelSize) rename("--voxel-size ", "the voxel size " + formatNumber(kDefaultVoxelOverSpacing) + " s = ");
-            throw ParameterError("--spacing " + formatNumber(spacing) + ": " + message);
+            throw ParameterError("--spacing " + formatNumber(spacing) + ": " + e.what());
         }
     }
 }

@@ -347,11 +347,12 @@ struct RasterizeColumnOp
 
 } // namespace
 
-void surface_stages_internal::requireVoxelsPerRadius(double effectiveRadius, double voxelSize)
+void surface_stages_internal::requireVoxelsPerRadius(double effectiveRadius, double voxelSize, const LengthNames& names)
 {
     if (effectiveRadius / voxelSize > kMaxVoxelsPerRadius) {
         std::ostringstream msg;
-        msg << "--voxel-size " << voxelSize << " is too small for --radius " << effectiveRadius << ": at most "
+        msg << names.voxelSize << " " << voxelSize << " is too small for " << names.radius << " " << effectiveRadius
+            << ": at most "
             << kMaxVoxelsPerRadius << " voxels per radius";
         throw ParameterError(msg.str());
     }

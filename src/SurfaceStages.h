@@ -15,6 +15,7 @@
 #include <openvdb/openvdb.h>
 #include <openvdb/util/NullInterrupter.h>
 
+#include <string>
 #include <vector>
 
 namespace nonbloppy {
@@ -25,11 +26,19 @@ namespace surface_stages_internal {
 /// cells of r_e (three per axis, 27 r_e³ visited for a 4.2 r_e³ sphere).
 constexpr double kCellOverRadius = 0.5;
 
+/// How a parameter check names r_e and h in its message: as the options, or, when a given
+/// --spacing set them, as their derivation ("the radius 2 s =", followed by the value).
+struct LengthNames
+{
+    std::string radius = "--radius";
+    std::string voxelSize = "--voxel-size";
+};
+
 /// Throw ParameterError("--voxel-size <h> is too small for --radius <r_e>: at most 32 voxels
-/// per radius") if r_e/h > kMaxVoxelsPerRadius: the one check of rasterizeDensity() and of
-/// the parameter estimate, which makes it before the threshold's calibration (whose cost
-/// grows as (r_e/s)³).
-void requireVoxelsPerRadius(double effectiveRadius, double voxelSize);
+/// per radius", the lengths named by @a names) if r_e/h > kMaxVoxelsPerRadius: the one check
+/// of rasterizeDensity() and of the parameter estimate, which makes it before the threshold's
+/// calibration (whose cost grows as (r_e/s)³).
+void requireVoxelsPerRadius(double effectiveRadius, double voxelSize, const LengthNames& names = {});
 
 /// Throw CancelledError("interrupted during <stage>") if @a interrupter (may be null) asks to
 /// stop. Cost: one wasInterrupted() call. Thread-safety: as the interrupter's.
