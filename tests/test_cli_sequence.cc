@@ -508,3 +508,19 @@ TEST_F(CliSequenceTest, MeshWithoutVdbIsTheSameMesh)
                   + quote(out("b.vdb")) + " -q").exitCode, 0);
     EXPECT_TRUE(readText(out("a.obj")) == readText(out("b.obj"))) << "meshes differ";
 }
+
+TEST_F(CliSequenceTest, AWarningEveryFrameWouldGiveIsGivenOncePerRun)
+{
+    // c = 0.5, t = 4 relax too strongly for the calibrated threshold (test_cli.cc): every
+    // frame would warn; the run says it once, with one frame job or two.
+    makeFrames({kCube, kCube, kCube});
+    const std::string warning = "nonbloppy: warning: --blend 0.5 --iterations 4 relax too strongly for --threshold "
+                                "to be calibrated: flat faces end inside the particles; lower --blend or "
+                                "--iterations, or give --spacing to correct the volume\n";
+    for (const char* jobs : {"1", "2"}) {
+        const RunResult r = run("mesh " + quote(in("fluid_{}.vtk")) + " -o " + quote(out(std::string("jobs") + jobs + "_{}.ply"))
+                                + " -q --blend 0.5 --iterations 4 --frame-jobs " + jobs);
+        ASSERT_EQ(r.exitCode, 0) << r.err;
+        EXPECT_EQ(r.err, warning) << jobs << " frame jobs";
+    }
+}

@@ -663,11 +663,18 @@ FrameOutcome meshFrame(const MeshOptions& o, ProgressInterrupter& interrupter)
     return outcome;
 }
 
-/// Once per run: relaxation too strong for the calibrated r_0 shrinks every flat face.
-void warnIfFacesEndInside(const MeshOptions& o, const nonbloppy::ResolvedParameters& p)
+/// The warnings a run of the mesh command gives once, however many of its frames (meshed
+/// one after another or by concurrent frame jobs) would give them.
+struct OnceWarnings
 {
-    static std::atomic<bool> printed{false};
-    if (p.thresholdReachesSurface || printed.exchange(true)) return;
+    std::atomic<bool> facesEndInside{false};
+    std::atomic<bool> coarseFloats{false};
+};
+
+/// Once per run: relaxation too strong for the calibrated r_0 shrinks every flat face.
+void warnIfFacesEndInside(const MeshOptions& o, const nonbloppy::ResolvedParameters& p, OnceWarnings& once)
+{
+    if (p.thresholdReachesSurface || once.facesEndInside.exchange(true)) return;
     std::cerr << "nonbloppy: warning: --blend " << formatNumber(o.blend) << " --iterations " << o.iterations
               << " relax too strongly for --threshold to be calibrated: flat faces end inside the "
                  "particles; lower --blend or --iterations, or give --spacing to correct the volume"
@@ -678,10 +685,9 @@ void warnIfFacesEndInside(const MeshOptions& o, const nonbloppy::ResolvedParamet
 /// a scene placed far out (georeferenced, say) meshes to a surface quantized to that step,
 /// and nothing else tells why it looks rough. Warned when the step at the mesh's farthest
 /// coordinate exceeds 1/16 of the spacing (from 8192 units out for s = 0.01).
-void warnIfCoarseFloats(const nonbloppy::SurfaceResult& result)
+void warnIfCoarseFloats(const nonbloppy::SurfaceResult& result, OnceWarnings& once)
 {
-    static std::atomic<bool> printed{false};
-    if (printed.load()) return;  // said once: later frames need no scan
+    if (once.coarseFloats.load()) return;  // said once: later frames need no scan
     const std::vector<openvdb::Vec3s>& points = result.mesh.points;
     const float farthest = tbb::parallel_reduce(tbb::blocked_range<size_t>(0, points.size()), 0.0f,
         [&](const tbb::blocked_range<size_t>& range, float found) {
@@ -695,7 +701,7 @@ void warnIfCoarseFloats(const nonbloppy::SurfaceResult& result)
         [](float a, float b) { return std::max(a, b); });
     const double step = double(std::nextafter(farthest, std::numeric_limits<float>::infinity())) - double(farthest);
     const double spacing = result.parameters.spacing;
-    if (!(spacing > 0.0) || !(step > spacing / 16.0) || printed.exchange(true)) return;
+    if (!(spacing > 0.0) || !(step > spacing / 16.0) || once.coarseFloats.exchange(true)) return;
     std::cerr << "nonbloppy: warning: the surface reaches " << formatNumber(double(farthest))
               << " from the origin, where float positions step by " << formatNumber(step)
               << ", more than 1/16 of the spacing " << formatNumber(spacing)
@@ -892,6 +898,7 @@ int runSequence(const MeshOptions& o)
     settings.missing = plan.missing;
 
     std::mutex verboseMutex;
+    OnceWarnings once;
     auto meshOne = [&](const BatchJob& job) {
         const MeshOptions f = optionsForFrame(o, job.frame);
         validatePaths(f);
@@ -899,8 +906,8 @@ int runSequence(const MeshOptions& o)
         std::unique_ptr<ResidentSampler> sampler;
         if (o.verbose) sampler = std::make_unique<ResidentSampler>();
         const FrameOutcome outcome = meshFrame(f, interrupter);
-        warnIfFacesEndInside(o, outcome.result.parameters);
-        warnIfCoarseFloats(outcome.result);
+        warnIfFacesEndInside(o, outcome.result.parameters, once);
+        warnIfCoarseFloats(outcome.result, once);
         warnIfEmpty(outcome.result, f.output);
 
         FrameReport report;
@@ -957,8 +964,9 @@ int runMesh(const MeshOptions& o)
     try {
         const FrameOutcome outcome = meshFrame(o, interrupter);
         interrupter.clearLine();
-        warnIfFacesEndInside(o, outcome.result.parameters);
-        warnIfCoarseFloats(outcome.result);
+        OnceWarnings once;
+        warnIfFacesEndInside(o, outcome.result.parameters, once);
+        warnIfCoarseFloats(outcome.result, once);
         warnIfEmpty(outcome.result, o.output);
         if (sampler) {
             sampler->stop();
