@@ -62,10 +62,13 @@ void computeNormals(SurfaceMesh& mesh, CancelPoll& poll)
                                        : std::make_pair(mesh.quads[polygon - triangleCount].asPointer(), 4);
     };
 
-    // The ranges of each block, in parallel with allocating the normals: resize() zero-fills
-    // in one thread (29 MB and 7,000 page faults for the 64x benchmark mesh).
+    // The ranges of each block, in parallel with allocating the normals where mesh.normals
+    // cannot hold them: resize() zero-fills in one thread (29 MB and 7,000 page faults for the
+    // 64x benchmark mesh). A mesh that already has the room (SurfaceReconstructor's, frame
+    // after frame) keeps it.
     std::vector<BlockRanges> blocks(blockCount);
-    std::vector<openvdb::Vec3s> normals;
+    const bool haveRoom = mesh.normals.capacity() >= vertexCount;
+    std::vector<openvdb::Vec3s> allocated;
     tbb::parallel_invoke(
         [&] {
             tbb::parallel_for(tbb::blocked_range<size_t>(0, blockCount),
@@ -100,13 +103,18 @@ void computeNormals(SurfaceMesh& mesh, CancelPoll& poll)
                     }
                 });
         },
-        [&] { normals.resize(vertexCount); });
+        [&] {
+            if (!haveRoom) allocated.resize(vertexCount);
+        });
     poll.throwIfStopped();
     // A corner out of range: the message names the first such polygon, and mesh.normals is
     // left untouched.
     for (const BlockRanges& b : blocks) {
         if (b.highestCorner >= vertexCount) polygon_indices_internal::requireValidIndices(mesh);
     }
+    if (haveRoom) mesh.normals.resize(vertexCount);
+    else mesh.normals.swap(allocated);
+    std::vector<openvdb::Vec3s>& normals = mesh.normals;
 
     // Each range's blocks, in block order.
     size_t visits = 0;
@@ -172,7 +180,6 @@ void computeNormals(SurfaceMesh& mesh, CancelPoll& poll)
             }
         });
     poll.throwIfStopped();
-    mesh.normals.swap(normals);
 }
 
 } // namespace cancellation_internal

@@ -119,3 +119,16 @@ TEST(ComputeNormals, SameBitsAsThePlainSumForAnyThreadCount)
         }
     }
 }
+
+TEST(ComputeNormals, ReusesTheRoomOfEarlierNormals)
+{
+    // A mesh meshed again (SurfaceReconstructor's, frame after frame) keeps its normals'
+    // memory instead of faulting in fresh pages; the values are the new frame's.
+    SurfaceMesh mesh = bumpyPatch(300, false);
+    computeNormals(mesh);
+    const openvdb::Vec3s* before = mesh.normals.data();
+    for (openvdb::Vec3s& p : mesh.points) p[2] = -p[2];
+    computeNormals(mesh);
+    EXPECT_EQ(mesh.normals.data(), before);
+    EXPECT_EQ(mesh.normals, referenceNormals(mesh));
+}
