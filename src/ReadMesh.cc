@@ -188,6 +188,9 @@ public:
                 fileNormals.push_back(readVector(line));
             } else if (line[0] == 'f' && (line[1] == ' ' || line[1] == '\t')) {
                 const std::vector<std::string_view> words = splitLine(line.substr(1));
+                // Said at its line: "polygon 4 has only 2 vertices" left the reader to count
+                // the faces before it.
+                if (words.size() < 3) failAtLine("face with " + std::to_string(words.size()) + " vertices (at least 3)");
                 int64_t highest = -1;
                 for (std::string_view word : words) {
                     ObjCorner corner = readCorner(word, mMesh.points.size(), fileNormals.size());

@@ -627,6 +627,12 @@ TEST_F(WriteMeshTest, ReadObjWithEveryCornerFormAndNegativeIndices)
     writeBytes(path("bad.obj"), "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 x\n");
     EXPECT_EQ(messageOf<FileError>([&] { readMesh(path("bad.obj")); }),
         "bad vertex index 'x' at line 4 (" + path("bad.obj") + ")");
+    writeBytes(path("bad.obj"), "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 1 2\n");
+    EXPECT_EQ(messageOf<FileError>([&] { readMesh(path("bad.obj")); }),
+        "face with 2 vertices (at least 3) at line 5 (" + path("bad.obj") + ")");
+    writeBytes(path("bad.obj"), "v 0 0 0\nf\t\r\n");
+    EXPECT_EQ(messageOf<FileError>([&] { readMesh(path("bad.obj")); }),
+        "face with 0 vertices (at least 3) at line 2 (" + path("bad.obj") + ")");
     writeBytes(path("bad.obj"), "v 0 0\n");
     EXPECT_EQ(messageOf<FileError>([&] { readMesh(path("bad.obj")); }),
         "expected three coordinates at line 1 (" + path("bad.obj") + ")");
