@@ -23,7 +23,7 @@ cd "$(dirname "$0")/../.."
 seconds="${1:-60}"
 shift || true
 targets=("$@")
-((${#targets[@]})) || targets=(bgeo vtu table json vdb_points vtk ply vtk_file ply_file bgeo_file table_file json_file)
+((${#targets[@]})) || targets=(bgeo vtu table json vdb_points vtk ply vtk_file ply_file bgeo_file table_file json_file obj_file)
 build_dir="${BUILD_DIR:-/tmp/nonbloppy-fuzz-build}"
 out="${OUT:-/tmp/nonbloppy-fuzz}"
 parallel="${PARALLEL:-1}"
@@ -43,6 +43,7 @@ seeds_for() {
     vdb_points) echo "tests/fuzz/seeds/*.vdb tests/data/fuzz/*.vdb" ;;
     vtk|vtk_file) echo "tests/data/cube_8_particles.vtk tests/data/free_particles_125_particles.vtk tests/data/fuzz/*.vtk" ;;
     ply|ply_file) echo "tests/fuzz/seeds/*.ply tests/data/fuzz/*.ply" ;;
+    obj_file) echo "tests/fuzz/seeds/*.obj tests/data/fuzz/*.obj" ;;
     *) echo "run_fuzzers: unknown target '$1'" >&2; exit 2 ;;
   esac
 }
