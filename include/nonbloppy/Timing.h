@@ -13,12 +13,20 @@
 
 namespace nonbloppy {
 
+/// The process's CPU time so far, in seconds: every thread, user and system (std::clock());
+/// 0 where the implementation cannot tell. Cost: one clock read.
+inline double processCpuSeconds()
+{
+    const std::clock_t now = std::clock();
+    return now == std::clock_t(-1) ? 0.0 : double(now) / CLOCKS_PER_SEC;
+}
+
 /// Seconds spent in each stage, in the order the stages ran.
 ///
-/// CPU time is that of the whole process (every thread, user and system, from std::clock())
-/// while the stage ran, so cpuSeconds / seconds is the number of cores the stage kept busy.
-/// It also counts whatever else the process did meanwhile, such as another frame meshed on
-/// other threads: compare it only for a process that runs one pipeline at a time.
+/// CPU time is that of the whole process (processCpuSeconds()) while the stage ran, so
+/// cpuSeconds / seconds is the number of cores the stage kept busy. It also counts whatever
+/// else the process did meanwhile, such as another frame meshed on other threads: compare it
+/// only for a process that runs one pipeline at a time.
 struct StageTimings
 {
     /// One stage's accumulated time.
@@ -75,14 +83,11 @@ public:
     /// Start timing @a stage; the time is added to @a timings on destruction.
     ScopedStageTimer(StageTimings& timings, std::string stage)
         : mTimings(timings), mStage(std::move(stage)), mStart(std::chrono::steady_clock::now()),
-          mCpuStart(std::clock()) {}
+          mCpuStart(processCpuSeconds()) {}
     ~ScopedStageTimer()
     {
         const std::chrono::duration<double> elapsed = std::chrono::steady_clock::now() - mStart;
-        const std::clock_t cpuEnd = std::clock();
-        const double cpuSeconds = (mCpuStart == std::clock_t(-1) || cpuEnd == std::clock_t(-1))
-            ? 0.0 : double(cpuEnd - mCpuStart) / CLOCKS_PER_SEC;
-        mTimings.add(mStage, elapsed.count(), cpuSeconds);
+        mTimings.add(mStage, elapsed.count(), processCpuSeconds() - mCpuStart);
     }
     ScopedStageTimer(const ScopedStageTimer&) = delete;
     ScopedStageTimer& operator=(const ScopedStageTimer&) = delete;
@@ -91,7 +96,7 @@ private:
     StageTimings& mTimings;
     std::string mStage;
     std::chrono::steady_clock::time_point mStart;
-    std::clock_t mCpuStart;  ///< (std::clock_t)-1 where the process CPU time is unavailable
+    double mCpuStart;  ///< processCpuSeconds() at construction
 };
 
 } // namespace nonbloppy

@@ -210,7 +210,7 @@ public:
                 + ", \"interrupted\": " + (wasInterrupted ? "true" : "false")
                 + ", \"frame_jobs\": " + std::to_string(mSettings.frameJobs)
                 + ", \"total_seconds\": " + jsonNumber(total)
-                + ", \"cpu_seconds\": " + jsonNumber(processCpuSeconds())
+                + ", \"cpu_seconds\": " + jsonNumber(nonbloppy::processCpuSeconds())
                 + ", \"particles\": " + std::to_string(mParticles)
                 + ", \"particles_per_second\": " + jsonNumber(rate)
                 + ", \"peak_rss_bytes\": " + std::to_string(peakResidentBytes()) + "}");
@@ -426,14 +426,6 @@ int runBatch(const std::vector<BatchJob>& jobs, const BatchSettings& settings,
     finished = true;
     if (ticker.joinable()) ticker.join();
     return state.finish(interrupted());
-}
-
-double processCpuSeconds()
-{
-    struct rusage usage;
-    if (::getrusage(RUSAGE_SELF, &usage) != 0) return 0.0;
-    const auto seconds = [](const timeval& t) { return double(t.tv_sec) + 1e-6 * double(t.tv_usec); };
-    return seconds(usage.ru_utime) + seconds(usage.ru_stime);
 }
 
 // ---------------------------------------------------------------------------------------

@@ -69,10 +69,6 @@ int runBatch(const std::vector<BatchJob>& jobs, const BatchSettings& settings,
              const std::function<FrameReport(const BatchJob&)>& meshFrame,
              const std::function<bool()>& interrupted);
 
-/// The process's CPU time so far, user plus system, over all its threads (getrusage), in
-/// seconds; 0 if unknown.
-double processCpuSeconds();
-
 // ---------------------------------------------------------------------------------------
 // Memory
 
