@@ -401,6 +401,9 @@ void checkParameters(const SurfaceParameters& params)
         if (!params.effectiveRadius) names.radius = "the radius " + formatNumber(kDefaultRadiusOverSpacing) + " s =";
         if (!params.voxelSize) names.voxelSize = "the voxel size " + formatNumber(kDefaultVoxelOverSpacing) + " s =";
         try {
+            // A radius the spacing sets is checked against the maximum first (requireLengthLimits
+            // checks it last): with a given --voxel-size, the voxels-per-radius limit it may also
+            // break would otherwise be named instead of the cause, the spacing's size.
             if (!params.effectiveRadius) requireRadiusBelowMaximum(radius, names);
             requireLengthLimits(radius, voxelSize, names);
         } catch (const ParameterError& e) {
