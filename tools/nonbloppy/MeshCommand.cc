@@ -900,6 +900,16 @@ int runSequence(const MeshOptions& o)
     std::mutex verboseMutex;
     OnceWarnings once;
     auto meshOne = [&](const BatchJob& job) {
+#ifdef __GLIBC__
+        // Hand back the pages the frames before freed. glibc keeps them (main() lets up to
+        // 256 MB stay at the heap's top, and freed blocks amid the heap are never returned
+        // unless trimmed), and the next frame's allocations reuse them only in part: on the
+        // 64x benchmark input a sequence's peak RSS rose 328 -> 440 MB by the third frame,
+        // so a farm job sized by meshing one frame could be killed mid-sequence. With this,
+        // 328 -> 345-353 MB; cost about 3% of the wall time per frame (8 frames, median of
+        // 4 alternating pairs), nothing measurable at 512x (1.71 GB peak either way).
+        malloc_trim(0);
+#endif
         const MeshOptions f = optionsForFrame(o, job.frame);
         validatePaths(f);
         ProgressInterrupter interrupter(o.verbose, false, "frame " + std::to_string(job.frame.number) + ": ");
