@@ -73,7 +73,10 @@ TEST_F(CliSequenceTest, MeshesEveryFrameFoundWithOneLinePerFrame)
     makeFrames({kFree, kCube, kFree});
     const RunResult r = run("mesh " + quote(in("fluid_{}.vtk")) + " -o " + quote(out("mesh_{}.obj")));
     ASSERT_EQ(r.exitCode, 0) << r.err;
-    EXPECT_TRUE(r.err.empty()) << r.err;
+    // Frames of a different scale each: the lengths derived per frame move (said once).
+    EXPECT_EQ(r.err, "nonbloppy: warning: the spacing estimate moves between frames (0.795085 in frame 1, "
+                     "0.0498381 in frame 2) and the lengths derived from it move too; to mesh every frame "
+                     "alike, give frame 1's: --radius 1.59017 --voxel-size 0.397542 --threshold 2.85599\n");
     EXPECT_EQ(listDir(dir() + "/out"),
               (std::vector<std::string>{"mesh_0001.obj", "mesh_0002.obj", "mesh_0003.obj"}));
     // stdout is not a terminal: one line per frame, then the summary.
@@ -543,6 +546,42 @@ TEST_F(CliSequenceTest, EachFrameStartsWithTheMemoryOfTheFramesBeforeHandedBack)
     for (size_t n = 1; n < before.size(); ++n) {
         EXPECT_LT(before[n], before[0] + 16.0) << "frame " << n + 1 << "\n" << r.err;
     }
+}
+
+TEST_F(CliSequenceTest, MovingSpacingEstimateIsSaidOnceWithTheValuesThatPinTheLengths)
+{
+    // Frames 1 and 3 are the cube (s = 0.0498381), frame 2 the scattered particles (0.795085).
+    makeFrames({kCube, kFree, kCube, kFree});
+    const std::string mesh = "mesh " + quote(in("fluid_{}.vtk")) + " -o " + quote(out("mesh_{}.obj")) + " -q";
+    const std::string warning = "nonbloppy: warning: the spacing estimate moves between frames (0.0498381 in "
+                                "frame 1, 0.795085 in frame 2) and the lengths derived from it move too; to "
+                                "mesh every frame alike, give frame 1's:";
+    RunResult r = run(mesh);
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_EQ(r.err, warning + " --radius 0.0996763 --voxel-size 0.0249191 --threshold 2.85599\n");
+
+    // A length given is not listed; all three given, or the spacing, pin the frames alike.
+    // (The radius has to suit frame 2's particles, 0.8 apart, and the voxel size both frames.)
+    r = run(mesh + " --threshold 3 --frames 1-2");
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_EQ(r.err, warning + " --radius 0.0996763 --voxel-size 0.0249191\n");
+    for (const std::string& pinned : {std::string(" --spacing 0.3"),
+                                      std::string(" --radius 1.6 --voxel-size 0.2 --threshold 3")}) {
+        r = run(mesh + pinned + " --method paper --frames 1-2");
+        ASSERT_EQ(r.exitCode, 0) << pinned << "\n" << r.err;
+        EXPECT_EQ(r.err, "") << pinned;
+    }
+
+    // Frames alike: nothing to say. Two frame jobs: still said once.
+    makeFrames({kCube, kCube, kCube, kCube});
+    r = run(mesh);
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_EQ(r.err, "");
+    makeFrames({kCube, kFree, kCube, kFree});
+    r = run(mesh + " --frame-jobs 2");
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_EQ(count(r.err, "nonbloppy: warning: the spacing estimate moves between frames ("), 1u) << r.err;
+    EXPECT_EQ(count(r.err, "\n"), 1u) << r.err;
 }
 
 TEST_F(CliSequenceTest, RegionLeavesChangeOnlyTheVertexOrder)
