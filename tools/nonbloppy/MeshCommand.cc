@@ -678,14 +678,16 @@ struct OnceWarnings
 };
 
 /// How far a sequence's spacing estimate may move from the first frame's, as a fraction of
-/// it, before warnIfLengthsMove() says so. The estimate of a steady fluid moves by far less;
-/// two dam-break frames of the same particle radius (0.025) gave 0.0467 and 0.0486 (4%).
+/// it, before warnIfLengthsMove() says so: each derived length moves by as much, and 1% of h
+/// is a whole voxel 100 voxels from the origin. (Two dam-break frames simulated with the
+/// same particle radius, 0.025, estimate 0.0467 and 0.0486: 4% apart.)
 constexpr double kSpacingMoveTolerance = 0.01;
 
 /// Once per run of a sequence: the lengths not given are derived from each frame's own
 /// spacing estimate, so when that moves, the voxel grid (h), the kernel (r_e) and the
 /// iso-value (r_0) move with it and the surface changes from frame to frame for that alone
-/// (a flicker in a rendered sequence). Says which values pin them: the first frame's.
+/// (a flicker in a rendered sequence). Says which values pin them: those of the first frame
+/// meshed (the lowest number, unless --frame-jobs meshes several at once).
 void warnIfLengthsMove(int frame, const nonbloppy::ResolvedParameters& p, OnceWarnings& once)
 {
     if (p.spacingGiven || (p.effectiveRadiusGiven && p.voxelSizeGiven && p.thresholdGiven)) return;
