@@ -26,6 +26,17 @@
 #include <utility>
 #include <vector>
 
+/// NONBLOPPY_TEST_ASAN is defined when the tests are built with AddressSanitizer (GCC's
+/// __SANITIZE_ADDRESS__, clang's __has_feature), whose quarantine keeps freed memory: tests
+/// that measure memory skip themselves there.
+#if defined(__SANITIZE_ADDRESS__)
+#define NONBLOPPY_TEST_ASAN 1
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+#define NONBLOPPY_TEST_ASAN 1
+#endif
+#endif
+
 namespace nonbloppy_test {
 
 inline std::string dataPath(const std::string& name)

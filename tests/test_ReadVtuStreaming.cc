@@ -36,14 +36,6 @@
 
 #include <sys/stat.h>
 
-#if defined(__SANITIZE_ADDRESS__)
-#define NONBLOPPY_TEST_ASAN 1
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer)
-#define NONBLOPPY_TEST_ASAN 1
-#endif
-#endif
-
 namespace {
 
 #ifdef NONBLOPPY_TEST_ASAN

@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include "CliTestUtil.h"
+#include "TestUtil.h"
 
 #include <nonbloppy/ReadParticles.h>
 #include <nonbloppy/WriteParticles.h>
@@ -18,14 +19,6 @@
 #include <sstream>
 #include <string>
 #include <vector>
-
-#if defined(__SANITIZE_ADDRESS__)
-#define NONBLOPPY_TEST_ASAN 1
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer)
-#define NONBLOPPY_TEST_ASAN 1
-#endif
-#endif
 
 namespace {
 
