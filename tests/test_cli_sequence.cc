@@ -9,8 +9,8 @@
 
 #include "CliTestUtil.h"
 #include "TestUtil.h"
+#include "bench/BenchUtil.h"
 
-#include <nonbloppy/ReadParticles.h>
 #include <nonbloppy/WriteParticles.h>
 
 #include <algorithm>
@@ -510,24 +510,13 @@ TEST_F(CliSequenceTest, EachFrameStartsWithTheMemoryOfTheFramesBeforeHandedBack)
 #ifdef NONBLOPPY_TEST_ASAN
     GTEST_SKIP() << "AddressSanitizer keeps freed memory in quarantine";
 #endif
-    // Eight disjoint copies of the dam-break frame (195,112 particles). glibc kept what a
+    // Eight disjoint copies of the dam-break frame (195,112 particles; the benchmarks' tiledFrame()). glibc kept what a
     // frame freed, and the next frame reused it only in part: the resident set before
-    // frames 2 and 3 was 94 and 102 MiB against 34 MiB before frame 1, and a 64x frame's
+    // frames 2 and 3 was 92-102 MiB against 34 MiB before frame 1, and a 64x frame's
     // peak rose 328 -> 440 MB by the third frame. Now about 41 MiB each: what is left is
     // mostly the libraries' code pages that frame 1 brought in.
-    const nonbloppy::ParticleSet frame = nonbloppy::readParticles(kData + "/dam_break_frame_23_24389_particles.vtk");
-    openvdb::Vec3f low(std::numeric_limits<float>::max()), high(-std::numeric_limits<float>::max());
-    for (const openvdb::Vec3f& p : frame.positions) {
-        low = openvdb::math::minComponent(low, p);
-        high = openvdb::math::maxComponent(high, p);
-    }
-    const openvdb::Vec3f step = (high - low) * 1.5f;  // gaps wider than any kernel radius
     nonbloppy::ParticleSet tiled;
-    for (int copy = 0; copy < 8; ++copy) {
-        const openvdb::Vec3f offset(step[0] * float(copy & 1), step[1] * float((copy >> 1) & 1),
-                                    step[2] * float(copy >> 2));
-        for (const openvdb::Vec3f& p : frame.positions) tiled.positions.push_back(p + offset);
-    }
+    tiled.positions = nonbloppy_bench::tiledFrame(kData + "/dam_break_frame_23_24389_particles.vtk", 2);
     fs::create_directories(dir() + "/in");
     for (const char* name : {"/in/fluid_1.ply", "/in/fluid_2.ply", "/in/fluid_3.ply"}) {
         nonbloppy::writeParticles(tiled, dir() + name);
