@@ -518,6 +518,24 @@ TEST_F(CliTest, AFailedVdbWriteLeavesTheEarlierMeshInPlace)
     EXPECT_TRUE(listDir(out("")).empty());
 }
 
+TEST_F(CliTest, ASuccessfulRunOverEarlierOutputsLeavesOnlyTheNewOnes)
+{
+    // The replaced files lose their last link on a thread of their own (BackgroundRemover):
+    // by the time the process exits they must be gone, and the new files in their place.
+    auto meshTo = [&](const std::string& name, const char* blend) {
+        return run("mesh " + quote(kData + "/dam_break_frame_23_24389_particles.vtk") + " -q -c " + blend +
+                   " -o " + quote(out(name + ".ply")) + " --vdb " + quote(out(name + ".vdb")));
+    };
+    ASSERT_EQ(meshTo("dam", "0.1").exitCode, 0);
+    const std::string before = readText(out("dam.ply"));
+    ASSERT_EQ(meshTo("dam", "0.5").exitCode, 0);
+    EXPECT_EQ(listDir(out("")), (std::vector<std::string>{"dam.ply", "dam.vdb"}));
+    const std::string after = readText(out("dam.ply"));
+    EXPECT_NE(after, before);
+    ASSERT_EQ(meshTo("fresh", "0.5").exitCode, 0);
+    EXPECT_EQ(after, readText(out("fresh.ply")));
+}
+
 TEST_F(CliTest, InspectMissingFile)
 {
     const std::string missing = in("missing.vdb");

@@ -245,6 +245,24 @@ TEST_F(CliSequenceTest, SkipExistingResumes)
     EXPECT_NE(readText(out("mesh_0001.obj")), "# kept\n");
 }
 
+TEST_F(CliSequenceTest, FramesMadeAgainLeaveNoLinkToTheFilesTheyReplaced)
+{
+    // Each frame's replaced outputs are unlinked on the remover's thread while the next
+    // frames run; the run must not end before they are gone.
+    makeFrames({kCube, kFree, kCube, kFree});
+    for (const char* jobs : {"--frame-jobs 1", "--frame-jobs 2"}) {
+        SCOPED_TRACE(jobs);
+        ASSERT_EQ(meshSequence(dir() + "/out", std::string("-q -c 0.1 ") + jobs).exitCode, 0);
+        const std::string before = readText(out("mesh_0003.obj"));
+        ASSERT_EQ(meshSequence(dir() + "/out", std::string("-q -c 0.5 ") + jobs).exitCode, 0);
+        EXPECT_EQ(listDir(dir() + "/out"),
+                  (std::vector<std::string>{"density_0001.vdb", "density_0002.vdb", "density_0003.vdb",
+                                            "density_0004.vdb", "mesh_0001.obj", "mesh_0002.obj",
+                                            "mesh_0003.obj", "mesh_0004.obj"}));
+        EXPECT_NE(readText(out("mesh_0003.obj")), before);
+    }
+}
+
 TEST_F(CliSequenceTest, FirstBadFrameStopsTheRun)
 {
     makeFrames({kFree, kFree, kFree});

@@ -6,6 +6,7 @@
 #include "Commands.h"
 #include "MeshOutputs.h"
 
+#include "BackgroundRemover.h"
 #include "BatchRun.h"
 #include "FrameSequence.h"
 #include "Json.h"
@@ -529,7 +530,7 @@ void printSummary(const MeshOptions& o, const nonbloppy::SurfaceResult& result,
 /// written there. So before an output is written, the file it will replace (symbolic links
 /// followed, as the writers do) gets a hard link beside it; on failure that link is renamed
 /// back over the new file, or, where nothing was replaced, the new file is removed.
-/// Cost: a link() and an unlink() per existing output. Where the file system has no hard
+/// Cost: a link() and an unlink() per existing output, the unlink() off the frame's path. Where the file system has no hard
 /// links, a failed run still removes the new file (the old one is then lost, as before).
 class OutputCleanup
 {
@@ -551,11 +552,12 @@ public:
     }
     /// Call once the output last announced by willWrite() is written.
     void written() { mOutputs.back().written = true; }
-    /// The frame succeeded: keep the new files, drop the links to the old ones.
-    void keep()
+    /// The frame succeeded: keep the new files, drop the links to the old ones. The old
+    /// files' blocks are freed on @a remover's thread (see BackgroundRemover.h for the wait).
+    void keep(BackgroundRemover& remover)
     {
         for (const Output& output : mOutputs) {
-            if (!output.backup.empty()) ::unlink(output.backup.c_str());
+            if (!output.backup.empty()) remover.remove(output.backup);
         }
         mOutputs.clear();
     }
@@ -600,8 +602,9 @@ struct FrameOutcome
 
 /// Read o.input, build the surface, write o.output (and o.vdbPath). Used for a single file
 /// and, with the paths of one frame filled in, for every frame of a sequence.
-/// On any exception the files written so far are removed again.
-FrameOutcome meshFrame(const MeshOptions& o, ProgressInterrupter& interrupter)
+/// On any exception the files written so far are removed again. The files the outputs
+/// replaced are handed to @a remover once the frame has succeeded.
+FrameOutcome meshFrame(const MeshOptions& o, ProgressInterrupter& interrupter, BackgroundRemover& remover)
 {
     OutputCleanup cleanup;
     nonbloppy::StageTimings before, after;
@@ -656,7 +659,7 @@ FrameOutcome meshFrame(const MeshOptions& o, ProgressInterrupter& interrupter)
         cleanup.written();
     }
     throwIfInterrupted();
-    cleanup.keep();
+    cleanup.keep(remover);
 
     outcome.timings = before;
     outcome.timings.add(result.timings);
@@ -943,6 +946,7 @@ int runSequence(const MeshOptions& o)
 
     std::mutex verboseMutex;
     OnceWarnings once;
+    BackgroundRemover remover;  // replaced outputs are freed while the next frames run
     auto meshOne = [&](const BatchJob& job) {
 #ifdef __GLIBC__
         // Hand back the pages the frames before freed. glibc keeps them (main() lets up to
@@ -959,7 +963,7 @@ int runSequence(const MeshOptions& o)
         ProgressInterrupter interrupter(o.verbose, false, "frame " + std::to_string(job.frame.number) + ": ");
         std::unique_ptr<ResidentSampler> sampler;
         if (o.verbose) sampler = std::make_unique<ResidentSampler>();
-        const FrameOutcome outcome = meshFrame(f, interrupter);
+        const FrameOutcome outcome = meshFrame(f, interrupter, remover);
         warnIfFacesEndInside(o, outcome.result.parameters, once);
         warnIfCoarseFloats(outcome.result, once);
         warnIfEmpty(outcome.result, f.output);
@@ -1016,8 +1020,11 @@ int runMesh(const MeshOptions& o)
     std::unique_ptr<ResidentSampler> sampler;
     if (o.verbose) sampler = std::make_unique<ResidentSampler>();
 
+    // Declared before the outcome, so that the replaced mesh is freed while the outcome's
+    // memory is given back and the summary printed.
+    BackgroundRemover remover;
     try {
-        const FrameOutcome outcome = meshFrame(o, interrupter);
+        const FrameOutcome outcome = meshFrame(o, interrupter, remover);
         interrupter.clearLine();
         OnceWarnings once;
         warnIfFacesEndInside(o, outcome.result.parameters, once);
