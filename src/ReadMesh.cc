@@ -5,6 +5,7 @@
 #include <nonbloppy/ReadMesh.h>
 
 #include <nonbloppy/Error.h>
+#include <nonbloppy/WriteMesh.h>
 
 #include "FileFormats.h"
 
@@ -300,11 +301,8 @@ private:
 SurfaceMesh
 readMesh(const std::string& path)
 {
+    requireMeshFile(path);  // the formats writeMesh() writes
     const std::string ext = lowerExtension(path);
-    if (ext != ".obj" && ext != ".ply" && ext != ".vtk") {
-        throw FileError("unknown mesh file extension '" + ext + "' (" + path +
-            "); expected .obj, .ply or .vtk");
-    }
     const std::vector<char> file = loadFile(path);
     if (ext == ".obj") return ObjReader(file, path).read();
     if (ext == ".ply") return readPlyMesh(file, path);

@@ -384,20 +384,12 @@ writeVtk(const SurfaceMesh& mesh, const PolygonView& polygons, const std::string
 }
 
 /// The lower-case extension of @a path, which must be one writeMesh() writes.
-/// @throw FileError naming the extension (or its absence) and @a path
+/// @throw FileError as requireMeshFile()
 std::string
 requireMeshOutput(const std::string& path)
 {
-    const std::string ext = io_internal::lowerExtension(path);
-    if (ext.empty()) {
-        throw FileError("mesh file name has no extension (" + path +
-            "); expected .obj, .ply or .vtk");
-    }
-    if (!isMeshFile(path)) {
-        throw FileError("unknown mesh file extension '" + ext + "' (" + path +
-            "); expected .obj, .ply or .vtk");
-    }
-    return ext;
+    requireMeshFile(path);
+    return io_internal::lowerExtension(path);
 }
 
 } // namespace
@@ -428,6 +420,18 @@ isMeshFile(const std::string& path)
 {
     const std::string ext = io_internal::lowerExtension(path);
     return ext == ".obj" || ext == ".ply" || ext == ".vtk";
+}
+
+void
+requireMeshFile(const std::string& path)
+{
+    const std::string ext = io_internal::lowerExtension(path);
+    if (ext.empty()) {
+        throw FileError("mesh file name has no extension (" + path + "); expected .obj, .ply or .vtk");
+    }
+    if (!isMeshFile(path)) {
+        throw FileError("unknown mesh file extension '" + ext + "' (" + path + "); expected .obj, .ply or .vtk");
+    }
 }
 
 } // namespace nonbloppy

@@ -79,17 +79,12 @@ vdbColumns(const std::string& base, int components)
 }
 
 /// The lower-case extension of @a path, which must be one writeParticles() writes.
-/// @throw FileError naming the extension (or its absence) and @a path
+/// @throw FileError as requireParticleOutputFile()
 std::string
 requireParticleOutput(const std::string& path)
 {
-    const std::string ext = lowerExtension(path);
-    if (!isParticleOutputFile(path)) {
-        throw FileError((ext.empty() ? "particle file name has no extension ("
-                                     : "unknown particle output extension '" + ext + "' (") +
-                        path + "); expected .ply, .vtk, .vtu, .xyz, .csv or .vdb");
-    }
-    return ext;
+    requireParticleOutputFile(path);
+    return lowerExtension(path);
 }
 
 /// The names the writer of extension @a ext (lower case, with the dot) gives the
@@ -535,6 +530,17 @@ isParticleOutputFile(const std::string& path)
     const std::string ext = lowerExtension(path);
     return ext == ".ply" || ext == ".vtk" || ext == ".vtu" || ext == ".xyz" || ext == ".csv" ||
            ext == ".vdb";
+}
+
+void
+requireParticleOutputFile(const std::string& path)
+{
+    if (!isParticleOutputFile(path)) {
+        const std::string ext = lowerExtension(path);
+        throw FileError((ext.empty() ? "particle file name has no extension ("
+                                     : "unknown particle output extension '" + ext + "' (") +
+                        path + "); expected .ply, .vtk, .vtu, .xyz, .csv or .vdb");
+    }
 }
 
 } // namespace nonbloppy

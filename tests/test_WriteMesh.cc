@@ -9,6 +9,7 @@
 #include <nonbloppy/ReadMesh.h>
 #include <nonbloppy/ReadParticles.h>
 #include <nonbloppy/WriteMesh.h>
+#include <nonbloppy/WriteParticles.h>
 
 #include "../src/AtomicFile.h"
 
@@ -372,6 +373,15 @@ TEST_F(WriteMeshTest, FailuresNameThePathAndLeaveNothingBehind)
 
     EXPECT_FALSE(nonbloppy::isMeshFile("x.stl"));
     EXPECT_TRUE(nonbloppy::isMeshFile("x.Vtk"));
+    // The same check, for callers that want it before the work; readMesh() makes it too.
+    EXPECT_NO_THROW(nonbloppy::requireMeshFile("x.Vtk"));
+    EXPECT_EQ(messageOf<FileError>([] { nonbloppy::requireMeshFile("out/mesh"); }),
+              "mesh file name has no extension (out/mesh); expected .obj, .ply or .vtk");
+    EXPECT_EQ(messageOf<FileError>([&] { readMesh(path("mesh")); }),
+              "mesh file name has no extension (" + path("mesh") + "); expected .obj, .ply or .vtk");
+    EXPECT_EQ(messageOf<FileError>([] { nonbloppy::requireParticleOutputFile("p.obj"); }),
+              "unknown particle output extension '.obj' (p.obj); expected .ply, .vtk, .vtu, .xyz, .csv or .vdb");
+    EXPECT_NO_THROW(nonbloppy::requireParticleOutputFile("p.VDB"));
 }
 
 TEST_F(WriteMeshTest, NewFilesGetTheUsualPermissions)

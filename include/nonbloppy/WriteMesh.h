@@ -63,6 +63,12 @@ NONBLOPPY_API std::vector<std::string> writtenAttributeNames(const SurfaceMesh& 
 /// True if @a path has an extension writeMesh() understands.
 NONBLOPPY_API bool isMeshFile(const std::string& path);
 
+/// Refuses @a path as writeMesh() would, by its extension alone, so that a caller can check
+/// an output name before the work that leads to it. Cost: O(length of @a path).
+/// @throw FileError "mesh file name has no extension (out); expected .obj, .ply or .vtk", or
+///        "unknown mesh file extension '.stl' (out.stl); expected .obj, .ply or .vtk"
+NONBLOPPY_API void requireMeshFile(const std::string& path);
+
 } // namespace nonbloppy
 
 #endif // NONBLOPPY_WRITE_MESH_H

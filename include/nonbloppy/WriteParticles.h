@@ -64,6 +64,12 @@ NONBLOPPY_API std::vector<std::string> writtenAttributeNames(const ParticleSet& 
 /// True if @a path has an extension writeParticles() understands.
 NONBLOPPY_API bool isParticleOutputFile(const std::string& path);
 
+/// Refuses @a path as writeParticles() would, by its extension alone, so that a caller can
+/// check an output name before reading its input. Cost: O(length of @a path).
+/// @throw FileError "particle file name has no extension (out); expected .ply, .vtk, .vtu,
+///        .xyz, .csv or .vdb", or "unknown particle output extension '.obj' (out.obj); ..."
+NONBLOPPY_API void requireParticleOutputFile(const std::string& path);
+
 /// The particles as an openvdb::points::PointDataGrid named "points": position `P`
 /// (world positions, NullCodec) and every attribute in the nearest OpenVDB type (3
 /// components become vec3s, vec3d, vec3i for integers of up to 32 bits, vec3d for wider

@@ -39,12 +39,10 @@ int runConvert(const ConvertOptions& o)
 {
     // Everything that can be checked before reading: the output format, and not
     // overwriting the input.
-    if (!nonbloppy::isParticleOutputFile(o.output)) {
-        const std::string ext = lowerExtensionOf(o.output);
-        throw UsageError(
-            (ext.empty() ? "particle file name has no extension ("
-                         : "unknown particle output extension '" + ext + "' (")
-            + o.output + "); expected .ply, .vtk, .vtu, .xyz, .csv or .vdb");
+    try {
+        nonbloppy::requireParticleOutputFile(o.output);
+    } catch (const nonbloppy::FileError& e) {
+        throw UsageError(e.what());  // a mistake in the command line (exit 2)
     }
     std::error_code ec;
     if (o.input == o.output || std::filesystem::equivalent(o.input, o.output, ec)) {

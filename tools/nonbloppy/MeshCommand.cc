@@ -401,13 +401,12 @@ void validateParameters(const MeshOptions& o)
 
 void validatePaths(const MeshOptions& o)
 {
-    // Spelled as writeMesh() spells it, which would say the same after all the work.
-    if (!nonbloppy::isMeshFile(o.output)) {
-        const std::string ext = lowerExtension(o.output);
-        throw UsageError(
-            (ext.empty() ? "mesh file name has no extension ("
-                         : "unknown mesh file extension '" + ext + "' (")
-            + o.output + "); expected .obj, .ply or .vtk");
+    // writeMesh()'s own check, which would say the same after all the work; here it is a
+    // mistake in the command line (exit 2).
+    try {
+        nonbloppy::requireMeshFile(o.output);
+    } catch (const nonbloppy::FileError& e) {
+        throw UsageError(e.what());
     }
     if (!o.vdbPath.empty() && lowerExtension(o.vdbPath) != ".vdb") {
         throw UsageError("--vdb file name must end in .vdb (" + o.vdbPath + ")");
