@@ -118,6 +118,25 @@ lowerExtension(const std::string& path)
     return ext;
 }
 
+bool
+isMeshExtension(const std::string& ext)
+{
+    return ext == ".obj" || ext == ".ply" || ext == ".vtk";
+}
+
+std::string
+requireMeshExtension(const std::string& path)
+{
+    const std::string ext = lowerExtension(path);
+    if (ext.empty()) {
+        throw FileError("mesh file name has no extension (" + path + "); expected .obj, .ply or .vtk");
+    }
+    if (!isMeshExtension(ext)) {
+        throw FileError("unknown mesh file extension '" + ext + "' (" + path + "); expected .obj, .ply or .vtk");
+    }
+    return ext;
+}
+
 void
 fail(const std::string& path, const std::string& what)
 {

@@ -62,6 +62,15 @@ std::vector<char> readToEndAndClose(int fd, const std::string& path, size_t size
 /// The extension of the last path component, lower-cased, with its dot (".vtk"), or "".
 std::string lowerExtension(const std::string& path);
 
+/// True for the lower-case extensions of the mesh formats: ".obj", ".ply", ".vtk".
+bool isMeshExtension(const std::string& ext);
+
+/// lowerExtension() of @a path, which must name a mesh format readMesh() and writeMesh()
+/// both know (.obj, .ply, .vtk). The one copy of the check behind requireMeshFile().
+/// @throw FileError "mesh file name has no extension (<path>); expected .obj, .ply or .vtk",
+///        or "unknown mesh file extension '<ext>' (<path>); expected .obj, .ply or .vtk"
+std::string requireMeshExtension(const std::string& path);
+
 /// Throw FileError("<what> (<path>)").
 [[noreturn]] void fail(const std::string& path, const std::string& what);
 

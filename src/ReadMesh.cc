@@ -5,7 +5,6 @@
 #include <nonbloppy/ReadMesh.h>
 
 #include <nonbloppy/Error.h>
-#include <nonbloppy/WriteMesh.h>
 
 #include "FileFormats.h"
 
@@ -301,8 +300,7 @@ private:
 SurfaceMesh
 readMesh(const std::string& path)
 {
-    requireMeshFile(path);  // the formats writeMesh() writes
-    const std::string ext = lowerExtension(path);
+    const std::string ext = requireMeshExtension(path);  // the formats writeMesh() writes
     const std::vector<char> file = loadFile(path);
     if (ext == ".obj") return ObjReader(file, path).read();
     if (ext == ".ply") return readPlyMesh(file, path);

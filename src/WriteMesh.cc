@@ -383,27 +383,18 @@ writeVtk(const SurfaceMesh& mesh, const PolygonView& polygons, const std::string
     out.flush();
 }
 
-/// The lower-case extension of @a path, which must be one writeMesh() writes.
-/// @throw FileError as requireMeshFile()
-std::string
-requireMeshOutput(const std::string& path)
-{
-    requireMeshFile(path);
-    return io_internal::lowerExtension(path);
-}
-
 } // namespace
 
 std::vector<std::string>
 writtenAttributeNames(const SurfaceMesh& mesh, const std::string& path)
 {
-    return attributeNamesFor(mesh, requireMeshOutput(path));
+    return attributeNamesFor(mesh, io_internal::requireMeshExtension(path));
 }
 
 void
 writeMesh(const SurfaceMesh& mesh, const std::string& path, const MeshWriteSettings& settings)
 {
-    const std::string ext = requireMeshOutput(path);
+    const std::string ext = io_internal::requireMeshExtension(path);
     validateMesh(mesh, path);
     const PolygonView polygons{mesh, settings.keepQuads};
     // A lower bound of every format's size: binary positions and corner indices.
@@ -418,20 +409,13 @@ writeMesh(const SurfaceMesh& mesh, const std::string& path, const MeshWriteSetti
 bool
 isMeshFile(const std::string& path)
 {
-    const std::string ext = io_internal::lowerExtension(path);
-    return ext == ".obj" || ext == ".ply" || ext == ".vtk";
+    return io_internal::isMeshExtension(io_internal::lowerExtension(path));
 }
 
 void
 requireMeshFile(const std::string& path)
 {
-    const std::string ext = io_internal::lowerExtension(path);
-    if (ext.empty()) {
-        throw FileError("mesh file name has no extension (" + path + "); expected .obj, .ply or .vtk");
-    }
-    if (!isMeshFile(path)) {
-        throw FileError("unknown mesh file extension '" + ext + "' (" + path + "); expected .obj, .ply or .vtk");
-    }
+    io_internal::requireMeshExtension(path);
 }
 
 } // namespace nonbloppy
