@@ -3,6 +3,7 @@
 #include <nonbloppy/ParticleIndex.h>
 
 #include "SurfaceStages.h"
+#include "UnwrittenVector.h"
 
 namespace nonbloppy {
 
@@ -13,7 +14,8 @@ SurfaceResult buildSurface(std::vector<openvdb::Vec3f> positions, const SurfaceP
     result.particleCount = positions.size();
     ParticleIndex index;
     surface_stages_internal::resolveAndIndex(params, nullptr, positions, index, result, interrupter);
-    std::vector<openvdb::Vec3s> unrelaxed;  // freed after fold repair, before the normals
+    // Freed after fold repair, before the normals; filled in parallel, without a memset.
+    memory_internal::UnwrittenVector<openvdb::Vec3s> unrelaxed;
     surface_stages_internal::runSurfaceStages(index, params.keepDensity, result, unrelaxed,
                                               surface_stages_internal::UnrelaxedBuffer::Release,
                                               interrupter);

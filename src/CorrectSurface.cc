@@ -173,7 +173,7 @@ void requireSameSize(const SurfaceMesh& mesh, const std::vector<openvdb::Vec3s>&
 /// marks and the count are the same in any order. Given @a moved (the vertices moved since
 /// the last call, which marked every folded triangle then), only triangles with a moved
 /// corner are tested: the others kept their shape, and were not folded.
-size_t markFolded(const SurfaceMesh& mesh, const std::vector<openvdb::Vec3s>& before,
+size_t markFolded(const SurfaceMesh& mesh, const openvdb::Vec3s* before,
                   std::vector<char>& marked, CancelPoll& poll, const std::vector<char>* moved = nullptr)
 {
     std::fill(marked.begin(), marked.end(), 0);
@@ -326,20 +326,20 @@ size_t countFoldedTriangles(const SurfaceMesh& mesh, const std::vector<openvdb::
     polygon_indices_internal::requireValidIndices(mesh);
     std::vector<char> marked(mesh.points.size());
     CancelPoll never(nullptr, "correct surface");
-    return markFolded(mesh, before, marked, never);
+    return markFolded(mesh, before.data(), marked, never);
 }
 
 size_t repairFolds(SurfaceMesh& mesh, const std::vector<openvdb::Vec3s>& before, int maxRounds,
                    openvdb::util::NullInterrupter* interrupter)
 {
     polygon_indices_internal::requireValidIndices(mesh);
-    return surface_stages_internal::repairFoldsUnchecked(mesh, before, maxRounds, interrupter);
+    requireSameSize(mesh, before);
+    return surface_stages_internal::repairFoldsUnchecked(mesh, before.data(), maxRounds, interrupter);
 }
 
-size_t surface_stages_internal::repairFoldsUnchecked(SurfaceMesh& mesh, const std::vector<openvdb::Vec3s>& before,
+size_t surface_stages_internal::repairFoldsUnchecked(SurfaceMesh& mesh, const openvdb::Vec3s* before,
                                                      int maxRounds, openvdb::util::NullInterrupter* interrupter)
 {
-    requireSameSize(mesh, before);
     if (maxRounds < 0) {
         throw ParameterError("fold repair rounds must be >= 0, got " + std::to_string(maxRounds));
     }

@@ -3,6 +3,7 @@
 #include "InstructionSet.h"
 #include "ParameterChecks.h"
 #include "ParticleIndexImpl.h"
+#include "UnwrittenVector.h"
 
 #include <nonbloppy/Error.h>
 #include <nonbloppy/Kernel.h>
@@ -29,34 +30,9 @@ namespace {
 
 using cancellation_internal::CancelPoll;
 
-/// std::allocator, except that resize() leaves new elements of trivial types unwritten
-/// (default- rather than value-initialised): the parallel loop that fills a buffer of
-/// millions of keys then touches its pages first, on both threads, instead of a serial
-/// memset faulting them all in beforehand.
-template<typename T>
-struct UnwrittenAllocator : std::allocator<T>
-{
-    template<typename U>
-    struct rebind
-    {
-        using other = UnwrittenAllocator<U>;
-    };
-    UnwrittenAllocator() = default;
-    template<typename U>
-    UnwrittenAllocator(const UnwrittenAllocator<U>&) noexcept {}
-    template<typename U>
-    void construct(U* p) noexcept
-    {
-        ::new (static_cast<void*>(p)) U;
-    }
-    template<typename U, typename... Args>
-    void construct(U* p, Args&&... args)
-    {
-        ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
-    }
-};
-template<typename T>
-using UnwrittenVector = std::vector<T, UnwrittenAllocator<T>>;
+// Buffers of millions of keys are filled by parallel loops, which then take their page
+// faults on both threads instead of a serial memset beforehand.
+using memory_internal::UnwrittenVector;
 
 /// Candidates processed side by side (two SSE registers, or one AVX register).
 constexpr size_t kLanes = 8;

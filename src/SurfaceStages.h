@@ -93,12 +93,15 @@ enum class UnrelaxedBuffer
 /// volume correction, timing each in result.timings. result.density is reset when
 /// @a keepDensity is false.
 /// @param index        the frame's particle index, cell size kCellOverRadius·r_e
-/// @param unrelaxed    scratch for the vertex positions before relaxation (fold repair)
+/// @param unrelaxed    scratch for the vertex positions before relaxation (fold repair),
+///                     a std::vector<openvdb::Vec3s> or a memory_internal::UnwrittenVector
+///                     of them (filled in parallel without a serial memset first)
 /// @param whenRepaired whether @a unrelaxed is freed or kept once fold repair is done
 /// Cost: as buildSurface() minus its first two stages. Thread-safety: reentrant.
 /// @throw ParameterError, CancelledError as buildSurface(); result is then unspecified.
+template<typename VertexBufferT>
 void runSurfaceStages(const ParticleIndex& index, bool keepDensity, SurfaceResult& result,
-                      std::vector<openvdb::Vec3s>& unrelaxed, UnrelaxedBuffer whenRepaired,
+                      VertexBufferT& unrelaxed, UnrelaxedBuffer whenRepaired,
                       openvdb::util::NullInterrupter* interrupter);
 
 /// repairFolds(), preserveVolume(mesh, VolumeSettings) and smoothSurface() without the check
@@ -107,7 +110,8 @@ void runSurfaceStages(const ParticleIndex& index, bool keepDensity, SurfaceResul
 /// synthetic mesh of 2.66M polygons, the 64x benchmark mesh's size): the chain's mesh comes
 /// from extractSurface(), valid by construction, and passes through all three. Same results,
 /// same other checks.
-size_t repairFoldsUnchecked(SurfaceMesh& mesh, const std::vector<openvdb::Vec3s>& before, int maxRounds,
+/// @a before holds mesh.points.size() positions (the public functions check that).
+size_t repairFoldsUnchecked(SurfaceMesh& mesh, const openvdb::Vec3s* before, int maxRounds,
                             openvdb::util::NullInterrupter* interrupter);
 double preserveVolumeUnchecked(SurfaceMesh& mesh, const VolumeSettings& settings,
                                openvdb::util::NullInterrupter* interrupter);
