@@ -2,12 +2,15 @@
 # Speed and memory of `nonbloppy mesh` against OpenVDB's own particle mesher, measured in one run
 # on the same inputs: the real dam-break frame tiled into 1, 64 and 512 disjoint copies.
 #
-#   bash tests/bench/run_benchmark.sh [--quick] [--runs N] [--out DIR]
+#   bash tests/bench/run_benchmark.sh [--quick] [--runs N] [--out DIR] [--keep-meshes]
 #
 #   --quick   skip the 512x input (12.5M particles) and the t/threads scans run once each
 #   --runs N  rounds over the inputs, each running both tools in turn on each input (default 3;
 #             the median is kept)
 #   --out DIR where the generated inputs, meshes and the report go (default /tmp/nonbloppy-bench)
+#   --keep-meshes  keep both tools' last meshes in DIR; by default they are removed at the end
+#             (2.1 GB after a full run, most of it the two 512x meshes), the inputs kept for the
+#             next run
 #
 # The peer is `vdb_tool` from Debian's libopenvdb-tools:
 #   vdb_tool -read IN.ply -points2ls voxel=0.025 radius=2 width=3 -ls2mesh adapt=0 -write OUT.ply
@@ -19,12 +22,14 @@ cd "$(dirname "$0")/../.."
 
 runs=3
 quick=0
+keep_meshes=0
 out=/tmp/nonbloppy-bench
 while (($#)); do
   case "$1" in
     --quick) quick=1 ;;
     --runs) runs="$2"; shift ;;
     --out) out="$2"; shift ;;
+    --keep-meshes) keep_meshes=1 ;;
     *) echo "run_benchmark.sh: unknown option '$1'" >&2; exit 2 ;;
   esac
   shift
@@ -240,4 +245,7 @@ done
 compute=$(median 1 "$out/nb_paper.compute")
 say ""
 say "Paper comparison: the 24,389-particle frame computes in ${compute} s (stages other than reading and writing, 2 threads, median of $paper_runs runs of nonbloppy alone; each: $(tr '\n' ' ' < "$out/nb_paper.compute")s), that is $(awk -v c="$compute" 'BEGIN {printf "%.3f", c * 14272 / 24389}') s for 14,272 particles (paper: about 15 s, t = 2)."
+if ((!keep_meshes)); then
+  rm -f "$out"/nb_x*.ply "$out"/vt_x*.ply "$out/scan.ply" "$out/nb_paper.ply"
+fi
 echo "report: $report" >&2
