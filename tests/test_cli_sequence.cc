@@ -528,11 +528,11 @@ TEST_F(CliSequenceTest, EachFrameStartsWithTheMemoryOfTheFramesBeforeHandedBack)
 #ifdef NONBLOPPY_TEST_ASAN
     GTEST_SKIP() << "AddressSanitizer keeps freed memory in quarantine";
 #endif
-    // Eight disjoint copies of the dam-break frame (195,112 particles; the benchmarks' tiledFrame()). glibc kept what a
-    // frame freed, and the next frame reused it only in part: the resident set before
-    // frames 2 and 3 was 92-102 MiB against 34 MiB before frame 1, and a 64x frame's
-    // peak rose 328 -> 440 MB by the third frame. Now about 41 MiB each: what is left is
-    // mostly the libraries' code pages that frame 1 brought in.
+    // Eight disjoint copies of the dam-break frame (195,112 particles; the benchmarks'
+    // tiledFrame()). glibc kept what a frame freed, and the next frame reused it only in
+    // part: the resident set before frames 2 and 3 was 92-102 MiB against 34 MiB before
+    // frame 1, and a 64x frame's peak rose 328 -> 440 MB by the third frame. Now about
+    // 41 MiB each: what is left is mostly the libraries' code pages that frame 1 brought in.
     nonbloppy::ParticleSet tiled;
     tiled.positions = nonbloppy_bench::tiledFrame(kData + "/dam_break_frame_23_24389_particles.vtk", 2);
     fs::create_directories(dir() + "/in");

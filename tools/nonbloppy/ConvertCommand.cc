@@ -39,11 +39,7 @@ int runConvert(const ConvertOptions& o)
 {
     // Everything that can be checked before reading: the output format, and not
     // overwriting the input.
-    try {
-        nonbloppy::requireParticleOutputFile(o.output);
-    } catch (const nonbloppy::FileError& e) {
-        throw UsageError(e.what());  // a mistake in the command line (exit 2)
-    }
+    requireAsUsage([&] { nonbloppy::requireParticleOutputFile(o.output); });
     std::error_code ec;
     if (o.input == o.output || std::filesystem::equivalent(o.input, o.output, ec)) {
         throw UsageError("cannot write " + o.output + ": it is the input file");

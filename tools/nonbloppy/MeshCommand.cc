@@ -401,13 +401,8 @@ void validateParameters(const MeshOptions& o)
 
 void validatePaths(const MeshOptions& o)
 {
-    // writeMesh()'s own check, which would say the same after all the work; here it is a
-    // mistake in the command line (exit 2).
-    try {
-        nonbloppy::requireMeshFile(o.output);
-    } catch (const nonbloppy::FileError& e) {
-        throw UsageError(e.what());
-    }
+    // writeMesh()'s own check, which would say the same after all the work.
+    requireAsUsage([&] { nonbloppy::requireMeshFile(o.output); });
     if (!o.vdbPath.empty() && lowerExtension(o.vdbPath) != ".vdb") {
         throw UsageError("--vdb file name must end in .vdb (" + o.vdbPath + ")");
     }
@@ -529,8 +524,9 @@ void printSummary(const MeshOptions& o, const nonbloppy::SurfaceResult& result,
 /// written there. So before an output is written, the file it will replace (symbolic links
 /// followed, as the writers do) gets a hard link beside it; on failure that link is renamed
 /// back over the new file, or, where nothing was replaced, the new file is removed.
-/// Cost: a link() and an unlink() per existing output, the unlink() off the frame's path. Where the file system has no hard
-/// links, a failed run still removes the new file (the old one is then lost, as before).
+/// Cost: a link() and an unlink() per existing output, the unlink() off the frame's path
+/// (BackgroundRemover). Where the file system has no hard links, a failed run still removes
+/// the new file (the old one is then lost, as before).
 class OutputCleanup
 {
 public:

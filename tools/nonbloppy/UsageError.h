@@ -21,6 +21,19 @@ public:
     using nonbloppy::Error::Error;
 };
 
+/// Runs @a check, one of the library's checks of an output file name (requireMeshFile(),
+/// requireParticleOutputFile()), before any work: the name it refuses is a mistake in the
+/// command line, so its FileError becomes a UsageError with the same message.
+template<typename CheckT>
+void requireAsUsage(const CheckT& check)
+{
+    try {
+        check();
+    } catch (const nonbloppy::FileError& e) {
+        throw UsageError(e.what());
+    }
+}
+
 } // namespace nonbloppy_tool
 
 #endif // NONBLOPPY_TOOL_USAGE_ERROR_H
