@@ -22,6 +22,7 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cmath>
 #include <string>
 #include <vector>
@@ -79,11 +80,13 @@ class CountingInterrupter : public openvdb::util::NullInterrupter
 {
 public:
     explicit CountingInterrupter(int stopAt) : mStopAt(stopAt) {}
+    // Atomic: extraction asks from its pipeline's parallel filter too, and CancelPoll asks
+    // interrupters from many tasks at once (Cancellation.h).
     bool wasInterrupted(int = -1) override { return ++mQuestions >= mStopAt; }
-    int questions() const { return mQuestions; }
+    int questions() const { return mQuestions.load(); }
 private:
     int mStopAt;
-    int mQuestions = 0;
+    std::atomic<int> mQuestions{0};
 };
 
 } // namespace
