@@ -3,6 +3,7 @@
 /// @brief Temporary-file-and-rename writing (see AtomicFile.h).
 
 #include "AtomicFile.h"
+#include "SystemBuffer.h"
 
 #include <nonbloppy/Error.h>
 
@@ -79,7 +80,6 @@ public:
     {
         stopWriter();
         if (mFd >= 0) ::close(mFd);
-        for (char* buffer : mBuffers) std::free(buffer);
     }
     DirectFileBuf(const DirectFileBuf&) = delete;
     DirectFileBuf& operator=(const DirectFileBuf&) = delete;
@@ -88,13 +88,12 @@ public:
     bool open(const std::string& path)
     {
 #if defined(O_DIRECT)
-        for (char*& buffer : mBuffers) {
-            buffer = static_cast<char*>(std::aligned_alloc(kAlignment, kBufferBytes));
-            if (!buffer) return false;
+        for (memory_internal::SystemBuffer& buffer : mBuffers) {
+            buffer = memory_internal::SystemBuffer(kBufferBytes);  // page-aligned
         }
         mFd = ::open(path.c_str(), O_WRONLY | O_TRUNC | O_CLOEXEC | O_DIRECT);
         if (mFd < 0) return false;
-        setp(mBuffers[0], mBuffers[0] + kBufferBytes);
+        setp(mBuffers[0].data(), mBuffers[0].data() + kBufferBytes);
         return true;
 #else
         (void)path;
@@ -162,7 +161,7 @@ private:
         }
         if (!mWriter.joinable()) mWriter = std::thread([this] { writerLoop(); });
         mChanged.notify_all();
-        char* next = full == mBuffers[0] ? mBuffers[1] : mBuffers[0];
+        char* next = full == mBuffers[0].data() ? mBuffers[1].data() : mBuffers[0].data();
         setp(next, next + kBufferBytes);
         return true;
     }
@@ -249,7 +248,7 @@ private:
     }
 
     int mFd = -1;
-    char* mBuffers[2] = {nullptr, nullptr};
+    memory_internal::SystemBuffer mBuffers[2];  ///< mapped, not from malloc (see SystemBuffer.h)
     bool mBuffered = false;  ///< O_DIRECT cleared: after a rejected or short write, or for the tail
 
     // The writer thread and the buffer it holds. mFd, mBuffered and writeAll() belong to

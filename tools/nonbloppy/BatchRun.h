@@ -8,7 +8,8 @@
 /// BatchSettings settings;                 // frameJobs, skipExisting, keepGoing, logPath, ...
 /// std::vector<BatchJob> jobs = ...;       // one per frame: input and every output it writes
 /// int exitCode = runBatch(jobs, settings, [&](const BatchJob& job) {
-///     return meshOneFrame(job);           // FrameReport: counts, stage seconds, parameters
+///     auto meshed = meshOneFrame(job);    // read and mesh
+///     return [=] { return writeOutputs(meshed); };  // FrameReport: counts, stage seconds, ...
 /// }, [] { return interruptRequested(); });
 /// @endcode
 
@@ -57,17 +58,26 @@ struct BatchSettings
     std::vector<int> missing;   ///< requested frames not on disk (listed once, skipped)
 };
 
+/// Meshes one frame and returns the step that writes its outputs and reports it: run at once
+/// when frames are meshed side by side (--frame-jobs 2 or more), otherwise on a thread of
+/// its own while the next frame is meshed. Either step may throw (the frame failed). The
+/// second argument waits until the frame before is written (at once if it is): call it
+/// before the frame's memory grows.
+using MeshFrameFunction =
+    std::function<std::function<FrameReport()>(const BatchJob&, const std::function<void()>& waitForWriteBefore)>;
+
 /// Mesh every job with @a meshFrame, at most settings.frameJobs at a time, and report.
+/// With one frame at a time, each frame is written while the next one is meshed (see
+/// MeshFrameFunction); frames are reported in order either way.
 /// @a interrupted is polled between frames; a frame that is interrupted throws
-/// nonbloppy::CancelledError from @a meshFrame (having removed its partial outputs).
+/// nonbloppy::CancelledError from either step (having removed its partial outputs).
 /// @return 0 when every frame was done or skipped, kExitInterrupted after an interrupt
 ///         (stderr names the finished frames).
 /// @throw the first frame's error when !keepGoing (after the summary and log are written),
 ///        nonbloppy::Error "N of M frames failed: 3, 7" when keepGoing and frames failed,
 ///        nonbloppy::FileError if the log cannot be written.
 int runBatch(const std::vector<BatchJob>& jobs, const BatchSettings& settings,
-             const std::function<FrameReport(const BatchJob&)>& meshFrame,
-             const std::function<bool()>& interrupted);
+             const MeshFrameFunction& meshFrame, const std::function<bool()>& interrupted);
 
 // ---------------------------------------------------------------------------------------
 // Memory

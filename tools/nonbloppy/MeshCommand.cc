@@ -139,6 +139,8 @@ private:
 ///   going; clearLine() (or the destructor) erases it before anything else is printed.
 /// wasInterrupted() is called from worker threads: every line is written whole, under one
 /// mutex shared by all interrupters; a live redraw never waits for it.
+/// setBeforeRasterize() gives it an action to run as "rasterize density" starts (a sequence
+/// waits there for the frame before to be written, see runSequence()).
 class ProgressInterrupter : public openvdb::util::NullInterrupter
 {
 public:
@@ -148,8 +150,12 @@ public:
     ProgressInterrupter(const ProgressInterrupter&) = delete;
     ProgressInterrupter& operator=(const ProgressInterrupter&) = delete;
 
+    /// Run @a action (on the thread that meshes) as the stage "rasterize density" starts.
+    void setBeforeRasterize(std::function<void()> action) { mBeforeRasterize = std::move(action); }
+
     void start(const char* name = nullptr) override
     {
+        if (mBeforeRasterize && name && std::strcmp(name, "rasterize density") == 0) mBeforeRasterize();
 #ifdef __GLIBC__
         // By now the library has freed the density grid (without --vdb) and the extraction's
         // temporaries, but glibc keeps those pages; hand them back before the mesh grows, or
@@ -231,6 +237,7 @@ private:
     struct Stage { std::string name; std::chrono::steady_clock::time_point start; };
     bool mVerbose, mLive;
     std::string mFrame;
+    std::function<void()> mBeforeRasterize;
     std::vector<Stage> mStages;
     std::atomic<int> mNextQuarter{1};
     bool mDrawn = false;
@@ -595,21 +602,24 @@ struct FrameOutcome
     nonbloppy::StageTimings timings;
 };
 
-/// Read o.input, build the surface, write o.output (and o.vdbPath). Used for a single file
-/// and, with the paths of one frame filled in, for every frame of a sequence.
-/// On any exception the files written so far are removed again. The files the outputs
-/// replaced are handed to @a remover once the frame has succeeded.
-FrameOutcome meshFrame(const MeshOptions& o, ProgressInterrupter& interrupter, BackgroundRemover& remover)
+/// A frame read and meshed, its outputs not yet written (see writeFrame()).
+struct MeshedFrame
 {
-    OutputCleanup cleanup;
-    nonbloppy::StageTimings before, after;
+    nonbloppy::ParticleSet particles;  ///< kept only for --attributes and --vdb-points
+    nonbloppy::SurfaceResult result;
+    nonbloppy::StageTimings before;    ///< "read particles"
+    nonbloppy::StageTimings after;     ///< "interpolate attributes", then the writes
+};
 
-    nonbloppy::ParticleSet particles;
+/// Read o.input and build the surface (with its attributes); writes nothing.
+MeshedFrame meshFrameSurface(const MeshOptions& o, ProgressInterrupter& interrupter)
+{
+    MeshedFrame frame;
     {
-        StageScope stage(interrupter, before, "read particles");
-        particles = nonbloppy::readParticles(o.input);
+        StageScope stage(interrupter, frame.before, "read particles");
+        frame.particles = nonbloppy::readParticles(o.input);
     }
-    if (particles.size() == 0) {
+    if (frame.particles.size() == 0) {
         throw nonbloppy::FileError("no particles in " + o.input);
     }
     throwIfInterrupted();
@@ -618,20 +628,38 @@ FrameOutcome meshFrame(const MeshOptions& o, ProgressInterrupter& interrupter, B
 
     // The particles are handed over, unless --attributes or --vdb-points still need them.
     const bool keepParticles = o.outputs.needParticles();
-    FrameOutcome outcome;
-    outcome.result = nonbloppy::buildSurface(
-        keepParticles ? std::vector<openvdb::Vec3f>(particles.positions) : std::move(particles.positions),
+    frame.result = nonbloppy::buildSurface(
+        keepParticles ? std::vector<openvdb::Vec3f>(frame.particles.positions) : std::move(frame.particles.positions),
         params, &interrupter);
-    nonbloppy::SurfaceResult& result = outcome.result;
-    if (!keepParticles) particles = nonbloppy::ParticleSet();
+    if (!keepParticles) frame.particles = nonbloppy::ParticleSet();
     throwIfInterrupted();
     if (!o.outputs.attributes.empty()) {
-        nonbloppy::ScopedStageTimer timer(after, "interpolate attributes");
-        addSurfaceAttributes(result, particles, o.outputs, o.output, &interrupter);
+        nonbloppy::ScopedStageTimer timer(frame.after, "interpolate attributes");
+        addSurfaceAttributes(frame.result, frame.particles, o.outputs, o.output, &interrupter);
     }
+    return frame;
+}
 
+/// What an interrupt does to writeFrame().
+enum class OnInterrupt
+{
+    Stop,    ///< stop between outputs and remove what was written (a single file's run)
+    Finish,  ///< write the outputs: a sequence's frame meshed before an interrupt is still
+             ///< written (a write is short, and stopping it would throw a finished frame
+             ///< away); only --vdb-surface's conversion, which takes seconds, still stops
+};
+
+/// Write @a frame's o.output (and o.vdbPath). On any exception the files written so far are
+/// removed again. The files the outputs replaced are handed to @a remover once the frame
+/// has succeeded. Returns the surface and every stage's seconds.
+FrameOutcome writeFrame(const MeshOptions& o, MeshedFrame& frame, ProgressInterrupter& interrupter,
+                        BackgroundRemover& remover, OnInterrupt onInterrupt)
+{
+    const bool stoppable = onInterrupt == OnInterrupt::Stop;
+    OutputCleanup cleanup;
+    nonbloppy::SurfaceResult& result = frame.result;
     {
-        StageScope stage(interrupter, after, "write mesh");
+        StageScope stage(interrupter, frame.after, "write mesh");
         nonbloppy::MeshWriteSettings settings;
         settings.keepQuads = o.quads;
         settings.directIo = !o.noDirectIo;
@@ -639,27 +667,38 @@ FrameOutcome meshFrame(const MeshOptions& o, ProgressInterrupter& interrupter, B
         nonbloppy::writeMesh(result.mesh, o.output, settings);
         cleanup.written();
     }
-    throwIfInterrupted();
+    if (stoppable) throwIfInterrupted();
 
     if (!o.vdbPath.empty()) {
         if (!result.density) throw nonbloppy::Error("no density grid to write");
-        StageScope stage(interrupter, after, "write vdb");
+        StageScope stage(interrupter, frame.after, "write vdb");
         result.density->insertMeta("source_file", openvdb::StringMetadata(o.input));
         openvdb::MetaMap fileMetadata;
         fileMetadata.insertMeta("creator", openvdb::StringMetadata(versionLine()));
         openvdb::GridCPtrVec grids{result.density};
-        appendVdbGrids(grids, result, particles, o.outputs, &interrupter);
+        appendVdbGrids(grids, result, frame.particles, o.outputs, &interrupter);
         cleanup.willWrite(o.vdbPath);
         nonbloppy::writeVdb(grids, o.vdbPath, fileMetadata);
         cleanup.written();
     }
-    throwIfInterrupted();
+    if (stoppable) throwIfInterrupted();
     cleanup.keep(remover);
 
-    outcome.timings = before;
+    FrameOutcome outcome;
+    outcome.timings = frame.before;
     outcome.timings.add(result.timings);
-    outcome.timings.add(after);
+    outcome.timings.add(frame.after);
+    outcome.result = std::move(result);
     return outcome;
+}
+
+/// Read o.input, build the surface, write o.output (and o.vdbPath): meshFrameSurface(), then
+/// writeFrame(), which an interrupt stops. Used for a single file; a sequence writes each
+/// frame while the next one is meshed.
+FrameOutcome meshFrame(const MeshOptions& o, ProgressInterrupter& interrupter, BackgroundRemover& remover)
+{
+    MeshedFrame frame = meshFrameSurface(o, interrupter);
+    return writeFrame(o, frame, interrupter, remover, OnInterrupt::Stop);
 }
 
 /// The warnings a run of the mesh command gives once, however many of its frames (meshed
@@ -942,23 +981,10 @@ int runSequence(const MeshOptions& o)
     std::mutex verboseMutex;
     OnceWarnings once;
     BackgroundRemover remover;  // replaced outputs are freed while the next frames run
-    auto meshOne = [&](const BatchJob& job) {
-#ifdef __GLIBC__
-        // Hand back the pages the frames before freed. glibc keeps them (main() lets up to
-        // 256 MB stay at the heap's top, and freed blocks amid the heap are never returned
-        // unless trimmed), and the next frame's allocations reuse them only in part: on the
-        // 64x benchmark input a sequence's peak RSS rose 328 -> 440 MB by the third frame,
-        // so a farm job sized by meshing one frame could be killed mid-sequence. With this,
-        // 328 -> 345-353 MB; cost about 3% of the wall time per frame (8 frames, median of
-        // 4 alternating pairs), nothing measurable at 512x (1.71 GB peak either way).
-        malloc_trim(0);
-#endif
-        const MeshOptions f = optionsForFrame(o, job.frame);
-        validatePaths(f);
-        ProgressInterrupter interrupter(o.verbose, false, "frame " + std::to_string(job.frame.number) + ": ");
-        std::unique_ptr<ResidentSampler> sampler;
-        if (o.verbose) sampler = std::make_unique<ResidentSampler>();
-        const FrameOutcome outcome = meshFrame(f, interrupter, remover);
+    // Writes a meshed frame, warns, and reports it; the frame's memory goes on return.
+    const auto writeAndReport = [&](const MeshOptions& f, const BatchJob& job, MeshedFrame& frame,
+                                    ProgressInterrupter& interrupter, ResidentSampler* sampler) {
+        const FrameOutcome outcome = writeFrame(f, frame, interrupter, remover, OnInterrupt::Finish);
         warnIfFacesEndInside(o, outcome.result.parameters, once);
         warnIfCoarseFloats(outcome.result, once);
         warnIfEmpty(outcome.result, f.output);
@@ -983,6 +1009,39 @@ int runSequence(const MeshOptions& o)
                       << sampler->report(outcome.timings, result.particleCount) << std::flush;
         }
         return report;
+    };
+    // Meshes a frame here; its write step may run on another thread (see runBatch()), so
+    // what it needs is shared with it. The frame before may still be being written: this one
+    // reads its particles and indexes them meanwhile, and waits for that write (which hands
+    // the frame's memory back) before its density grid grows. Without the wait, on small
+    // frames written in about as long as the next takes to reach its peak, a sequence of
+    // three 195k-particle frames peaked at 133-148 MiB against 108-119 for one frame.
+    auto meshOne = [&](const BatchJob& job, const std::function<void()>& waitForWriteBefore) {
+        const MeshOptions f = optionsForFrame(o, job.frame);
+        validatePaths(f);
+        auto interrupter = std::make_shared<ProgressInterrupter>(
+            o.verbose, false, "frame " + std::to_string(job.frame.number) + ": ");
+        interrupter->setBeforeRasterize(waitForWriteBefore);
+        std::shared_ptr<ResidentSampler> sampler;
+        if (o.verbose) sampler = std::make_shared<ResidentSampler>();
+        auto frame = std::make_shared<MeshedFrame>(meshFrameSurface(f, *interrupter));
+        return std::function<FrameReport()>([&writeAndReport, f, job, interrupter, sampler, frame]() mutable {
+            const FrameReport report = writeAndReport(f, job, *frame, *interrupter, sampler.get());
+            frame.reset();
+#ifdef __GLIBC__
+            // Hand back the pages this frame freed. glibc keeps them (main() lets up to
+            // 256 MB stay at the heap's top, and freed blocks amid the heap are never
+            // returned unless trimmed), and the next frame's allocations reuse them only in
+            // part: on the 64x benchmark input a sequence's peak RSS rose 328 -> 440 MB by
+            // the third frame, so a farm job sized by meshing one frame could be killed
+            // mid-sequence. With this, 328 -> 345-353 MB; cost about 3% of the wall time per
+            // frame (8 frames, median of 4 alternating pairs), nothing measurable at 512x
+            // (1.71 GB peak either way). Once the frame is written, not as the next one
+            // starts: that one starts while this one is written.
+            malloc_trim(0);
+#endif
+            return report;
+        });
     };
     return runBatch(jobs, settings, meshOne, [] { return gInterruptRequested.load(); });
 }
