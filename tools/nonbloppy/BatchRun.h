@@ -60,11 +60,8 @@ struct BatchSettings
 
 /// Meshes one frame and returns the step that writes its outputs and reports it: run at once
 /// when frames are meshed side by side (--frame-jobs 2 or more), otherwise on a thread of
-/// its own while the next frame is meshed. Either step may throw (the frame failed). The
-/// second argument waits until the frame before is written (at once if it is): call it
-/// before the frame's memory grows.
-using MeshFrameFunction =
-    std::function<std::function<FrameReport()>(const BatchJob&, const std::function<void()>& waitForWriteBefore)>;
+/// its own while the next frame is meshed. Either step may throw (the frame failed).
+using MeshFrameFunction = std::function<std::function<FrameReport()>(const BatchJob&)>;
 
 /// Mesh every job with @a meshFrame, at most settings.frameJobs at a time, and report.
 /// With one frame at a time, each frame is written while the next one is meshed (see

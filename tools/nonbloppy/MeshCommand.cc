@@ -139,8 +139,6 @@ private:
 ///   going; clearLine() (or the destructor) erases it before anything else is printed.
 /// wasInterrupted() is called from worker threads: every line is written whole, under one
 /// mutex shared by all interrupters; a live redraw never waits for it.
-/// setBeforeRasterize() gives it an action to run as "rasterize density" starts (a sequence
-/// waits there for the frame before to be written, see runSequence()).
 class ProgressInterrupter : public openvdb::util::NullInterrupter
 {
 public:
@@ -150,12 +148,8 @@ public:
     ProgressInterrupter(const ProgressInterrupter&) = delete;
     ProgressInterrupter& operator=(const ProgressInterrupter&) = delete;
 
-    /// Run @a action (on the thread that meshes) as the stage "rasterize density" starts.
-    void setBeforeRasterize(std::function<void()> action) { mBeforeRasterize = std::move(action); }
-
     void start(const char* name = nullptr) override
     {
-        if (mBeforeRasterize && name && std::strcmp(name, "rasterize density") == 0) mBeforeRasterize();
 #ifdef __GLIBC__
         // By now the library has freed the density grid (without --vdb) and the extraction's
         // temporaries, but glibc keeps those pages; hand them back before the mesh grows, or
@@ -237,7 +231,6 @@ private:
     struct Stage { std::string name; std::chrono::steady_clock::time_point start; };
     bool mVerbose, mLive;
     std::string mFrame;
-    std::function<void()> mBeforeRasterize;
     std::vector<Stage> mStages;
     std::atomic<int> mNextQuarter{1};
     bool mDrawn = false;
@@ -1010,18 +1003,13 @@ int runSequence(const MeshOptions& o)
         }
         return report;
     };
-    // Meshes a frame here; its write step may run on another thread (see runBatch()), so
-    // what it needs is shared with it. The frame before may still be being written: this one
-    // reads its particles and indexes them meanwhile, and waits for that write (which hands
-    // the frame's memory back) before its density grid grows. Without the wait, on small
-    // frames written in about as long as the next takes to reach its peak, a sequence of
-    // three 195k-particle frames peaked at 133-148 MiB against 108-119 for one frame.
-    auto meshOne = [&](const BatchJob& job, const std::function<void()>& waitForWriteBefore) {
+    // Meshes a frame here; its write step may run on another thread while the next frame is
+    // meshed (see runBatch()), so what it needs is shared with it.
+    auto meshOne = [&](const BatchJob& job) {
         const MeshOptions f = optionsForFrame(o, job.frame);
         validatePaths(f);
         auto interrupter = std::make_shared<ProgressInterrupter>(
             o.verbose, false, "frame " + std::to_string(job.frame.number) + ": ");
-        interrupter->setBeforeRasterize(waitForWriteBefore);
         std::shared_ptr<ResidentSampler> sampler;
         if (o.verbose) sampler = std::make_shared<ResidentSampler>();
         auto frame = std::make_shared<MeshedFrame>(meshFrameSurface(f, *interrupter));
