@@ -14,8 +14,10 @@
 
 #include <CLI/CLI.hpp>
 
+#include <cctype>
 #include <cstdint>
 #include <cstdio>
+#include <filesystem>
 #include <functional>
 #include <sstream>
 #include <string>
@@ -56,6 +58,14 @@ std::string versionLine();
 /// out.ply as 'a_b_2'". Defined in main.cc.
 void warnRenamedAttributes(const std::vector<std::string>& original, const std::vector<std::string>& written,
                            const std::string& path);
+
+/// The extension of @a path's last component with its dot, lower-cased (".vtk"), or "".
+inline std::string lowerExtension(const std::string& path)
+{
+    std::string ext = std::filesystem::path(path).extension().string();
+    for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    return ext;
+}
 
 /// A number as a person reads it: shortest of %g with 6 significant digits ("0.05", "1.5").
 /// This is also how the library spells numbers in its parameter errors.

@@ -28,13 +28,6 @@ struct ConvertOptions
     bool noDirectIo = false;  ///< --no-direct-io: write through the page cache
 };
 
-std::string lowerExtensionOf(const std::string& path)
-{
-    std::string ext = std::filesystem::path(path).extension().string();
-    for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-    return ext;
-}
-
 int runConvert(const ConvertOptions& o)
 {
     // Everything that can be checked before reading: the output format, and not
@@ -46,7 +39,7 @@ int runConvert(const ConvertOptions& o)
     }
 
     const nonbloppy::ParticleSet particles = nonbloppy::readParticles(o.input);
-    const bool positionsOnly = lowerExtensionOf(o.output) == ".xyz";
+    const bool positionsOnly = lowerExtension(o.output) == ".xyz";
     if (positionsOnly && !particles.attributes.empty()) {
         std::string names;
         for (const auto& a : particles.attributes) names += (names.empty() ? "" : ", ") + a.name;

@@ -113,13 +113,6 @@ private:
 // ---------------------------------------------------------------------------------------
 // Helpers
 
-std::string lowerExtension(const std::string& path)
-{
-    std::string ext = std::filesystem::path(path).extension().string();
-    for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-    return ext;
-}
-
 std::string formatVec3(double x, double y, double z)
 {
     return "(" + formatNumber(x) + ", " + formatNumber(y) + ", " + formatNumber(z) + ")";

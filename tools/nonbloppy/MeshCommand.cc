@@ -320,14 +320,6 @@ nonbloppy::SurfaceParameters surfaceParameters(const MeshOptions& o)
     return params;
 }
 
-/// The extension of @a path's last component with its dot, lower-cased ("" if none).
-std::string lowerExtension(const std::string& path)
-{
-    std::string ext = fs::path(path).extension().string();
-    for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-    return ext;
-}
-
 /// True if @a a and @a b name one file: the same name (which need not exist yet), or
 /// existing paths to one file (hard links, symbolic links, "./").
 bool sameFile(const std::string& a, const std::string& b)
