@@ -16,6 +16,7 @@
 #include <filesystem>
 #include <fstream>
 #include <mutex>
+#include <new>
 #include <streambuf>
 #include <thread>
 #include <vector>
@@ -84,12 +85,17 @@ public:
     DirectFileBuf(const DirectFileBuf&) = delete;
     DirectFileBuf& operator=(const DirectFileBuf&) = delete;
 
-    /// Open @a path (it exists) for writing with O_DIRECT. False if that is refused.
+    /// Open @a path (it exists) for writing with O_DIRECT. False if that is refused, or if
+    /// its two blocks cannot be mapped.
     bool open(const std::string& path)
     {
 #if defined(O_DIRECT)
-        for (memory_internal::SystemBuffer& buffer : mBuffers) {
-            buffer = memory_internal::SystemBuffer(kBufferBytes);  // page-aligned
+        try {
+            for (memory_internal::SystemBuffer& buffer : mBuffers) {
+                buffer = memory_internal::SystemBuffer(kBufferBytes);  // page-aligned
+            }
+        } catch (const std::bad_alloc&) {
+            return false;  // no room for the blocks: the caller writes through the page cache
         }
         mFd = ::open(path.c_str(), O_WRONLY | O_TRUNC | O_CLOEXEC | O_DIRECT);
         if (mFd < 0) return false;
