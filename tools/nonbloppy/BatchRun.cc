@@ -415,6 +415,7 @@ void workWritingBehind(BatchState& state, const std::vector<BatchJob>& jobs, con
     const auto waitForWriter = [&writer] {
         if (writer.joinable()) writer.join();
     };
+    // On every way out, a throw included: a joinable std::thread's destructor terminates.
     struct JoinWriter
     {
         const decltype(waitForWriter)& wait;
@@ -441,7 +442,6 @@ void workWritingBehind(BatchState& state, const std::vector<BatchJob>& jobs, con
             }, [] {});
         });
     }
-    waitForWriter();
 }
 
 } // namespace
