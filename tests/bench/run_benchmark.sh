@@ -168,10 +168,12 @@ for ((r = 0; r < scan_runs; ++r)); do
   done
 done
 # One and two threads in pairs of adjacent runs, the order swapped every other pair, at least
-# five pairs: the machine's slow spells last seconds, so a ratio of two medians taken from
+# seven pairs: the machine's slow spells last seconds, so a ratio of two medians taken from
 # different rounds strayed (2026-12-04: medians 3.02 / 1.97 s = 1.53x while the three pairs
-# gave 1.41, 1.71 and 1.72). Each pair's stage times are kept for the per-stage ratios.
-thread_pairs=$(( scan_runs < 5 ? 5 : scan_runs ))
+# gave 1.41, 1.71 and 1.72), and one pair of five can still fall far out (2026-12-05: 1.32x
+# beside 1.61-1.78x), which moves a median of five more than one of seven. Each pair's stage
+# times are kept for the per-stage ratios.
+thread_pairs=$(( scan_runs < 7 ? 7 : scan_runs ))
 ((quick)) && thread_pairs=1
 rm -f "$out/scan_threads1" "$out/scan_threads2" "$out/scan_threads_stages"
 for ((r = 0; r < thread_pairs; ++r)); do
@@ -230,6 +232,38 @@ while IFS= read -r stage; do
   cores=$(awk -F'\t' -v name="$stage" '$1 == 2 && $3 == name {print $5}' "$out/scan_threads_stages" | median_of)
   say "| $stage | $one | $two | $(thread_ratios "$stage" | median_of) | $cores |"
 done < <(awk -F'\t' '$1 == 1 && $2 == 0 {print $3}' "$out/scan_threads_stages")
+
+# Sequences: one `mesh` call over frames, as a cache is meshed, against the single-frame runs
+# above. Every frame is the 64x input (symbolic links), so each frame costs what one run
+# measured. By default a frame is written while the next one is meshed; --frame-jobs 2 meshes
+# two frames at once, each with both threads.
+seq_frames=6
+mkdir -p "$out/sequence"
+for ((f = 1; f <= seq_frames; ++f)); do ln -sf "$out/dam_break_x64.ply" "$out/sequence/in_$f.ply"; done
+rm -f "$out/seq_behind" "$out/seq_jobs2"
+for ((r = 0; r < scan_runs; ++r)); do
+  for mode in behind jobs2; do
+    rm -f "$out"/sequence/out_*.ply
+    extra=(); [ "$mode" = jobs2 ] && extra=(--frame-jobs 2)
+    run_timed "$out/seq_$mode" "$nonbloppy" mesh "$out/sequence/in_{}.ply" -o "$out/sequence/out_{}.ply" \
+      --frames "1-$seq_frames" "${nb_args[@]}" "${extra[@]}"
+  done
+done
+rm -f "$out"/sequence/out_*.ply
+say ""
+say "Sequences: $seq_frames frames of the 64x input in one call (\`mesh 'in_{}.ply' -o 'out_{}.ply' --frames 1-$seq_frames\`), median of $scan_runs runs, against $seq_frames single-frame runs (the 64x rows above):"
+say ""
+say "| $seq_frames frames of 64x | wall s | per frame s | peak RSS MB | per frame / one-frame run | per frame / vdb_tool run |"
+say "| --- | --- | --- | --- | --- | --- |"
+vt64=$(median 1 "$out/vt_64")
+sequence_row() {  # sequence_row LABEL WALL RSS_KB
+  awk -v label="$1" -v w="$2" -v m="$3" -v n="$seq_frames" -v one="${nb_wall[64]}" -v vt="$vt64" \
+    'BEGIN {printf "| %s | %.2f | %.3f | %d | %.2f | %.3f |\n", label, w, w / n, m / 1024, w / n / one, w / n / vt}' \
+    | tee -a "$report"
+}
+sequence_row "one frame at a time, written while the next is meshed" "$(median 1 "$out/seq_behind")" "$(median 3 "$out/seq_behind")"
+sequence_row "--frame-jobs 2" "$(median 1 "$out/seq_jobs2")" "$(median 3 "$out/seq_jobs2")"
+sequence_row "$seq_frames separate runs" "$(awk -v w="${nb_wall[64]}" -v n="$seq_frames" 'BEGIN {print w * n}')" "$(median 3 "$out/nb_64")"
 
 # The paper's figure: 14,272 particles, t = 2, about 15 s on a 2008 desktop. Compute time of the
 # 1x frame (24,389 particles; stages without reading and writing) scaled to 14,272 particles.
