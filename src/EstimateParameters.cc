@@ -259,9 +259,13 @@ double calibrateThreshold(double effectiveRadiusOverSpacing)
     return cancellation_internal::calibrateThreshold(effectiveRadiusOverSpacing, never);
 }
 
-double cancellation_internal::calibrateThreshold(double effectiveRadiusOverSpacing, CancelPoll& poll)
+namespace {
+
+/// @throw ParameterError unless r_e/s (@a ratio) lies in (1/2, kMaxCalibratedRadiusOverSpacing]:
+/// the calibration's lattice has no density at the surface's plane below, and its cost grows
+/// as the ratio cubed above.
+void requireCalibratableRadius(double ratio)
 {
-    const double ratio = effectiveRadiusOverSpacing;
     if (!(ratio > 0.5) || !std::isfinite(ratio)) {
         throw ParameterError("--radius must exceed half the particle spacing to calibrate --threshold, got " +
                              formatNumber(ratio) + " spacings");
@@ -271,6 +275,14 @@ double cancellation_internal::calibrateThreshold(double effectiveRadiusOverSpaci
                              " particle spacings to calibrate --threshold, got " + formatNumber(ratio) +
                              " spacings; give --threshold");
     }
+}
+
+} // namespace
+
+double cancellation_internal::calibrateThreshold(double effectiveRadiusOverSpacing, CancelPoll& poll)
+{
+    const double ratio = effectiveRadiusOverSpacing;
+    requireCalibratableRadius(ratio);
     // Lattice of unit spacing filling z ≤ 0; average φ over the plane z = 1/2 by sampling one
     // lattice cell on a regular grid.
     constexpr int kSamples = 16;
@@ -350,6 +362,27 @@ void requireLengthLimits(std::optional<double> effectiveRadius, std::optional<do
     }
 }
 
+/// The limits of the lengths that the spacing @a spacing sets where @a params gives none
+/// (r_e = 2 s, h = s/2), with the given ones; messages start "<@a spacingName>: " and name
+/// each derived length by its formula ("the voxel size 0.5 s = 5e-07 is below ...").
+void requireLengthLimitsFromSpacing(const SurfaceParameters& params, double spacing, const std::string& spacingName)
+{
+    const double radius = params.effectiveRadius.value_or(kDefaultRadiusOverSpacing * spacing);
+    const double voxelSize = params.voxelSize.value_or(kDefaultVoxelOverSpacing * spacing);
+    LengthNames names;
+    if (!params.effectiveRadius) names.radius = "the radius " + formatNumber(kDefaultRadiusOverSpacing) + " s =";
+    if (!params.voxelSize) names.voxelSize = "the voxel size " + formatNumber(kDefaultVoxelOverSpacing) + " s =";
+    try {
+        // A radius the spacing sets is checked against the maximum first (requireLengthLimits
+        // checks it last): with a given --voxel-size, the voxels-per-radius limit it may also
+        // break would otherwise be named instead of the cause, the spacing's size.
+        if (!params.effectiveRadius) requireRadiusBelowMaximum(radius, names);
+        requireLengthLimits(radius, voxelSize, names);
+    } catch (const ParameterError& e) {
+        throw ParameterError(spacingName + ": " + e.what());
+    }
+}
+
 } // namespace
 
 void checkParameters(const SurfaceParameters& params)
@@ -394,21 +427,11 @@ void checkParameters(const SurfaceParameters& params)
     // whatever the particles: checked now and said of --spacing. "--voxel-size 5e-07 is
     // below ..." named an option never given, and only once the input had been read.
     if (params.spacing && !(params.effectiveRadius && params.voxelSize)) {
-        const double spacing = *params.spacing;
-        const double radius = params.effectiveRadius.value_or(kDefaultRadiusOverSpacing * spacing);
-        const double voxelSize = params.voxelSize.value_or(kDefaultVoxelOverSpacing * spacing);
-        LengthNames names;
-        if (!params.effectiveRadius) names.radius = "the radius " + formatNumber(kDefaultRadiusOverSpacing) + " s =";
-        if (!params.voxelSize) names.voxelSize = "the voxel size " + formatNumber(kDefaultVoxelOverSpacing) + " s =";
-        try {
-            // A radius the spacing sets is checked against the maximum first (requireLengthLimits
-            // checks it last): with a given --voxel-size, the voxels-per-radius limit it may also
-            // break would otherwise be named instead of the cause, the spacing's size.
-            if (!params.effectiveRadius) requireRadiusBelowMaximum(radius, names);
-            requireLengthLimits(radius, voxelSize, names);
-        } catch (const ParameterError& e) {
-            throw ParameterError("--spacing " + formatNumber(spacing) + ": " + e.what());
-        }
+        requireLengthLimitsFromSpacing(params, *params.spacing, "--spacing " + formatNumber(*params.spacing));
+    }
+    // The threshold's calibration needs r_e/s within its range: known now when both are given.
+    if (params.spacing && params.effectiveRadius && !params.threshold) {
+        requireCalibratableRadius(*params.effectiveRadius / *params.spacing);
     }
 }
 
@@ -441,21 +464,12 @@ ResolvedParameters resolveParametersWith(const SurfaceParameters& params, const 
     out.effectiveRadius = params.effectiveRadius ? *params.effectiveRadius
                                                  : kDefaultRadiusOverSpacing * out.spacing;
     out.voxelSize = params.voxelSize ? *params.voxelSize : kDefaultVoxelOverSpacing * out.spacing;
-    // OpenVDB's smallest voxel, and index cell (kCellOverRadius·r_e).
-    using openvdb_scale_internal::requireOpenVdbScale;
-    requireOpenVdbScale(out.voxelSize, kMinCellSize, "--voxel-size");
-    requireOpenVdbScale(out.effectiveRadius, kMinCellSize / surface_stages_internal::kCellOverRadius, "--radius");
-    // The grid holds (2 r_e / h)³ voxels per particle: refuse sizes that would exhaust memory,
-    // before the threshold's calibration, whose cost grows as (r_e/s)³.
-    surface_stages_internal::requireVoxelsPerRadius(out.effectiveRadius, out.voxelSize);
-    if (out.voxelSize > out.effectiveRadius) {
-        // Name what the user gave: a derived voxel size (s/2) is not theirs to fix.
-        if (!out.voxelSizeGiven) {
-            throw ParameterError("--radius " + formatNumber(out.effectiveRadius) + " is smaller than the voxel size " +
-                                 formatNumber(out.voxelSize) + " (derived: half the particle spacing): at least one "
-                                 "voxel per radius");
-        }
-        requireVoxelWithinRadius(out.effectiveRadius, out.voxelSize);
+    // Lengths derived from an estimated spacing meet the limits that checkParameters() made of
+    // the given ones (and of those a given spacing sets), before the threshold's calibration,
+    // whose cost grows as (r_e/s)³. Said of the estimate: "--voxel-size 5e-10 is below ..."
+    // named an option never given.
+    if (!params.spacing && needSpacing && !(params.effectiveRadius && params.voxelSize)) {
+        requireLengthLimitsFromSpacing(params, out.spacing, "--spacing " + formatNumber(out.spacing) + " (estimated)");
     }
     out.method = params.method;
     const bool faithful = params.method == Method::Faithful;

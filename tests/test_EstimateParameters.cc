@@ -12,6 +12,7 @@
 
 #include <cmath>
 #include <limits>
+#include <sstream>
 
 using namespace nonbloppy;
 using nonbloppy_test::latticeParticles;
@@ -281,10 +282,10 @@ TEST(EstimateParameters, ResolveReportsWhatWasGivenAndChecksRanges)
     narrow.effectiveRadius = 0.001;
     expectMessage(narrow, "--spacing 0.05: the voxel size 0.5 s = 0.025 is too large for --radius 0.001: at least "
                           "one voxel per radius");
-    // The spacing estimated, the voxel size derived from it: the radius is named.
+    // The spacing estimated, the voxel size derived from it: named as such, with the estimate.
     narrow.spacing.reset();
-    expectMessage(narrow, "--radius 0.001 is smaller than the voxel size 0.0249191 (derived: half the particle "
-                          "spacing): at least one voxel per radius");
+    expectMessage(narrow, "--spacing 0.0498381 (estimated): the voxel size 0.5 s = 0.0249191 is too large for "
+                          "--radius 0.001: at least one voxel per radius");
     wide.voxelSize = 0.1;  // one voxel per radius: accepted
     EXPECT_NO_THROW(resolveParameters(wide, ball));
     bad.voxelSize = 2.0;
@@ -319,6 +320,36 @@ TEST(EstimateParameters, ResolveReportsWhatWasGivenAndChecksRanges)
     } catch (const ParameterError& e) {
         EXPECT_STREQ(e.what(), "no particles to mesh");
     }
+}
+
+TEST(EstimateParameters, LengthsDerivedFromTheEstimateAreNamedAsSuch)
+{
+    // Positions in metres of a fluid with 1 µm spacing: the voxel size s/2 is below OpenVDB's
+    // smallest. The message named "--voxel-size", an option never given.
+    const auto tiny = latticeParticles(1e-6, 6e-6, [](const openvdb::Vec3d& x) { return x.length() < 5e-6; });
+    const std::string message = nonbloppy_test::messageOf<ParameterError>(
+        [&] { resolveParameters(SurfaceParameters(), tiny); });
+    const double spacing = estimateSpacing(tiny);
+    EXPECT_NEAR(spacing, 1e-6, 0.01e-6);
+    const auto printed = [](double value) {  // as the messages print numbers
+        std::ostringstream out;
+        out << value;
+        return out.str();
+    };
+    EXPECT_EQ(message, "--spacing " + printed(spacing) + " (estimated): the voxel size 0.5 s = " +
+                           printed(0.5 * spacing) +
+                           " is below 1.5e-05, the smallest OpenVDB accepts: give the positions in a smaller unit");
+    // A given spacing and radius too far apart to calibrate the threshold: known without
+    // particles, so checkParameters() refuses them; a given threshold needs no calibration.
+    SurfaceParameters wide;
+    wide.spacing = 0.05;
+    wide.effectiveRadius = 1.65;
+    wide.voxelSize = 0.06;
+    EXPECT_EQ(nonbloppy_test::messageOf<ParameterError>([&] { checkParameters(wide); }),
+              "--radius must be at most 32 particle spacings to calibrate --threshold, got 33 spacings; give "
+              "--threshold");
+    wide.threshold = 1.0;
+    EXPECT_NO_THROW(checkParameters(wide));
 }
 
 TEST(EstimateParameters, EnumeratorsOutOfRangeAreRefused)

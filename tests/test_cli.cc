@@ -335,15 +335,23 @@ TEST_F(CliTest, BadParameters)
     expectUsageError(base + "--threshold 1e39",
                      "--threshold must be a positive number within float's range (the density grid's values), got "
                      "1e+39");
-    expectFailure(base + "--spacing 0.05 --radius 50 --voxel-size 2",
-                  "--radius must be at most 32 particle spacings to calibrate --threshold, got 1000 spacings; "
-                  "give --threshold");
-    // The spacing estimated (0.0498) through an index of cells r_e/2 = 0.0005 took 40 s.
+    // A given spacing and radius too far apart for the threshold's calibration: before the
+    // input too.
+    expectUsageError(base + "--spacing 0.05 --radius 50 --voxel-size 2",
+                     "--radius must be at most 32 particle spacings to calibrate --threshold, got 1000 spacings; "
+                     "give --threshold");
+    // Lengths derived from the estimated spacing (0.0498): refused once it is known, exit 1,
+    // the input and the estimate named. The radius 0.001 went through an index of cells
+    // r_e/2 = 0.0005, which took 40 s.
     expectFailure(base + "--radius 0.001",
-                  "--radius 0.001 is smaller than the voxel size 0.0249191 (derived: half the particle spacing): "
-                  "at least one voxel per radius");
+                  kCube + ": --spacing 0.0498381 (estimated): the voxel size 0.5 s = 0.0249191 is too large for "
+                  "--radius 0.001: at least one voxel per radius");
     expectFailure(base + "--voxel-size 64",
-                  "--voxel-size 64 is too large for --radius 0.0996763: at least one voxel per radius");
+                  kCube + ": --spacing 0.0498381 (estimated): --voxel-size 64 is too large for the radius 2 s = "
+                  "0.0996763: at least one voxel per radius");
+    expectFailure(base + "--radius 50 --voxel-size 2",
+                  kCube + ": --radius must be at most 32 particle spacings to calibrate --threshold, got 1003.25 "
+                  "spacings; give --threshold");
 }
 
 TEST_F(CliTest, NegativeValuesWithSpace)

@@ -321,10 +321,10 @@ TEST_F(CliSequenceTest, ParametersThatDoNotSuitAFrameFailThatFrame)
                                 "--radius, --threshold and --voxel-size";
     const RunResult r = meshSequence(dir() + "/out", "-q");
     EXPECT_EQ(r.exitCode, 1);
-    EXPECT_EQ(r.err, "nonbloppy: frame 2: " + message + "\n");
+    EXPECT_EQ(r.err, "nonbloppy: frame 2: " + in("fluid_0002.vtk") + ": " + message + "\n");
     const RunResult single = run("mesh " + quote(in("fluid_0002.vtk")) + " -o " + quote(out("one.obj")));
     EXPECT_EQ(single.exitCode, 1);
-    EXPECT_EQ(single.err, "nonbloppy: " + message + "\n");
+    EXPECT_EQ(single.err, "nonbloppy: " + in("fluid_0002.vtk") + ": " + message + "\n");
 }
 
 TEST_F(CliSequenceTest, KeepGoingListsFailedFrames)

@@ -190,9 +190,10 @@ struct ResolvedParameters
 /// Check what @a params fixes without looking at particles: each value's range (r_0 also
 /// within float's, the density grid's type), and where the lengths are given or set by a
 /// given spacing (r_e = 2 s, h = s/2), the limits between them (r_e and h at least OpenVDB's
-/// smallest cell, r_e/h in [1, kMaxVoxelsPerRadius], r_e ≤ 1e18). resolveParameters() makes
-/// the same checks first; the command line calls this before reading a file, so a mistake
-/// costs nothing. Cost: O(1).
+/// smallest cell, r_e/h in [1, kMaxVoxelsPerRadius], r_e ≤ 1e18), and r_e/s within the
+/// threshold calibration's (1/2, kMaxCalibratedRadiusOverSpacing] when s and r_e are given
+/// and r_0 is not. resolveParameters() makes the same checks first; the command line calls
+/// this before reading a file, so a mistake costs nothing. Cost: O(1).
 /// @throw ParameterError naming the parameter, as resolveParameters(); a length set by the
 ///        spacing is named as such: "--spacing 1e-06: the voxel size 0.5 s = 5e-07 is below
 ///        1.5e-05, the smallest OpenVDB accepts: give the positions in a smaller unit".
@@ -201,7 +202,10 @@ NONBLOPPY_API void checkParameters(const SurfaceParameters& params);
 /// Check @a params and fill in what is missing. @a positions is only read when the spacing
 /// must be estimated (spacing unset and effectiveRadius, threshold or voxelSize unset).
 /// @throw ParameterError naming the parameter, e.g. "--blend must lie in [0,1], got 1.5"
-///        (parameters are named by their command-line spelling).
+///        (parameters are named by their command-line spelling); a length derived from an
+///        estimated spacing is named as such: "--spacing 1e-09 (estimated): the voxel size
+///        0.5 s = 5e-10 is below 1.5e-05, the smallest OpenVDB accepts: give the positions in
+///        a smaller unit".
 /// Cost: that of estimateSpacing() when it is needed, plus the threshold calibration
 /// (~10 ms, not interruptible), else O(1).
 /// @param params       what the user gave

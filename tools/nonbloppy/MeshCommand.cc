@@ -613,9 +613,16 @@ MeshedFrame meshFrameSurface(const MeshOptions& o, ProgressInterrupter& interrup
 
     // The particles are handed over, unless --attributes or --vdb-points still need them.
     const bool keepParticles = o.outputs.needParticles();
-    frame.result = nonbloppy::buildSurface(
-        keepParticles ? std::vector<openvdb::Vec3f>(frame.particles.positions) : std::move(frame.particles.positions),
-        params, &interrupter);
+    try {
+        frame.result = nonbloppy::buildSurface(
+            keepParticles ? std::vector<openvdb::Vec3f>(frame.particles.positions) : std::move(frame.particles.positions),
+            params, &interrupter);
+    } catch (const nonbloppy::ParameterError& e) {
+        // validate() has checked every parameter that needs no particles: what is left comes
+        // of this input (a spacing that cannot be estimated, lengths derived from it out of
+        // range), and the message names it.
+        throw nonbloppy::ParameterError(o.input + ": " + e.what());
+    }
     if (!keepParticles) frame.particles = nonbloppy::ParticleSet();
     throwIfInterrupted();
     if (!o.outputs.attributes.empty()) {
