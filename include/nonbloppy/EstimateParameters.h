@@ -153,10 +153,12 @@ struct SurfaceParameters
     /// surface has the same polygons and vertices whatever the value (only their order changes);
     /// the value trades cancel latency against speed, since OpenVDB's volumeToMesh cannot
     /// be stopped inside a region. On the 64x benchmark input (1.56M particles, two
-    /// cores, no --vdb), extraction wall time / process peak: 1024 leaves 1.03-1.14 s /
-    /// 272-282 MB (longest region 34-41 ms), 4096 leaves 0.98-1.21 s / 291 MB, 16384
-    /// leaves 0.98-1.10 s / 380 MB, whole grid 0.68-0.80 s / 435-444 MB (one call that
-    /// cannot be stopped). Scratch memory grows with the region.
+    /// cores, no --vdb, 2026-12-05 at fca7043), extraction wall time / process peak,
+    /// medians of 3-5 alternating runs: 1024 leaves 0.61-0.63 s / 313-321 MB (longest
+    /// region 34-41 ms when measured at 2b7aabc), 2048 leaves 0.63 s / 319 MB, 4096 leaves
+    /// 0.64 s / 355 MB, 16384 leaves 0.63-0.64 s / 480 MB, whole grid 0.56 s / 446-483 MB
+    /// (one call that cannot be stopped). Scratch memory grows with the region; at one
+    /// thread 1024, 2048 and 4096 leaves took 1.10-1.27 s alike.
     size_t regionLeaves = kDefaultRegionLeaves;
 };
 
