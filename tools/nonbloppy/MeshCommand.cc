@@ -1137,7 +1137,8 @@ Command setupMeshCommand(CLI::App& parent)
         "Polygon merging in flat regions, in [0,1] (default: 0)")->group(kGroupAdvanced);
     o.regionLeavesOpt = cmd->add_option("--region-leaves", o.regionLeaves,
         "Density leaves per extraction region: smaller takes less memory and answers Ctrl-C "
-        "sooner, larger is faster; 0: the whole grid at once; the same surface either way, its vertices in another order "
+        "sooner; 0: the whole grid at once, about 10% faster to extract and uninterruptible; the same surface either way, "
+        "its vertices in another order "
         "(default: " + std::to_string(nonbloppy::kDefaultRegionLeaves) + ")")->group(kGroupAdvanced);
     o.threadsOpt = cmd->add_option("--threads", o.threads,
         "Worker threads (default: all cores); results do not depend on it")
