@@ -315,8 +315,6 @@ TEST_F(CliTest, BadParameters)
     expectUsageError(base + "--radius 2e18 --voxel-size 1e18",
                      "--radius 2e+18 is too large: at most 1e+18 (lengths are squared in single precision); give the "
                      "positions in a larger unit");
-    // Judged against the particles (their spacing, given or estimated): exit 1.
-    // Refused before r_0 is calibrated over a kernel 1000 spacings wide (hours).
     // Lengths a given spacing sets (r_e = 2 s, h = s/2): before the input too, named so.
     expectUsageError(base + "--spacing 0.05 --radius 50",
                      "--spacing 0.05: the voxel size 0.5 s = 0.025 is too small for --radius 50: at most 32 voxels "
@@ -335,14 +333,14 @@ TEST_F(CliTest, BadParameters)
     expectUsageError(base + "--threshold 1e39",
                      "--threshold must be a positive number within float's range (the density grid's values), got "
                      "1e+39");
-    // A given spacing and radius too far apart for the threshold's calibration: before the
-    // input too.
+    // A given spacing and radius too far apart for the threshold's calibration (over a
+    // kernel 1000 spacings wide it would take hours): before the input too.
     expectUsageError(base + "--spacing 0.05 --radius 50 --voxel-size 2",
                      "--radius must be at most 32 particle spacings to calibrate --threshold, got 1000 spacings; "
                      "give --threshold");
     // Lengths derived from the estimated spacing (0.0498): refused once it is known, exit 1,
-    // the input and the estimate named. The radius 0.001 went through an index of cells
-    // r_e/2 = 0.0005, which took 40 s.
+    // the input and the estimate named. (Unchecked, --radius 0.001 estimated the spacing
+    // through an index of cells r_e/2 = 0.0005, which took 40 s.)
     expectFailure(base + "--radius 0.001",
                   kCube + ": --spacing 0.0498381 (estimated): the voxel size 0.5 s = 0.0249191 is too large for "
                   "--radius 0.001: at least one voxel per radius");
