@@ -10,7 +10,6 @@
 #include <nonbloppy/ReadParticles.h>
 #include <nonbloppy/WriteParticles.h>
 
-#include <cctype>
 #include <filesystem>
 #include <iostream>
 #include <memory>

@@ -21,12 +21,10 @@
 #include <openvdb/tools/Count.h>
 
 #include <algorithm>
-#include <cctype>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
-#include <filesystem>
 #include <iostream>
 #include <limits>
 #include <memory>
