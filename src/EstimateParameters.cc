@@ -468,7 +468,7 @@ ResolvedParameters resolveParametersWith(const SurfaceParameters& params, const 
     // the given ones (and of those a given spacing sets), before the threshold's calibration,
     // whose cost grows as (r_e/s)³. Said of the estimate: "--voxel-size 5e-10 is below ..."
     // named an option never given.
-    if (!params.spacing && needSpacing && !(params.effectiveRadius && params.voxelSize)) {
+    if (!params.spacing && !(params.effectiveRadius && params.voxelSize)) {
         requireLengthLimitsFromSpacing(params, out.spacing, "--spacing " + formatNumber(out.spacing) + " (estimated)");
     }
     out.method = params.method;
