@@ -83,6 +83,28 @@ private:
     std::atomic<bool> mStopped{false};
 };
 
+/// Announces one stage to an optional interrupter: start(stage) on construction, end() on
+/// destruction, also when the stage throws (a start() without its end() leaves a caller's
+/// progress display in the stage). Cost: two virtual calls.
+class AnnouncedStage
+{
+public:
+    /// @param interrupter  may be null (then nothing is announced)
+    AnnouncedStage(openvdb::util::NullInterrupter* interrupter, const char* stage) : mInterrupter(interrupter)
+    {
+        if (mInterrupter) mInterrupter->start(stage);
+    }
+    ~AnnouncedStage()
+    {
+        if (mInterrupter) mInterrupter->end();
+    }
+    AnnouncedStage(const AnnouncedStage&) = delete;
+    AnnouncedStage& operator=(const AnnouncedStage&) = delete;
+
+private:
+    openvdb::util::NullInterrupter* mInterrupter;
+};
+
 /// computeNormals() reporting a stop under @a poll's stage (preserveVolume() calls it inside
 /// "correct surface"). Defined in ComputeNormals.cc.
 /// @throw CancelledError("interrupted during <poll's stage>")

@@ -2,6 +2,7 @@
 /// @file InterpolateAttributes.cc
 /// @brief Kernel-weighted particle attributes at mesh vertices, through the particle index.
 
+#include "Cancellation.h"
 #include "ParameterChecks.h"
 #include "ParticleIndexImpl.h"
 
@@ -12,7 +13,6 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
-#include <atomic>
 #include <cmath>
 #include <sstream>
 
@@ -59,16 +59,11 @@ struct InterpolateOp
     std::vector<MeshAttribute>& out;
     int totalComponents;
     float effectiveRadius;
-    openvdb::util::NullInterrupter* interrupter;
-    std::atomic<bool>& cancelled;
+    cancellation_internal::CancelPoll& poll;
 
     void operator()(const tbb::blocked_range<size_t>& range) const
     {
-        if (cancelled.load(std::memory_order_relaxed)) return;
-        if (interrupter && interrupter->wasInterrupted()) {
-            cancelled = true;
-            return;
-        }
+        if (poll.stopped()) return;
         openvdb::tree::ValueAccessor<const particle_index_internal::IndexTree> accessor(index.grid->tree());
         const std::vector<openvdb::Vec3f>& positions = index.sortedPositions;
         std::vector<double> sums(static_cast<size_t>(totalComponents));
@@ -111,59 +106,53 @@ interpolateAttributes(SurfaceMesh& mesh, const ParticleSet& particles,
 {
     parameter_checks_internal::requirePositive(effectiveRadius, "--radius");
     const std::vector<std::string> resolved = resolveAttributeNames(particles, names);
-    if (resolved.empty() || mesh.points.empty()) {
-        for (const std::string& name : resolved) {
-            const ParticleAttribute* attribute = particles.findAttribute(name);
-            MeshAttribute empty;
-            empty.name = name;
-            empty.components = attribute->components;
-            empty.values.assign(mesh.points.size() * size_t(attribute->components), 0.0f);
-            mesh.attributes.push_back(std::move(empty));
-        }
-        return;
-    }
-    if (interrupter) interrupter->start("interpolate attributes");
-
-    // The index sorts the particles into cells of r_e: a vertex's support spans 3³ cells.
-    const ParticleIndex particleIndex = ParticleIndex::build(particles.positions, effectiveRadius);
-    const ParticleIndex::Impl& index = particleIndex.impl();
-    std::vector<SortedAttribute> sorted(resolved.size());
-    int totalComponents = 0;
-    for (size_t a = 0; a < resolved.size(); ++a) {
-        const ParticleAttribute& attribute = *particles.findAttribute(resolved[a]);
+    // Every check before start(), so that a start() is always followed by its end().
+    std::vector<const ParticleAttribute*> attributes;
+    for (const std::string& name : resolved) {
+        const ParticleAttribute& attribute = *particles.findAttribute(name);
         if (attribute.size() != particles.size()) {
             throw ParameterError("attribute '" + attribute.name + "' has " +
                                  std::to_string(attribute.size()) + " values for " +
                                  std::to_string(particles.size()) + " particles");
         }
-        sorted[a].name = attribute.name;
-        sorted[a].components = attribute.components;
-        sorted[a].values.resize(particles.size() * size_t(attribute.components));
-        totalComponents += attribute.components;
-        const std::vector<uint32_t>& original = index.originalIndex;
-        tbb::parallel_for(tbb::blocked_range<size_t>(0, original.size()),
-            [&](const tbb::blocked_range<size_t>& range) {
-                for (size_t k = range.begin(); k < range.end(); ++k) {
-                    for (int c = 0; c < attribute.components; ++c) {
-                        sorted[a].values[k * size_t(attribute.components) + size_t(c)] =
-                            attribute.asDouble(original[k], c);
-                    }
-                }
-            });
+        attributes.push_back(&attribute);
     }
 
-    std::vector<MeshAttribute> out(sorted.size());
-    for (size_t a = 0; a < sorted.size(); ++a) {
-        out[a].name = sorted[a].name;
-        out[a].components = sorted[a].components;
-        out[a].values.resize(mesh.points.size() * size_t(sorted[a].components));
+    std::vector<MeshAttribute> out(attributes.size());
+    for (size_t a = 0; a < attributes.size(); ++a) {
+        out[a].name = attributes[a]->name;
+        out[a].components = attributes[a]->components;
+        out[a].values.resize(mesh.points.size() * size_t(attributes[a]->components));  // zeros
     }
-    std::atomic<bool> cancelled{false};
-    const InterpolateOp op{mesh, index, sorted, out, totalComponents, float(effectiveRadius),
-                           interrupter, cancelled};
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, mesh.points.size(), 256), op);
-    if (interrupter) interrupter->end();
-    if (cancelled) throw CancelledError("interrupted while interpolating attributes");
+    if (!attributes.empty() && !mesh.points.empty()) {
+        const cancellation_internal::AnnouncedStage announced(interrupter, "interpolate attributes");
+        cancellation_internal::CancelPoll poll(interrupter, "interpolate attributes");
+        // The index sorts the particles into cells of r_e: a vertex's support spans 3³ cells.
+        const ParticleIndex particleIndex = ParticleIndex::build(particles.positions, effectiveRadius);
+        const ParticleIndex::Impl& index = particleIndex.impl();
+        std::vector<SortedAttribute> sorted(attributes.size());
+        int totalComponents = 0;
+        for (size_t a = 0; a < attributes.size(); ++a) {
+            const ParticleAttribute& attribute = *attributes[a];
+            sorted[a].name = attribute.name;
+            sorted[a].components = attribute.components;
+            sorted[a].values.resize(particles.size() * size_t(attribute.components));
+            totalComponents += attribute.components;
+            const std::vector<uint32_t>& original = index.originalIndex;
+            tbb::parallel_for(tbb::blocked_range<size_t>(0, original.size()),
+                [&](const tbb::blocked_range<size_t>& range) {
+                    for (size_t k = range.begin(); k < range.end(); ++k) {
+                        for (int c = 0; c < attribute.components; ++c) {
+                            sorted[a].values[k * size_t(attribute.components) + size_t(c)] =
+                                attribute.asDouble(original[k], c);
+                        }
+                    }
+                });
+        }
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, mesh.points.size(), 256),
+            InterpolateOp{mesh, index, sorted, out, totalComponents, float(effectiveRadius), poll});
+        poll.throwIfStopped();
+    }
 
     for (MeshAttribute& attribute : out) {
         auto same = std::find_if(mesh.attributes.begin(), mesh.attributes.end(),

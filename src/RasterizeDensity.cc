@@ -384,7 +384,7 @@ openvdb::FloatGrid::Ptr instruction_set_internal::rasterizeDensity(const Particl
     surface_stages_internal::requireVoxelsPerRadius(settings.effectiveRadius, voxelSize);
     particle_index_internal::requireCellsPerRadius(particles, settings.effectiveRadius);
 
-    if (interrupter) interrupter->start("rasterize density");
+    const cancellation_internal::AnnouncedStage announced(interrupter, "rasterize density");
     CancelPoll poll(interrupter, "rasterize density");
     const std::vector<openvdb::Coord> origins =
         candidateLeafOrigins(particles, *transform, settings.effectiveRadius, poll);
@@ -410,7 +410,6 @@ openvdb::FloatGrid::Ptr instruction_set_internal::rasterizeDensity(const Particl
         }
         if (results[n]) tree.addLeaf(results[n]);
     }
-    if (interrupter) interrupter->end();
     poll.throwIfStopped();
     return grid;
 }

@@ -494,27 +494,21 @@ void instruction_set_internal::relaxVertices(SurfaceMesh& mesh, const ParticleIn
     particle_index_internal::requireCellsPerRadius(particles, settings.effectiveRadius);
     if (settings.iterations == 0 || settings.blend == 0.0 || mesh.points.empty()) return;
 
-    if (interrupter) interrupter->start("relax vertices");
+    const cancellation_internal::AnnouncedStage announced(interrupter, "relax vertices");
     CancelPoll poll(interrupter, "relax vertices");
     const bool avx2 = instruction_set_internal::useAvx2(set);
-    try {
-        UnwrittenVector<uint32_t> order;
-        std::vector<size_t> groupStart;
-        // Grouped once: each step bounds a group by its vertices' current box, so its
-        // candidate lists stay exact however the vertices move, and as a step moves a vertex
-        // less than r_e (towards its particles) the groups stay compact.
-        groupVerticesByCell(mesh.points, kGroupCells * particles.cellSize(), order, groupStart, poll);
-        std::atomic<size_t> groupsDone{0};
-        tbb::parallel_for(tbb::blocked_range<size_t>(0, groupStart.size() - 1, 64),
-            RelaxGroupsOp{particles, order, groupStart, mesh.points, settings.iterations,
-                          float(settings.effectiveRadius), float(settings.blend), float(settings.maxStep), poll,
-                          groupsDone, avx2});
-        poll.throwIfStopped();
-    } catch (...) {
-        if (interrupter) interrupter->end();
-        throw;
-    }
-    if (interrupter) interrupter->end();
+    UnwrittenVector<uint32_t> order;
+    std::vector<size_t> groupStart;
+    // Grouped once: each step bounds a group by its vertices' current box, so its candidate
+    // lists stay exact however the vertices move, and as a step moves a vertex less than r_e
+    // (towards its particles) the groups stay compact.
+    groupVerticesByCell(mesh.points, kGroupCells * particles.cellSize(), order, groupStart, poll);
+    std::atomic<size_t> groupsDone{0};
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, groupStart.size() - 1, 64),
+        RelaxGroupsOp{particles, order, groupStart, mesh.points, settings.iterations,
+                      float(settings.effectiveRadius), float(settings.blend), float(settings.maxStep), poll,
+                      groupsDone, avx2});
+    poll.throwIfStopped();
 }
 
 } // namespace nonbloppy

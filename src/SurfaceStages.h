@@ -7,6 +7,8 @@
 #ifndef NONBLOPPY_SURFACE_STAGES_H
 #define NONBLOPPY_SURFACE_STAGES_H
 
+#include "Cancellation.h"
+
 #include <nonbloppy/BuildSurface.h>
 #include <nonbloppy/CorrectSurface.h>
 #include <nonbloppy/ParticleIndex.h>
@@ -51,20 +53,11 @@ class StageScope
 {
 public:
     StageScope(StageTimings& timings, openvdb::util::NullInterrupter* interrupter, const char* stage)
-        : mTimer(timings, stage), mInterrupter(interrupter)
-    {
-        if (mInterrupter) mInterrupter->start(stage);
-    }
-    ~StageScope()
-    {
-        if (mInterrupter) mInterrupter->end();
-    }
-    StageScope(const StageScope&) = delete;
-    StageScope& operator=(const StageScope&) = delete;
+        : mTimer(timings, stage), mAnnounced(interrupter, stage) {}
 
 private:
-    ScopedStageTimer mTimer;
-    openvdb::util::NullInterrupter* mInterrupter;
+    ScopedStageTimer mTimer;  // destroyed last: the time includes end()
+    cancellation_internal::AnnouncedStage mAnnounced;
 };
 
 /// The stages "estimate parameters" and "index particles", timed in result.timings and

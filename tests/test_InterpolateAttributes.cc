@@ -18,6 +18,7 @@
 
 #include <cstdlib>
 #include <cstring>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -165,6 +166,76 @@ TEST(InterpolateAttributes, NamesAndErrors)
         EXPECT_STREQ(e.what(), "unknown attribute 'velocity'; the particles have no attributes");
     }
     EXPECT_THROW(interpolateAttributes(fx.mesh, fx.particles, {"c"}, 0.0), ParameterError);
+}
+
+/// Counts start() and end() calls; says stop from the start of the stage when @a stop.
+struct CountingInterrupter : openvdb::util::NullInterrupter
+{
+    explicit CountingInterrupter(bool stopInStage) : stop(stopInStage) {}
+    void start(const char* name) override
+    {
+        ++starts;
+        stage = name ? name : "";
+    }
+    void end() override { ++ends; }
+    bool wasInterrupted(int = -1) override { return stop && starts > 0; }
+    bool stop;
+    int starts = 0, ends = 0;
+    std::string stage;
+};
+
+TEST(InterpolateAttributes, AStopOrAnErrorEndsTheAnnouncedStage)
+{
+    Fixture fx;
+    CountingInterrupter stopping(true);
+    try {
+        interpolateAttributes(fx.mesh, fx.particles, {"c"}, fx.radius, &stopping);
+        FAIL() << "no exception";
+    } catch (const CancelledError& e) {
+        EXPECT_STREQ(e.what(), "interrupted during interpolate attributes");
+    }
+    EXPECT_EQ(stopping.stage, "interpolate attributes");
+    EXPECT_EQ(stopping.starts, 1);
+    EXPECT_EQ(stopping.ends, 1);
+    EXPECT_TRUE(fx.mesh.attributes.empty()) << "a stop leaves the mesh as it was";
+
+    // Refused while indexing the particles, after the stage began: it still ends.
+    ParticleSet far = fx.particles;
+    far.positions[7] = openvdb::Vec3f(std::numeric_limits<float>::quiet_NaN(), 0.0f, 0.0f);
+    CountingInterrupter counting(false);
+    EXPECT_EQ(nonbloppy_test::messageOf<ParameterError>(
+                  [&] { interpolateAttributes(fx.mesh, far, {"c"}, fx.radius, &counting); }),
+              "non-finite position of particle 7");
+    EXPECT_EQ(counting.starts, 1);
+    EXPECT_EQ(counting.ends, 1);
+
+    // Refused before the stage begins: nothing announced.
+    ParticleSet shortAttribute = fx.particles;
+    shortAttribute.attributes[0].bytes.resize(sizeof(float));
+    EXPECT_EQ(nonbloppy_test::messageOf<ParameterError>(
+                  [&] { interpolateAttributes(fx.mesh, shortAttribute, {"c"}, fx.radius, &counting); }),
+              "attribute 'c' has 1 values for " + std::to_string(fx.particles.size()) + " particles");
+    EXPECT_EQ(counting.starts, 1);
+    EXPECT_EQ(counting.ends, 1);
+}
+
+TEST(InterpolateAttributes, AnAttributeOfTheSameNameIsReplacedEvenWithoutVertices)
+{
+    Fixture fx;
+    SurfaceMesh empty;
+    interpolateAttributes(empty, fx.particles, {"c", "f"}, fx.radius);
+    interpolateAttributes(empty, fx.particles, {"c"}, fx.radius);  // used to append a second "c"
+    ASSERT_EQ(empty.attributes.size(), 2u);
+    EXPECT_EQ(empty.attributes[0].name, "c");
+    EXPECT_EQ(empty.attributes[1].name, "f");
+    EXPECT_EQ(empty.attributes[1].components, 3);
+    EXPECT_TRUE(empty.attributes[0].values.empty());
+
+    interpolateAttributes(fx.mesh, fx.particles, {"c"}, fx.radius);
+    interpolateAttributes(fx.mesh, fx.particles, {"c", "id"}, fx.radius);
+    ASSERT_EQ(fx.mesh.attributes.size(), 2u);
+    EXPECT_EQ(fx.mesh.attributes[0].name, "c");
+    EXPECT_EQ(fx.mesh.attributes[1].name, "id");
 }
 
 TEST(InterpolateAttributes, WrittenAsPlyPropertiesAndVtkPointData)

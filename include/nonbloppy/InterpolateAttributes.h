@@ -38,11 +38,22 @@ NONBLOPPY_API std::vector<std::string> resolveAttributeNames(const ParticleSet& 
 /// with the MPS weight w of Kernel.h over r_e = @a effectiveRadius, the same weights as the
 /// relaxation's weighted mean t_i. A vertex with no particle within r_e gets 0. Values are
 /// converted to float; every component is interpolated independently. An attribute already
-/// on the mesh under the same name is replaced.
-/// Cost: V · (particles within r_e) kernel evaluations, parallel over vertices; sums run in
-/// a fixed order in double, so the result does not depend on the thread count.
-/// @throw ParameterError for r_e ≤ 0, an unknown name, or an attribute whose size differs
-///        from the particle count; CancelledError when @a interrupter says so.
+/// on the mesh under the same name is replaced (also on a mesh without vertices).
+/// Cost: a ParticleIndex of the particles with cells of r_e (O(N), not interruptible), then
+/// V · (particles within r_e) kernel evaluations, parallel over vertices; sums run in a
+/// fixed order in double, so the result does not depend on the thread count.
+/// @param mesh         vertices to sample at; gets (or has replaced) one attribute per name
+/// @param particles    positions and attributes, world units; only read
+/// @param names        attribute names, as resolveAttributeNames() takes them ("all" for every one)
+/// @param effectiveRadius  r_e, world units, as the relaxation's
+/// @param interrupter  optional; start("interpolate attributes") … end() around the work
+///                     (not for an empty mesh or no names), wasInterrupted() before each
+///                     block of 256 vertices
+/// @throw ParameterError for r_e ≤ 0 or not finite, an unknown name, an attribute whose
+///        size differs from the particle count, or particles ParticleIndex::build() refuses
+///        (r_e below kMinCellSize, a non-finite position, coordinates too far from the
+///        origin); CancelledError("interrupted during interpolate attributes") when
+///        @a interrupter says so.
 NONBLOPPY_API void interpolateAttributes(SurfaceMesh& mesh, const ParticleSet& particles,
                            const std::vector<std::string>& names, double effectiveRadius,
                            openvdb::util::NullInterrupter* interrupter = nullptr);
