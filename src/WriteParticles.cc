@@ -103,18 +103,19 @@ namesForExtension(const ParticleSet& particles, const std::string& ext)
     return std::vector<std::string>(particles.attributes.size());
 }
 
+/// @throw ParameterError naming the first attribute that does not hold one value of at
+///        least one component per particle, followed by @a suffix (" (path)" or "").
 void
-requireSizes(const ParticleSet& particles, const std::string& path)
+requireSizes(const ParticleSet& particles, const std::string& suffix)
 {
     for (const ParticleAttribute& a : particles.attributes) {
         if (a.components < 1) {
             throw ParameterError("attribute '" + a.name + "' has " + std::to_string(a.components) +
-                                 " components, at least 1 needed (" + path + ")");
+                                 " components, at least 1 needed" + suffix);
         }
         if (a.size() != particles.size()
             || a.bytes.size() != particles.size() * size_t(a.components) * scalarSize(a.type)) {
-            throw ParameterError("attribute '" + a.name + "' does not hold one value per particle (" +
-                                 path + ")");
+            throw ParameterError("attribute '" + a.name + "' does not hold one value per particle" + suffix);
         }
     }
 }
@@ -454,11 +455,10 @@ pointDataGridOfFinitePositions(const ParticleSet& particles, double voxelSize)
     const std::vector<std::string> names = namesForExtension(particles, ".vdb");
     for (size_t i = 0; i < particles.attributes.size(); ++i) {
         const ParticleAttribute& a = particles.attributes[i];
-        if (a.size() != particles.size()) continue;
         if (a.components == 3) {
             if (a.type == ScalarType::Float32) addVectorAttribute<openvdb::Vec3f>(*grid, *index, a, names[i]);
             else if (a.type == ScalarType::Float64) addVectorAttribute<openvdb::Vec3d>(*grid, *index, a, names[i]);
-            // Integers up to 32 bits as vec3i; wider ones (int64, uint32, uint64) as vec3d,
+            // int8 to int32, uint8 and uint16 as vec3i; uint32, int64 and uint64 as vec3d,
             // exact to 2^53, where vec3i wrapped 4e9 and 2^40 to -2147483648.
             else if (a.type == ScalarType::Int64 || a.type == ScalarType::UInt32 || a.type == ScalarType::UInt64) {
                 addVectorAttribute<openvdb::Vec3d>(*grid, *index, a, names[i]);
@@ -492,6 +492,7 @@ pointDataGridOfFinitePositions(const ParticleSet& particles, double voxelSize)
 openvdb::GridBase::Ptr
 makePointDataGrid(const ParticleSet& particles, double voxelSize)
 {
+    requireSizes(particles, "");
     requirePlaceablePositions(particles, "");
     return pointDataGridOfFinitePositions(particles, voxelSize);
 }
@@ -500,7 +501,7 @@ void
 writeParticles(const ParticleSet& particles, const std::string& path, const ParticleWriteSettings& settings)
 {
     const std::string ext = requireParticleOutput(path);
-    requireSizes(particles, path);
+    requireSizes(particles, " (" + path + ")");
     if (ext == ".vdb") {
         requirePlaceablePositions(particles, " (" + path + ")");
         openvdb::MetaMap metadata;

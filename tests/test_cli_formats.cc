@@ -532,4 +532,7 @@ TEST_F(CliFormatsTest, AttributesOfTheWrongShapeAreNamedAndNothingIsWritten)
     particles.attributes[0].bytes.resize(4);  // one float for two particles
     EXPECT_EQ(message(), "attribute 'speed' does not hold one value per particle (" + file + ")");
     EXPECT_FALSE(std::filesystem::exists(file));
+    // The in-memory grid refuses it too (it used to leave the attribute out silently).
+    EXPECT_EQ(nonbloppy_test::messageOf<nonbloppy::ParameterError>([&] { nonbloppy::makePointDataGrid(particles); }),
+              "attribute 'speed' does not hold one value per particle");
 }

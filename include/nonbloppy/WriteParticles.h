@@ -72,13 +72,15 @@ NONBLOPPY_API void requireParticleOutputFile(const std::string& path);
 
 /// The particles as an openvdb::points::PointDataGrid named "points": position `P`
 /// (world positions, NullCodec) and every attribute in the nearest OpenVDB type (3
-/// components become vec3s, vec3d, vec3i for integers of up to 32 bits, vec3d for wider
-/// ones; scalar unsigned integers widen to the next signed type, uint64 to int64; other
-/// component counts become one scalar attribute per component, "name_<c>"). The grid
+/// components become vec3s, vec3d, vec3i for int8 to int32, uint8 and uint16, vec3d for
+/// uint32, int64 and uint64; scalar unsigned integers widen to the next signed type,
+/// uint64 to int64; other component counts become one scalar attribute per component,
+/// "name_<c>"). The grid
 /// holds the particles in voxel order: readParticles() gives them back in that order.
 /// @a voxelSize ≤ 0 picks one with about 8 points per voxel (points::computeVoxelSize).
 /// @throw ParameterError for an infinite @a voxelSize or one below kMinCellSize, a uint64
-///        value above 2^63 - 1, or a non-finite position (as writeParticles()).
+///        value above 2^63 - 1, a non-finite position, or an attribute that does not hold
+///        one value per particle (as writeParticles(), without the path).
 /// Returned as GridBase so this header stays light (cast with
 /// openvdb::gridPtrCast<openvdb::points::PointDataGrid>).
 NONBLOPPY_API openvdb::GridBase::Ptr makePointDataGrid(const ParticleSet& particles, double voxelSize = 0.0);
