@@ -41,8 +41,10 @@ constexpr size_t kSpacingSamples = 8192;
 /// @param interrupter  optional; asked every 4096 particles of the bounding box, as in
 ///                     ParticleIndex::build() while bucketing, and every 16 samples of each
 ///                     parallel search task; no start()/end()
-/// @throw ParameterError with fewer than two particles, or when the median is 0
-///        (half the particles sit on top of another one);
+/// @throw ParameterError with fewer than two particles, a non-finite position ("non-finite
+///        position of particle N"), all particles at one position, a median of 0 (half the
+///        particles sit on top of another one), or no neighbour found within 2⁴⁰ times the
+///        first guess ("cannot estimate the particle spacing; give --spacing");
 ///        CancelledError("interrupted during estimate parameters") when @a interrupter says stop.
 NONBLOPPY_API double estimateSpacing(const std::vector<openvdb::Vec3f>& positions,
                                      size_t maxSamples = kSpacingSamples,
@@ -110,16 +112,19 @@ struct SurfaceParameters
 {
     std::optional<double> spacing;          ///< s; default: estimateSpacing()
     std::optional<double> effectiveRadius;  ///< r_e; default: 2 s
-    /// r_0 (dimensionless); default: calibrateRelaxedThreshold(r_e/s, c, t) (Faithful) or
+    /// r_0 (dimensionless); default: calibrateRelaxedThreshold(r_e/s, c, t, nullptr,
+    /// maxStep/s) (Faithful: calibrated for the capped steps the mesh takes) or
     /// calibrateThreshold(r_e/s) (Paper)
     std::optional<double> threshold;
     std::optional<double> voxelSize;        ///< h; default: s / 2
     double blend = kDefaultBlend;           ///< c in [0,1]
     int iterations = kDefaultIterations;    ///< t ≥ 0
     double adaptivity = kDefaultAdaptivity; ///< in [0,1]
-    /// Return the exact density grid in SurfaceResult::density. false lets buildSurface()
-    /// replace leaves deep inside the fluid by tiles before extraction and return no grid:
-    /// the same mesh, bit for bit, with less memory and a faster extraction.
+    /// Return the exact density grid in SurfaceResult::density. false lets the extraction
+    /// free the grid's leaves as its regions pass (adaptivity 0 and regionLeaves > 0), and
+    /// SurfaceResult::density is then null: the same mesh, bit for bit, with a lower peak
+    /// memory (64x benchmark input, `mesh` without and with `--vdb`: peak RSS 313 against
+    /// 394 MiB).
     bool keepDensity = true;
     Method method = Method::Faithful;       ///< Paper: the plain method; see Method
     /// Faithful only: cap on how far one relaxation step moves a vertex, world units
@@ -202,14 +207,17 @@ struct ResolvedParameters
 NONBLOPPY_API void checkParameters(const SurfaceParameters& params);
 
 /// Check @a params and fill in what is missing. @a positions is only read when the spacing
-/// must be estimated (spacing unset and effectiveRadius, threshold or voxelSize unset).
+/// must be estimated: spacing unset and effectiveRadius, threshold or voxelSize unset, or
+/// (Faithful) preserveVolume or smoothSurface on, which need s for the volume N·s³ and the
+/// smoothing's width. Empty @a positions throw ParameterError("no particles to mesh").
 /// @throw ParameterError naming the parameter, e.g. "--blend must lie in [0,1], got 1.5"
 ///        (parameters are named by their command-line spelling); a length derived from an
 ///        estimated spacing is named as such: "--spacing 1e-09 (estimated): the voxel size
 ///        0.5 s = 5e-10 is below 1.5e-05, the smallest OpenVDB accepts: give the positions in
 ///        a smaller unit".
-/// Cost: that of estimateSpacing() when it is needed, plus the threshold calibration
-/// (~10 ms, not interruptible), else O(1).
+/// Cost: that of estimateSpacing() when it is needed, plus the threshold calibration (a few
+/// ms at r_e = 2 s, growing as (r_e/s)³ and with t; it asks @a interrupter before every
+/// sample), else O(1).
 /// @param params       what the user gave
 /// @param positions    particle positions, world units (only read)
 /// @param interrupter  optional; passed to estimateSpacing() and asked after each step;

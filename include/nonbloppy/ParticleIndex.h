@@ -72,7 +72,10 @@ public:
     ///                     partial counts); no start()/end() (buildSurface() announces
     ///                     "index particles")
     /// Thread-safety: reentrant.
-    /// @throw ParameterError if cellSize < kMinCellSize or a position is not finite;
+    /// @throw ParameterError if cellSize is not finite or below kMinCellSize, a position is
+    ///        not finite, a coordinate's cell number would not fit 32 bits ("particle
+    ///        coordinates up to X are too far from the origin for a cell size of C (32-bit
+    ///        index space)") or there are more than 2³² − 1 particles;
     ///        CancelledError("interrupted during index particles") when @a interrupter says stop.
     static ParticleIndex build(std::vector<openvdb::Vec3f> positions, double cellSize,
                                openvdb::util::NullInterrupter* interrupter = nullptr);

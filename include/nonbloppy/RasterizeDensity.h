@@ -47,7 +47,8 @@ struct DensitySettings
 ///                     while assembling the tree; end().
 ///                     After a stop the partial grid is freed.
 /// Thread-safety: reentrant; the index is only read.
-/// @throw ParameterError if r_e ≤ 0, h ≤ 0, r_e/h > kMaxVoxelsPerRadius, or @a particles
+/// @throw ParameterError if r_e or h is not finite or ≤ 0, h < kMinCellSize, a given
+///        transform is not a uniform scale, r_e/h > kMaxVoxelsPerRadius, or @a particles
 ///        holds particles in cells outside kMinCellsPerRadius..kMaxCellsPerRadius of r_e;
 ///        CancelledError if @a interrupter says so.
 NONBLOPPY_API openvdb::FloatGrid::Ptr rasterizeDensity(const ParticleIndex& particles,

@@ -39,8 +39,9 @@
 /// binary arrays are read from the file straight into the final position and attribute
 /// arrays (then byte-swapped in place if needed), so memory is the particle set plus that
 /// buffer (12 bytes per particle for x y z; about 0.35 s for 12.5M binary PLY particles).
-/// `.vtu`/`.vtp` (an XML document) and `.vdb` (read by OpenVDB) hold the whole file in
-/// memory while they are read.
+/// `.vtu`/`.vtp` (an XML document, parsed by expat in chunks; appended raw arrays read
+/// straight into the final arrays) and `.vdb` (OpenVDB reading through a 64 KB stream
+/// buffer; peak memory the PointDataGrid, then the particle arrays) are streamed too.
 /// Text is parsed with std::from_chars; no per-particle heap objects. Every count in a
 /// header is checked against the bytes left in the file (its size) before allocating.
 /// Pipes, whose size is unknown, are read whole first.

@@ -49,7 +49,8 @@ namespace nonbloppy {
 class NONBLOPPY_API SurfaceReconstructor
 {
 public:
-    /// @param params  as for buildSurface(); checked on each reconstruct() call.
+    /// @param params  as for buildSurface(); checked on each reconstruct() call that resolves
+    ///                them (not while kept parameters are reused, see setKeepParameters()).
     explicit SurfaceReconstructor(const SurfaceParameters& params = SurfaceParameters());
     ~SurfaceReconstructor();
     SurfaceReconstructor(const SurfaceReconstructor&) = delete;
@@ -60,9 +61,10 @@ public:
     /// The parameters as given (not resolved; see SurfaceResult::parameters for those).
     const SurfaceParameters& parameters() const { return mParams; }
 
-    /// When true, the parameters resolved on the first frame (estimated spacing, r_e, r_0,
-    /// h) are used for every later frame, so the surface does not flicker with the spacing
-    /// estimate and the estimation cost is paid once. Default false (as buildSurface()).
+    /// When true, the parameters resolved on the last frame meshed so far (the first frame
+    /// when set before any: estimated spacing, r_e, r_0, h) are used for every later frame,
+    /// so the surface does not flicker with the spacing estimate and the estimation cost is
+    /// paid once. Default false (as buildSurface()). setParameters() forgets them.
     void setKeepParameters(bool keep) { mKeepParameters = keep; }
     /// Whether the first frame's resolved parameters are kept; see setKeepParameters().
     bool keepParameters() const { return mKeepParameters; }

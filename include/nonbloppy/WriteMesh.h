@@ -47,8 +47,11 @@ struct MeshWriteSettings
 /// Thread-safety: reentrant; concurrent calls must write different paths.
 /// @throw FileError for an unknown extension or a file that cannot be written, e.g.
 ///        "cannot write out/mesh.obj: No such file or directory"; nothing is left behind.
-/// @throw ParameterError if a polygon references a vertex that does not exist, or
-///        mesh.normals is non-empty but not one per vertex.
+///        PLY and VTK, whose indices are 32-bit, refuse a mesh with more than 2³¹ − 1
+///        vertices or polygon corners ("too many vertices for 32-bit indices (PATH)").
+/// @throw ParameterError if a polygon references a vertex that does not exist,
+///        mesh.normals is non-empty but not one per vertex, or an attribute has fewer than
+///        one component or not V·components values.
 NONBLOPPY_API void writeMesh(const SurfaceMesh& mesh, const std::string& path,
                const MeshWriteSettings& settings = MeshWriteSettings());
 

@@ -17,7 +17,8 @@ namespace nonbloppy {
 /// Write @a grids to @a path (temporary file, then rename), with @a fileMetadata as the
 /// file's metadata. Grids keep their own metadata (names, class, nonbloppy parameters).
 /// Written without compression timestamps, so the same grids give the same bytes.
-/// Cost: one pass over the grids' voxels (hashed for the file UUID, then written).
+/// Cost: one pass over the grids' voxels to write the temporary file, then one read of it
+/// to hash its bytes into the file UUID, written in place before the rename.
 /// Thread-safety: reentrant; concurrent calls must write different paths.
 /// @throw FileError naming @a path when it cannot be written.
 NONBLOPPY_API void writeVdb(const openvdb::GridCPtrVec& grids, const std::string& path,
