@@ -17,6 +17,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -79,6 +80,15 @@ inline size_t count(const std::string& text, const std::string& needle)
     size_t n = 0;
     for (size_t at = text.find(needle); at != std::string::npos; at = text.find(needle, at + 1)) ++n;
     return n;
+}
+
+/// The number after `"key": ` in a JSON text (its first occurrence), NaN when absent.
+inline double jsonNumber(const std::string& json, const std::string& key)
+{
+    const std::string needle = "\"" + key + "\": ";
+    const size_t at = json.find(needle);
+    if (at == std::string::npos) return std::nan("");
+    return std::strtod(json.c_str() + at + needle.size(), nullptr);
 }
 
 struct RunResult

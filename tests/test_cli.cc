@@ -37,15 +37,6 @@ protected:
     }
 };
 
-/// The number after `"key": ` in a JSON text, NaN when absent.
-double jsonNumber(const std::string& json, const std::string& key)
-{
-    const std::string needle = "\"" + key + "\": ";
-    const size_t at = json.find(needle);
-    if (at == std::string::npos) return std::nan("");
-    return std::strtod(json.c_str() + at + needle.size(), nullptr);
-}
-
 } // namespace
 
 TEST_F(CliTest, MeshWritesObjAndVdbAndSummary)
@@ -692,4 +683,10 @@ TEST_F(CliTest, VersionAndHelp)
     const RunResult helpMesh = run("help mesh");
     EXPECT_EQ(helpMesh.exitCode, 0);
     EXPECT_EQ(helpMesh.out, meshHelp.out);
+    // "help" alone is the list of commands (it printed the usage of "help" itself).
+    const RunResult bare = run("help");
+    EXPECT_EQ(bare.exitCode, 0);
+    EXPECT_EQ(bare.out, help.out);
+    EXPECT_NE(bare.out.find("  convert "), std::string::npos) << bare.out;
+    EXPECT_NE(meshHelp.out.find("--max-step"), std::string::npos) << meshHelp.out;
 }

@@ -69,7 +69,8 @@ TEST_F(CliSequenceTest, MeshesEveryFrameFoundWithOneLinePerFrame)
     // Frames of a different scale each: the lengths derived per frame move (said once).
     EXPECT_EQ(r.err, "nonbloppy: warning: the spacing estimate moves between frames (0.795085 in frame 1, "
                      "0.0498381 in frame 2) and the lengths derived from it move too; to mesh every frame "
-                     "alike, give frame 1's: --radius 1.59017 --voxel-size 0.397542 --threshold 2.85599\n");
+                     "alike, give frame 1's: --radius 1.59017 --voxel-size 0.397542 --threshold 2.85599 "
+                     "--max-step 0.397542\n");
     EXPECT_EQ(listDir(dir() + "/out"),
               (std::vector<std::string>{"mesh_0001.obj", "mesh_0002.obj", "mesh_0003.obj"}));
     // stdout is not a terminal: one line per frame, then the summary.
@@ -438,7 +439,7 @@ TEST_F(CliSequenceTest, LogHasOneObjectPerFrameAndASummary)
           std::string("\"rasterize density\": "), std::string("\"write vdb\": "),
           std::string("\"peak_rss_bytes\": "), std::string("\"parameters\": {\"spacing\": "),
           std::string("\"effective_radius\": 0.1, "), std::string("\"iterations\": 2, "),
-          std::string("\"region_leaves\": 1024}")}) {
+          std::string("\"region_leaves\": 1024, \"max_step\": 0.0249190720783451")}) {
         EXPECT_NE(frame2.find(field), std::string::npos) << field << "\n" << frame2;
     }
     EXPECT_EQ(frame2.back(), '}');
@@ -585,13 +586,13 @@ TEST_F(CliSequenceTest, MovingSpacingEstimateIsSaidOnceWithTheValuesThatPinTheLe
                                 "mesh every frame alike, give frame 1's:";
     RunResult r = run(mesh);
     ASSERT_EQ(r.exitCode, 0) << r.err;
-    EXPECT_EQ(r.err, warning + " --radius 0.0996763 --voxel-size 0.0249191 --threshold 2.85599\n");
+    EXPECT_EQ(r.err, warning + " --radius 0.0996763 --voxel-size 0.0249191 --threshold 2.85599 --max-step 0.0249191\n");
 
     // A length given is not listed; all three given, or the spacing, pin the frames alike.
     // (The radius has to suit frame 2's particles, 0.8 apart, and the voxel size both frames.)
     r = run(mesh + " --threshold 3 --frames 1-2");
     ASSERT_EQ(r.exitCode, 0) << r.err;
-    EXPECT_EQ(r.err, warning + " --radius 0.0996763 --voxel-size 0.0249191\n");
+    EXPECT_EQ(r.err, warning + " --radius 0.0996763 --voxel-size 0.0249191 --max-step 0.0249191\n");
     for (const std::string& pinned : {std::string(" --spacing 0.3"),
                                       std::string(" --radius 1.6 --voxel-size 0.2 --threshold 3")}) {
         r = run(mesh + pinned + " --method paper --frames 1-2");
@@ -609,6 +610,43 @@ TEST_F(CliSequenceTest, MovingSpacingEstimateIsSaidOnceWithTheValuesThatPinTheLe
     ASSERT_EQ(r.exitCode, 0) << r.err;
     EXPECT_EQ(count(r.err, "nonbloppy: warning: the spacing estimate moves between frames ("), 1u) << r.err;
     EXPECT_EQ(count(r.err, "\n"), 1u) << r.err;
+}
+
+TEST_F(CliSequenceTest, TheLoggedLengthsAndStepCapGivenBackMeshTheSameBytes)
+{
+    // Strong relaxation, where the faithful step cap (s/2) shapes the surface. With r_e, r_0
+    // and h all given and no spacing there is nothing to derive the cap from: pinning the
+    // lengths alone changes the surface, so the warning above pins --max-step too.
+    makeFrames({kData + "/dam_break_frame_23_24389_particles.vtk"});
+    const std::string mesh = "mesh " + quote(in("fluid_{}.vtk")) + " -q -c 1 -t 4 -o ";
+    RunResult r = run(mesh + quote(out("derived_{}.ply")) + " --log " + quote(out("derived.jsonl")));
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    const std::string log = readText(out("derived.jsonl"));
+    const auto given = [&](const char* option, const char* key) {
+        char text[64];
+        std::snprintf(text, sizeof(text), " %s %.17g", option, jsonNumber(log, key));
+        return std::string(text);
+    };
+    ASSERT_GT(jsonNumber(log, "max_step"), 0.0) << log;
+    const std::string derived = readText(out("derived_0001.ply"));
+    ASSERT_GT(derived.size(), 100000u);
+    const std::string lengths = given("--radius", "effective_radius") + given("--threshold", "threshold") +
+                                given("--voxel-size", "voxel_size");
+    r = run(mesh + quote(out("pinned_{}.ply")) + lengths + given("--max-step", "max_step"));
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_TRUE(derived == readText(out("pinned_0001.ply")));
+
+    r = run(mesh + quote(out("uncapped_{}.ply")) + lengths + " --log " + quote(out("uncapped.jsonl")));
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_EQ(jsonNumber(readText(out("uncapped.jsonl")), "max_step"), 0.0);
+    EXPECT_FALSE(derived == readText(out("uncapped_0001.ply")));
+    // The summary says which cap a run used.
+    const std::string single = "mesh " + quote(in("fluid_0001.vtk")) + " -c 1 -t 4 -o " + quote(out("one.ply"));
+    EXPECT_NE(run(single).out.find("  max step             0.023357       (s/2)\n"), std::string::npos);
+    EXPECT_NE(run(single + lengths).out.find("  max step             none           (no spacing to derive it from)\n"),
+              std::string::npos);
+    EXPECT_NE(run(single + " --max-step 0.01").out.find("  max step             0.01           (given)\n"),
+              std::string::npos);
 }
 
 TEST_F(CliSequenceTest, RegionLeavesChangeOnlyTheVertexOrder)

@@ -77,7 +77,7 @@ Command setupConvertCommand(CLI::App& parent)
         "Write through the page cache (by default files of 1 MiB or more bypass it on local ext4, "
         "XFS and Btrfs disks; the bytes are the same)")
         ->group(kGroupInputOutput);
-    cmd->add_flag("-q,--quiet", options->quiet, "Print nothing but errors")->group(kGroupDebug);
+    cmd->add_flag("-q,--quiet", options->quiet, "Print only warnings and errors (stderr)")->group(kGroupDebug);
     return {cmd, [options]() { return runConvert(*options); }};
 }
 

@@ -268,6 +268,7 @@ struct MeshOptions
 {
     std::string input, output, vdbPath;
     double spacing = 0, radius = 0, threshold = 0, voxelSize = 0;
+    double maxStep = 0;  ///< --max-step, world units (faithful); given or not: maxStepOpt
     double blend = nonbloppy::kDefaultBlend;
     int iterations = nonbloppy::kDefaultIterations;
     double adaptivity = nonbloppy::kDefaultAdaptivity;
@@ -290,7 +291,7 @@ struct MeshOptions
     CLI::Option *spacingOpt = nullptr, *radiusOpt = nullptr, *thresholdOpt = nullptr,
                 *voxelSizeOpt = nullptr, *blendOpt = nullptr, *iterationsOpt = nullptr,
                 *adaptivityOpt = nullptr, *threadsOpt = nullptr, *vdbOpt = nullptr,
-                *regionLeavesOpt = nullptr;
+                *regionLeavesOpt = nullptr, *maxStepOpt = nullptr;
 };
 
 std::optional<double> ifGiven(const CLI::Option* option, double value)
@@ -311,6 +312,7 @@ nonbloppy::SurfaceParameters surfaceParameters(const MeshOptions& o)
     params.iterations = o.iterations;
     params.adaptivity = o.adaptivity;
     params.method = o.method == "paper" ? nonbloppy::Method::Paper : nonbloppy::Method::Faithful;
+    params.maxStep = ifGiven(o.maxStepOpt, o.maxStep);
     if (o.noSmooth) params.smoothSurface = false;
     // Without --vdb nothing needs the grid: the library frees it before relaxing, which
     // lowers the peak memory of large frames.
@@ -461,6 +463,8 @@ void printSummary(const MeshOptions& o, const nonbloppy::SurfaceResult& result,
     row("adaptivity", formatNumber(p.adaptivity), origin(o.adaptivityOpt->count() > 0, "(default)"));
     row("method", o.method, origin(o.methodOpt->count() > 0, "(default)"));
     if (p.method == nonbloppy::Method::Faithful) {
+        row("max step", p.maxStep > 0.0 ? formatNumber(p.maxStep) : "none",
+            o.maxStepOpt->count() > 0 ? "(given)" : p.maxStep > 0.0 ? "(s/2)" : "(no spacing to derive it from)");
         row("volume offset",
             !p.preserveVolume ? "off" : p.volumeOffset == nonbloppy::VolumeOffset::Convex ? "convex" : "uniform",
             p.preserveVolume ? "(N*s^3, --spacing given)" : "(needs --spacing)");
@@ -716,7 +720,7 @@ constexpr double kSpacingMoveTolerance = 0.01;
 /// iso-value (r_0) move with it and the surface changes from frame to frame for that alone
 /// (a flicker in a rendered sequence). Says which values pin them: those of the first frame
 /// meshed (the lowest number, unless --frame-jobs meshes several at once).
-void warnIfLengthsMove(int frame, const nonbloppy::ResolvedParameters& p, OnceWarnings& once)
+void warnIfLengthsMove(int frame, const nonbloppy::ResolvedParameters& p, bool maxStepGiven, OnceWarnings& once)
 {
     if (p.spacingGiven || (p.effectiveRadiusGiven && p.voxelSizeGiven && p.thresholdGiven)) return;
     if (once.lengthsMoved.load()) return;
@@ -737,6 +741,11 @@ void warnIfLengthsMove(int frame, const nonbloppy::ResolvedParameters& p, OnceWa
     if (!p.effectiveRadiusGiven) pin += " --radius " + formatNumber(first.second.effectiveRadius);
     if (!p.voxelSizeGiven) pin += " --voxel-size " + formatNumber(first.second.voxelSize);
     if (!p.thresholdGiven) pin += " --threshold " + formatNumber(first.second.threshold);
+    // The faithful step cap s/2 follows the estimate too, and with the three lengths given
+    // and no spacing there is none: pinned as well, so the pinned run meshes frame 1 alike.
+    if (p.method == nonbloppy::Method::Faithful && !maxStepGiven) {
+        pin += " --max-step " + formatNumber(first.second.maxStep);
+    }
     std::cerr << "nonbloppy: warning: the spacing estimate moves between frames (" << formatNumber(reference)
               << " in frame " << first.first << ", " << formatNumber(p.spacing) << " in frame " << frame
               << ") and the lengths derived from it move too; to mesh every frame alike, give frame "
@@ -979,7 +988,7 @@ int runSequence(const MeshOptions& o)
         warnIfFacesEndInside(o, outcome.result.parameters, once);
         warnIfCoarseFloats(outcome.result, once);
         warnIfEmpty(outcome.result, f.output);
-        warnIfLengthsMove(job.frame.number, outcome.result.parameters, once);
+        warnIfLengthsMove(job.frame.number, outcome.result.parameters, o.maxStepOpt->count() > 0, once);
 
         FrameReport report;
         const nonbloppy::SurfaceResult& result = outcome.result;
@@ -992,7 +1001,8 @@ int runSequence(const MeshOptions& o)
         report.parameters = {{"spacing", p.spacing}, {"effective_radius", p.effectiveRadius},
                              {"threshold", p.threshold}, {"voxel_size", p.voxelSize},
                              {"blend", p.blend}, {"iterations", double(p.iterations)},
-                             {"adaptivity", p.adaptivity}, {"region_leaves", double(p.regionLeaves)}};
+                             {"adaptivity", p.adaptivity}, {"region_leaves", double(p.regionLeaves)},
+                             {"max_step", p.maxStep}};
         if (sampler) {
             sampler->stop();
             std::lock_guard<std::mutex> lock(verboseMutex);
@@ -1128,6 +1138,10 @@ Command setupMeshCommand(CLI::App& parent)
         "faithful (default): r_0 calibrated for the relaxed surface, steps capped at s/2, folds "
         "repaired, volume N*s^3 kept and faces smoothed when --spacing is given; paper: the paper's plain method")
         ->check(CLI::IsMember({"faithful", "paper"}))->group(kGroupNumerical);
+    o.maxStepOpt = cmd->add_option("--max-step", o.maxStep,
+        "faithful: the farthest one relaxation step moves a vertex; 0: no cap (default: s/2; no "
+        "cap when --radius, --threshold and --voxel-size are all given without --spacing)")
+        ->group(kGroupNumerical);
     cmd->add_flag("--no-smooth", o.noSmooth,
         "faithful: skip the edge-preserving smoothing that follows the volume correction "
         "(on when --spacing is given)")->group(kGroupNumerical);
@@ -1165,7 +1179,7 @@ Command setupMeshCommand(CLI::App& parent)
         "Write one JSON object per frame and a summary line to this file")
         ->group(kGroupSequence);
 
-    CLI::Option* quiet = cmd->add_flag("-q,--quiet", o.quiet, "Print nothing but errors")
+    CLI::Option* quiet = cmd->add_flag("-q,--quiet", o.quiet, "Print only warnings and errors (stderr)")
         ->group(kGroupDebug);
     CLI::Option* verbose = cmd->add_flag("-v,--verbose", o.verbose,
         "Print each stage, its progress and its memory (bytes per particle) on stderr")->group(kGroupDebug);

@@ -170,7 +170,8 @@ int run(int argc, char** argv)
     help->add_option("COMMAND", helpTopic, "mesh, inspect or convert");
     commands.push_back({help, [&]() {
         if (helpTopic.empty()) {
-            std::cout << app.help();
+            // Not app.help(): CLI11 hands that to the selected subcommand, "help" itself.
+            std::cout << app.get_formatter()->make_help(&app, app.get_name(), CLI::AppFormatMode::Normal);
             return 0;
         }
         for (const Command& command : commands) {
