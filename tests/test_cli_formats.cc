@@ -200,11 +200,19 @@ TEST_F(CliFormatsTest, MeshAttributesReachPlyAndVtk)
     EXPECT_EQ(obj.exitCode, 0);
     EXPECT_EQ(obj.err, "nonbloppy: warning: OBJ cannot store vertex attributes; write .ply or .vtk "
                        "to keep --attributes\n");
-    const RunResult unknown = run("mesh -q " + quote(source) + " -o " + quote(path("u.ply")) + " --attributes speed");
+    // Refused once the file is read, before it is meshed (-v lists the stages that ran).
+    const RunResult unknown = run("mesh -v " + quote(source) + " -o " + quote(path("u.ply")) + " --attributes speed");
     EXPECT_EQ(unknown.exitCode, 1);
-    EXPECT_EQ(unknown.err, "nonbloppy: unknown attribute 'speed'; the particles have: velocity, "
-                           "pressure, density, index\n");
+    EXPECT_EQ(lines(unknown.err).back(), "nonbloppy: " + source + ": unknown attribute 'speed'; the particles "
+                                         "have: velocity, pressure, density, index");
+    EXPECT_EQ(unknown.err.find("rasterize density"), std::string::npos) << unknown.err;
     EXPECT_FALSE(fs::exists(path("u.ply")));
+    // A list without a name is a usage error, before anything is read.
+    for (const std::string list : {"", " , "}) {
+        const RunResult none = run("mesh -q " + quote(source) + " -o " + quote(path("u.ply")) + " --attributes " + quote(list));
+        EXPECT_EQ(none.exitCode, 2) << list;
+        EXPECT_EQ(none.err, "nonbloppy: --attributes names no attribute, got '" + list + "'\n");
+    }
 }
 
 TEST_F(CliFormatsTest, VdbSurfaceAndPointsGrids)

@@ -362,6 +362,7 @@ void validateParameters(const MeshOptions& o)
 {
     // An empty --vdb ('--vdb ""', a variable left unset) wrote no grid without a word.
     if (o.vdbOpt->count() > 0 && o.vdbPath.empty()) throw UsageError("--vdb needs a file name, got ''");
+    checkAttributeList(o.outputs);
     // CLI11 reads an empty value ('--blend ""') as 0 without a word.
     for (const CLI::Option* option : {o.spacingOpt, o.radiusOpt, o.thresholdOpt, o.voxelSizeOpt, o.blendOpt,
                                       o.iterationsOpt, o.adaptivityOpt, o.regionLeavesOpt, o.threadsOpt,
@@ -609,6 +610,12 @@ MeshedFrame meshFrameSurface(const MeshOptions& o, ProgressInterrupter& interrup
     }
     if (frame.particles.size() == 0) {
         throw nonbloppy::FileError("no particles in " + o.input);
+    }
+    // Before meshing: a misspelt name used to cost the whole frame's work first.
+    try {
+        requireAttributes(frame.particles, o.outputs);
+    } catch (const nonbloppy::ParameterError& e) {
+        throw nonbloppy::ParameterError(o.input + ": " + e.what());
     }
     throwIfInterrupted();
 

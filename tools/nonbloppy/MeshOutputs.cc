@@ -44,7 +44,7 @@ std::atomic<bool> gRenameWarningPrinted{false};
 
 void addMeshOutputOptions(CLI::App* cmd, MeshOutputOptions& o, CLI::Option* vdbOption)
 {
-    cmd->add_option("--attributes", o.attributes,
+    o.attributesOpt = cmd->add_option("--attributes", o.attributes,
         "Particle attributes to carry to the mesh vertices, e.g. velocity,id, or all "
         "(PLY properties, VTK point data; OBJ cannot store them)")
         ->group(kGroupInputOutput);
@@ -56,13 +56,25 @@ void addMeshOutputOptions(CLI::App* cmd, MeshOutputOptions& o, CLI::Option* vdbO
         ->needs(vdbOption)->group(kGroupInputOutput);
 }
 
+void checkAttributeList(const MeshOutputOptions& o)
+{
+    // '--attributes ""' (a variable left unset) used to carry nothing without a word.
+    if (o.attributesOpt && o.attributesOpt->count() > 0 && splitNames(o.attributes).empty()) {
+        throw UsageError("--attributes names no attribute, got '" + o.attributes + "'");
+    }
+}
+
+void requireAttributes(const nonbloppy::ParticleSet& particles, const MeshOutputOptions& o)
+{
+    if (!o.attributes.empty()) nonbloppy::resolveAttributeNames(particles, splitNames(o.attributes));
+}
+
 void addSurfaceAttributes(nonbloppy::SurfaceResult& result, const nonbloppy::ParticleSet& particles,
                           const MeshOutputOptions& o, const std::string& meshPath,
                           openvdb::util::NullInterrupter* interrupter)
 {
     if (o.attributes.empty()) return;
     const std::vector<std::string> names = splitNames(o.attributes);
-    if (names.empty()) throw UsageError("--attributes names no attribute");
     nonbloppy::interpolateAttributes(result.mesh, particles, names,
                                      result.parameters.effectiveRadius, interrupter);
     std::string ext = std::filesystem::path(meshPath).extension().string();

@@ -23,6 +23,7 @@ namespace nonbloppy_tool {
 struct MeshOutputOptions
 {
     std::string attributes;  ///< --attributes: comma-separated names, or "all"
+    CLI::Option* attributesOpt = nullptr;  ///< set by addMeshOutputOptions()
     bool vdbSurface = false, vdbPoints = false;
 
     /// True if the particles (positions and attributes) are needed after meshing.
@@ -32,6 +33,15 @@ struct MeshOutputOptions
 /// Declare --attributes, --vdb-surface and --vdb-points on @a cmd (the last two need
 /// @a vdbOption, the --vdb FILE option).
 void addMeshOutputOptions(CLI::App* cmd, MeshOutputOptions& options, CLI::Option* vdbOption);
+
+/// @throw UsageError("--attributes names no attribute, got ','") if --attributes was given
+///        a list without a name ('' or only commas and spaces). Checked before any input is read.
+void checkAttributeList(const MeshOutputOptions& options);
+
+/// @throw nonbloppy::ParameterError("unknown attribute 'x'; the particles have: ...") if
+///        --attributes names an attribute @a particles lack: checked once the frame is read,
+///        before it is meshed.
+void requireAttributes(const nonbloppy::ParticleSet& particles, const MeshOutputOptions& options);
 
 /// With --attributes, interpolate the named attributes of @a particles to the final
 /// vertices of result.mesh (see nonbloppy::interpolateAttributes). Warns once on stderr
