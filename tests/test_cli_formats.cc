@@ -215,6 +215,22 @@ TEST_F(CliFormatsTest, MeshAttributesReachPlyAndVtk)
     }
 }
 
+TEST_F(CliFormatsTest, APlyMeshGivenAsParticlesIsSaidToBeOne)
+{
+    // A mesh from an earlier run given back as IN: its vertices are meshed, with a warning.
+    const std::string cube = kData + "/cube_2366_particles.vtk";
+    ASSERT_EQ(run("mesh -q " + quote(cube) + " -o " + quote(path("surface.ply"))).exitCode, 0);
+    const RunResult again = run("mesh -q " + quote(path("surface.ply")) + " -o " + quote(path("again.ply")));
+    EXPECT_EQ(again.exitCode, 0) << again.err;
+    EXPECT_EQ(again.err, "nonbloppy: warning: " + path("surface.ply") + " is a mesh (its header declares faces): "
+                         "its vertices were meshed as particles\n");
+    // A PLY of particles: nothing to say.
+    ASSERT_EQ(run("convert -q " + quote(cube) + " " + quote(path("particles.ply"))).exitCode, 0);
+    const RunResult particles = run("mesh -q " + quote(path("particles.ply")) + " -o " + quote(path("p.ply")));
+    EXPECT_EQ(particles.exitCode, 0);
+    EXPECT_EQ(particles.err, "");
+}
+
 TEST_F(CliFormatsTest, VdbSurfaceAndPointsGrids)
 {
     openvdb::initialize();

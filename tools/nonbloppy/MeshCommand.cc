@@ -13,6 +13,7 @@
 
 #include <nonbloppy/BuildSurface.h>
 #include <nonbloppy/Error.h>
+#include <nonbloppy/ReadMesh.h>
 #include <nonbloppy/ReadParticles.h>
 #include <nonbloppy/Timing.h>
 #include <nonbloppy/WriteMesh.h>
@@ -710,6 +711,7 @@ struct OnceWarnings
     std::atomic<bool> facesEndInside{false};
     std::atomic<bool> coarseFloats{false};
     std::atomic<bool> lengthsMoved{false};
+    std::atomic<bool> meshInput{false};
     /// The first frame meshed and its parameters, which warnIfLengthsMove() compares the
     /// later frames with.
     std::mutex firstFrameMutex;
@@ -804,6 +806,35 @@ void warnIfEmpty(const nonbloppy::SurfaceResult& result, const std::string& outp
     std::cerr << "nonbloppy: warning: " << output << " is empty: the density of the "
               << result.particleCount << " particles nowhere reaches --threshold "
               << formatNumber(result.parameters.threshold) << std::endl;
+}
+
+/// Once per run: a PLY input whose header declares faces is a mesh, not particles; its
+/// vertices were meshed as particles (readParticles() reads the vertex element of any PLY).
+/// Only regular PLY files are asked: the header alone tells, while a VTK file would be
+/// decoded again up to its POLYGONS, and a pipe cannot be read twice.
+void warnIfMeshInput(const std::string& input, OnceWarnings& once)
+{
+    std::error_code ec;
+    if (lowerExtension(input) != ".ply" || !fs::is_regular_file(input, ec) || once.meshInput.load()) return;
+    bool polygons = false;
+    try {
+        polygons = nonbloppy::declaresPolygons(input);
+    } catch (const nonbloppy::Error&) {
+        return;  // gone since it was read: nothing to say about it
+    }
+    if (!polygons || once.meshInput.exchange(true)) return;
+    std::cerr << "nonbloppy: warning: " << input << " is a mesh (its header declares faces): its "
+              << "vertices were meshed as particles" << std::endl;
+}
+
+/// The warnings about one meshed frame (@a f: its options, paths included), each printed
+/// once per run.
+void warnAboutFrame(const MeshOptions& f, const nonbloppy::SurfaceResult& result, OnceWarnings& once)
+{
+    warnIfFacesEndInside(f, result.parameters, once);
+    warnIfCoarseFloats(result, once);
+    warnIfEmpty(result, f.output);
+    warnIfMeshInput(f.input, once);
 }
 
 // ---------------------------------------------------------------------------------------
@@ -992,9 +1023,7 @@ int runSequence(const MeshOptions& o)
     const auto writeAndReport = [&](const MeshOptions& f, const BatchJob& job, MeshedFrame& frame,
                                     ProgressInterrupter& interrupter, ResidentSampler* sampler) {
         const FrameOutcome outcome = writeFrame(f, frame, interrupter, remover, OnInterrupt::Finish);
-        warnIfFacesEndInside(o, outcome.result.parameters, once);
-        warnIfCoarseFloats(outcome.result, once);
-        warnIfEmpty(outcome.result, f.output);
+        warnAboutFrame(f, outcome.result, once);
         warnIfLengthsMove(job.frame.number, outcome.result.parameters, o.maxStepOpt->count() > 0, once);
 
         FrameReport report;
@@ -1084,9 +1113,7 @@ int runMesh(const MeshOptions& o)
         const FrameOutcome outcome = meshFrame(o, interrupter, remover);
         interrupter.clearLine();
         OnceWarnings once;
-        warnIfFacesEndInside(o, outcome.result.parameters, once);
-        warnIfCoarseFloats(outcome.result, once);
-        warnIfEmpty(outcome.result, o.output);
+        warnAboutFrame(o, outcome.result, once);
         if (sampler) {
             sampler->stop();
             std::cerr << sampler->report(outcome.timings, outcome.result.particleCount);
