@@ -36,6 +36,8 @@ void resolveAndIndex(const SurfaceParameters& params, const ResolvedParameters* 
                      std::vector<openvdb::Vec3f>& positions, ParticleIndex& index, SurfaceResult& result,
                      openvdb::util::NullInterrupter* interrupter)
 {
+    // Kept parameters skip resolveParameters(), which refuses this for buildSurface().
+    if (positions.empty()) throw ParameterError("no particles to mesh");
     const auto indexParticles = [&](double effectiveRadius) {
         StageScope scope(result.timings, interrupter, "index particles");
         index = ParticleIndex::build(std::move(positions), kCellOverRadius * effectiveRadius, interrupter);

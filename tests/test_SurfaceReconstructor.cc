@@ -99,6 +99,24 @@ TEST(SurfaceReconstructor, KeepsTheFirstFramesParametersWhenAsked)
     EXPECT_NEAR(reconstructor.reconstruct(ParticleSet{sparse, {}}).parameters.spacing, 0.2, 0.005 * 0.2);
 }
 
+TEST(SurfaceReconstructor, AFrameWithoutParticlesIsRefusedKeptParametersOrNot)
+{
+    // With kept parameters nothing was resolved to refuse it: an empty mesh, or with the
+    // spacing given "target volume must be > 0, got 0" from the volume correction.
+    const auto ball = latticeParticles(0.1, 0.7, [](const openvdb::Vec3d& x) { return x.length() < 0.6; });
+    SurfaceParameters params;
+    params.spacing = 0.1;
+    for (const bool keep : {false, true}) {
+        SurfaceReconstructor reconstructor(params);
+        reconstructor.setKeepParameters(keep);
+        const size_t vertices = reconstructor.reconstruct(ParticleSet{ball, {}}).mesh.points.size();
+        EXPECT_EQ(nonbloppy_test::messageOf<ParameterError>([&] { reconstructor.reconstruct(ParticleSet{}); }),
+                  "no particles to mesh")
+            << "keep " << keep;
+        EXPECT_EQ(reconstructor.reconstruct(ParticleSet{ball, {}}).mesh.points.size(), vertices);
+    }
+}
+
 TEST(SurfaceReconstructor, AFrameThatFailsKeepsNoParameters)
 {
     // The parameters were kept as soon as they were resolved: a frame stopped later (or

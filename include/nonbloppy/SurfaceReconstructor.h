@@ -74,7 +74,8 @@ public:
     /// @return the result, valid until the next reconstruct() or setParameters() call.
     /// @param particles    any ParticleList, world units (read once)
     /// @param interrupter  optional; announced stages and polls as for buildSurface()
-    /// @throw ParameterError for bad parameters or non-finite positions, CancelledError
+    /// @throw ParameterError for bad parameters, non-finite positions or no particles ("no
+    ///        particles to mesh", kept parameters or not), CancelledError
     ///        ("interrupted during <stage>") when @a interrupter asks to stop; the object
     ///        stays usable, and the next frame gives the same bytes as a fresh object would.
     /// Cost: as buildSurface(), minus the allocations listed in the file comment.
