@@ -138,6 +138,22 @@ TEST_F(CliTest, InspectMeshIsClosedManifoldWithPositiveVolume)
     EXPECT_LT(volume, 0.6) << r.out;
 }
 
+TEST_F(CliTest, InspectSaysWhyAnOpenOrEmptyMeshIsNotManifold)
+{
+    // "manifold" includes "closed": an open mesh with no bad edge is still not manifold.
+    writeText(out("triangle.obj"), "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+    RunResult r = run("inspect " + quote(out("triangle.obj")));
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_NE(r.out.find("  closed           no (3 boundary edges)\n"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("  manifold         no (0 non-manifold, 0 inconsistently oriented edges; not closed)\n"),
+              std::string::npos) << r.out;
+    writeText(out("empty.obj"), "");
+    r = run("inspect " + quote(out("empty.obj")));
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_NE(r.out.find("  closed           no (no faces)\n  manifold         no (no faces)\n"), std::string::npos)
+        << r.out;
+}
+
 TEST_F(CliTest, InspectVdbListsDensityGrid)
 {
     ASSERT_EQ(meshCube("cube", "-q").exitCode, 0);

@@ -248,12 +248,18 @@ int inspectMesh(const std::string& path, const nonbloppy::SurfaceMesh& mesh, boo
                                                  : ""));
     printRow("faces", std::to_string(m.polygons) + " (" + std::to_string(mesh.triangles.size())
                           + " triangles, " + std::to_string(mesh.quads.size()) + " quads)");
-    printRow("closed", std::string(m.closed ? "yes" : "no") + " ("
-                           + std::to_string(m.boundaryEdges) + " boundary edges)");
-    printRow("manifold", std::string(m.manifold ? "yes" : "no") + " ("
-                             + std::to_string(m.nonManifoldEdges) + " non-manifold, "
-                             + std::to_string(m.inconsistentEdges)
-                             + " inconsistently oriented edges)");
+    // Manifold here includes closed (MeshMeasures), so an open or empty mesh says why not.
+    if (m.polygons == 0) {
+        printRow("closed", "no (no faces)");
+        printRow("manifold", "no (no faces)");
+    } else {
+        printRow("closed", std::string(m.closed ? "yes" : "no") + " ("
+                               + std::to_string(m.boundaryEdges) + " boundary edges)");
+        printRow("manifold", std::string(m.manifold ? "yes" : "no") + " ("
+                                 + std::to_string(m.nonManifoldEdges) + " non-manifold, "
+                                 + std::to_string(m.inconsistentEdges) + " inconsistently oriented edges"
+                                 + (m.closed ? "" : "; not closed") + ")");
+    }
     printRow("area", formatNumber(m.area));
     printRow("volume", formatNumber(m.volume) + (m.closed ? "" : " (not closed: not meaningful)"));
     if (bbox) {
