@@ -487,6 +487,8 @@ TEST_F(CliTest, UnreadableNumbersAreNamed)
     const std::string base = "mesh " + quote(kCube) + " -o " + quote(out("x.obj")) + " ";
     expectUsageError(base + "--threads abc", "--threads needs an integer, got 'abc'");
     expectUsageError(base + "--iterations 2.5", "--iterations needs an integer, got '2.5'");
+    expectUsageError(base + "--iterations 99999999999", "--iterations 99999999999 is out of range");
+    expectUsageError(base + "--threads -99999999999", "--threads -99999999999 is out of range");
     expectUsageError(base + "--blend x", "--blend needs a number, got 'x'");
     expectUsageError(base + "--radius 0.1m", "--radius needs a number, got '0.1m'");
     expectUsageError(base + "--frame-jobs 1e3", "--frame-jobs needs an integer, got '1e3'");
@@ -555,6 +557,20 @@ TEST_F(CliTest, InspectMissingFile)
     const RunResult r = run("inspect " + quote(missing));
     EXPECT_EQ(r.exitCode, 1);
     EXPECT_EQ(r.err, "nonbloppy: cannot open " + missing + ": No such file or directory\n");
+}
+
+TEST_F(CliTest, AnEmptyInputNameIsAUsageError)
+{
+    // An unset shell variable: "cannot open : No such file or directory" named nothing.
+    for (const auto& [command, expected] :
+         {std::pair<std::string, std::string>{"mesh '' -o " + quote(out("m.obj")), "IN needs a file name, got ''"},
+          {"inspect ''", "FILE needs a file name, got ''"},
+          {"convert '' " + quote(out("p.ply")), "IN needs a file name, got ''"}}) {
+        const RunResult r = run(command);
+        EXPECT_EQ(r.exitCode, 2) << command;
+        EXPECT_EQ(r.err, "nonbloppy: " + expected + "\n") << command;
+    }
+    EXPECT_TRUE(listDir(dir() + "/out").empty());
 }
 
 TEST_F(CliTest, OnATerminalASingleFrameShowsItsStagesOnOneLine)

@@ -396,6 +396,8 @@ void validateParameters(const MeshOptions& o)
 
 void validatePaths(const MeshOptions& o)
 {
+    // An unset shell variable: "cannot open : No such file or directory" named nothing.
+    if (o.input.empty()) throw UsageError("IN needs a file name, got ''");
     // writeMesh()'s own check, which would say the same after all the work.
     requireAsUsage([&] { nonbloppy::requireMeshFile(o.output); });
     if (!o.vdbPath.empty() && lowerExtension(o.vdbPath) != ".vdb") {
