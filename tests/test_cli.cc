@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "../src/AtomicFile.h"
 #include "CliTestUtil.h"
 
 #include <openvdb/version.h>
@@ -44,9 +45,9 @@ TEST_F(CliTest, MeshWritesObjAndVdbAndSummary)
     const RunResult r = meshCube("cube");
     ASSERT_EQ(r.exitCode, 0) << r.err;
     EXPECT_TRUE(r.err.empty()) << r.err;
-    EXPECT_NE(r.out.find("particles"), std::string::npos) << r.out;
-    EXPECT_NE(r.out.find("2366"), std::string::npos) << r.out;
-    EXPECT_NE(r.out.find("(derived)"), std::string::npos) << r.out;
+    // Whole rows: the file's name holds "particles" and "2366" too.
+    EXPECT_NE(r.out.find("\n  particles            2366\n"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("\n  spacing s            0.0498381      (derived)\n"), std::string::npos) << r.out;
     EXPECT_NE(r.out.find("volume offset        off            (needs --spacing)"), std::string::npos) << r.out;
     EXPECT_NE(r.out.find("smoothing            off            (needs --spacing)"), std::string::npos) << r.out;
     EXPECT_NE(r.out.find("region leaves        1024           (default)"), std::string::npos) << r.out;
@@ -119,7 +120,13 @@ TEST_F(CliTest, GivenParametersAreMarkedGiven)
 {
     const RunResult r = meshCube("cube", "--radius 0.1 -c 0.5 -t 1");
     ASSERT_EQ(r.exitCode, 0) << r.err;
-    EXPECT_NE(r.out.find("(given)"), std::string::npos) << r.out;
+    for (const char* row : {"\n  radius r_e           0.1            (given)\n",
+                            "\n  threshold r_0        3.18499        (derived)\n",
+                            "\n  blend c              0.5            (given)\n",
+                            "\n  iterations t         1              (given)\n",
+                            "\n  adaptivity           0              (default)\n"}) {
+        EXPECT_NE(r.out.find(row), std::string::npos) << row << r.out;
+    }
 }
 
 TEST_F(CliTest, InspectMeshIsClosedManifoldWithPositiveVolume)
@@ -132,10 +139,11 @@ TEST_F(CliTest, InspectMeshIsClosedManifoldWithPositiveVolume)
     EXPECT_GT(jsonNumber(r.out, "vertices"), 0.0) << r.out;
     EXPECT_GT(jsonNumber(r.out, "faces"), 0.0) << r.out;
     EXPECT_GT(jsonNumber(r.out, "area"), 0.0) << r.out;
-    // 2366 particles at spacing about 0.05 fill about 2366 · 0.05³ = 0.3 cubic units.
     const double volume = jsonNumber(r.out, "volume");
-    EXPECT_GT(volume, 0.15) << r.out;
-    EXPECT_LT(volume, 0.6) << r.out;
+    // The calibrated r_0 ends flat faces s/2 outside the outer layer, so the cube encloses
+    // N s³ (s = 0.0498381, the estimate), less what relaxation takes from edges and corners.
+    const double expected = 2366 * std::pow(0.0498381, 3);  // 0.29289
+    EXPECT_NEAR(volume, expected, 0.02 * expected) << r.out;
 }
 
 TEST_F(CliTest, InspectSaysWhyAnOpenOrEmptyMeshIsNotManifold)
@@ -178,8 +186,9 @@ TEST_F(CliTest, InspectParticleFile)
 
     const RunResult text = run("inspect " + quote(kData + "/dam_break_frame_23_24389_particles.vtk"));
     ASSERT_EQ(text.exitCode, 0) << text.err;
-    EXPECT_NE(text.out.find("24389"), std::string::npos) << text.out;
-    EXPECT_NE(text.out.find("velocity"), std::string::npos) << text.out;
+    // Whole rows: the file's name holds "24389" too.
+    EXPECT_NE(text.out.find("\n  particles        24389\n"), std::string::npos) << text.out;
+    EXPECT_NE(text.out.find("\n                   velocity  float32 x3\n"), std::string::npos) << text.out;
 }
 
 TEST_F(CliTest, InspectJsonIsValidForNamesThatAreNotUtf8)
@@ -226,6 +235,7 @@ TEST_F(CliTest, NoDirectIoWritesTheSameMesh)
 {
     // The dam-break frame's PLY (2.7 MB) is over the 1 MiB from which meshes bypass the page
     // cache; --no-direct-io writes it through the cache, with the same bytes.
+    if (!nonbloppy::directIoSuitable(dir())) GTEST_SKIP() << "no direct I/O on " << dir();
     const std::string frame = quote(kData + "/dam_break_frame_23_24389_particles.vtk");
     ASSERT_EQ(run("mesh " + frame + " -o " + quote(out("direct.ply")) + " -q").exitCode, 0);
     ASSERT_EQ(run("mesh " + frame + " -o " + quote(out("cached.ply")) + " -q --no-direct-io").exitCode, 0);
@@ -590,9 +600,18 @@ TEST_F(CliTest, OnATerminalASingleFrameShowsItsStagesOnOneLine)
     const size_t summary = shown.find("input");
     ASSERT_NE(summary, std::string::npos) << shown;
     EXPECT_EQ(shown.rfind("\r\033[K", summary), summary - 4) << shown;
-    // Not through a pipe or file, nor with -q: their output is unchanged.
+    // Not through a pipe or file, nor with -q on the terminal: their output is unchanged.
     const RunResult piped = run("mesh " + quote(kCube) + " -o " + quote(out("cube2.obj")));
+    ASSERT_EQ(piped.exitCode, 0) << piped.err;
+    ASSERT_EQ(piped.out.compare(0, 6, "input\n"), 0) << piped.out;
     EXPECT_EQ(piped.out.find('\r'), std::string::npos);
+    EXPECT_EQ(piped.err, "");
+    const std::string quiet = "script -qec " +
+                              quote(quote(kCli) + " mesh " + quote(kCube) + " -q -o " + quote(out("cube3.obj"))) +
+                              " /dev/null >" + quote(transcript) + " 2>&1";
+    ASSERT_EQ(std::system(quiet.c_str()), 0) << readText(transcript);
+    EXPECT_EQ(readText(transcript), "");
+    EXPECT_TRUE(fs::exists(out("cube3.obj")));
 }
 
 TEST_F(CliTest, SigintSigtermAndSighupCancelWithoutLeavingFiles)

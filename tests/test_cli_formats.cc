@@ -16,6 +16,7 @@
 
 #include <gtest/gtest.h>
 
+#include "../src/AtomicFile.h"
 #include "CliTestUtil.h"
 #include "TestUtil.h"
 
@@ -150,6 +151,8 @@ TEST_F(CliFormatsTest, LargeParticleFilesAreTheSameWithAndWithoutDirectIo)
         speed.bytes.insert(speed.bytes.end(), bytes, bytes + sizeof(value));
     }
     particles.attributes.push_back(speed);
+    // Elsewhere (tmpfs, overlayfs) both ways would be the page cache's: nothing to compare.
+    if (!nonbloppy::directIoSuitable(dir())) GTEST_SKIP() << "no direct I/O on " << dir();
     for (const std::string ext : {"ply", "vtk", "vtu", "xyz", "csv"}) {
         nonbloppy::ParticleWriteSettings cached;
         cached.directIo = false;
