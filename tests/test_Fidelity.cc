@@ -136,8 +136,10 @@ TEST(Fidelity, PaperMethodIsThePlainPipeline)
     relax.blend = kDefaultBlend;
     relax.iterations = kDefaultIterations;
     relaxVertices(mesh, index, relax);
+    ASSERT_GT(mesh.points.size(), 500u);
     ASSERT_EQ(mesh.points.size(), result.mesh.points.size());
     for (size_t i = 0; i < mesh.points.size(); ++i) ASSERT_EQ(mesh.points[i], result.mesh.points[i]) << i;
+    EXPECT_TRUE(mesh.quads == result.mesh.quads && mesh.triangles == result.mesh.triangles);
 }
 
 TEST(Fidelity, DefaultsAreIdenticalWithOneAndTwoThreads)
@@ -152,8 +154,11 @@ TEST(Fidelity, DefaultsAreIdenticalWithOneAndTwoThreads)
         tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 2);
         two = meshShape(jet);
     }
+    ASSERT_GT(one.points.size(), 500u);
     ASSERT_EQ(one.points.size(), two.points.size());
     for (size_t i = 0; i < one.points.size(); ++i) ASSERT_EQ(one.points[i], two.points[i]) << i;
+    EXPECT_TRUE(one.normals == two.normals);
+    EXPECT_TRUE(one.quads == two.quads && one.triangles == two.triangles);
 }
 
 // ------------------------------------------------------------------------------------------
@@ -275,6 +280,7 @@ TEST(Fidelity, MaxStepCapsEveryRelaxationStep)
     density.effectiveRadius = 1.0;
     density.voxelSize = 0.05;
     SurfaceMesh mesh = extractSurface(*rasterizeDensity(index, density), 1.0);
+    ASSERT_GT(mesh.points.size(), 1000u);  // the sphere of radius r_e/(1+r_0) = 0.5
     const std::vector<openvdb::Vec3s> before = mesh.points;
     RelaxSettings relax;
     relax.effectiveRadius = 1.0;

@@ -80,6 +80,7 @@ struct Fixture
         SurfaceResult result = buildSurface(particles.positions, params);
         mesh = std::move(result.mesh);
         radius = result.parameters.effectiveRadius;
+        EXPECT_GT(mesh.points.size(), 500u) << "the ball's surface";
         mesh.points.push_back(openvdb::Vec3s(5.0f, 5.0f, 5.0f));  // no particle in reach
         if (!mesh.normals.empty()) mesh.normals.push_back(openvdb::Vec3s(0.0f, 0.0f, 1.0f));
     }
@@ -105,6 +106,7 @@ TEST(InterpolateAttributes, LinearFieldGivesTheFieldAtTheWeightedMean)
     interpolateAttributes(fx.mesh, fx.particles, {"f"}, fx.radius);
     const MeshAttribute& f = fx.mesh.attributes.at(0);
     ASSERT_EQ(f.components, 3);
+    ASSERT_EQ(f.values.size(), 3 * fx.mesh.points.size());
     const float re = float(fx.radius);
     size_t checked = 0;
     for (size_t i = 0; i < fx.mesh.points.size(); ++i) {

@@ -31,6 +31,9 @@ struct OneParticle
         settings.effectiveRadius = 1.0;
         settings.voxelSize = 0.05;
         mesh = extractSurface(*rasterizeDensity(index, settings), 1.0);
+        // A sphere of radius r_e/(1+r_0) = 0.5 at h = 0.05 (about 4πr²/h² = 1257 quads): the
+        // tests' per-vertex loops have vertices to check.
+        EXPECT_GT(mesh.points.size(), 1000u);
     }
 };
 

@@ -261,6 +261,7 @@ TEST_F(CliFormatsTest, VdbSurfaceAndPointsGrids)
     const auto surface = openvdb::gridPtrCast<openvdb::FloatGrid>(byName["surface"]);
     const double h = surface->voxelSize()[0];
     const nonbloppy::SurfaceMesh mesh = nonbloppy::readMesh(ply);
+    ASSERT_GT(mesh.points.size(), 100u);
     openvdb::tools::GridSampler<openvdb::FloatGrid, openvdb::tools::BoxSampler> sampler(*surface);
     for (size_t i = 0; i < mesh.points.size(); i += 7) {
         ASSERT_LT(std::abs(sampler.wsSample(openvdb::Vec3d(mesh.points[i]))), 1.0 * h) << "vertex " << i;
@@ -346,6 +347,7 @@ TEST_F(CliFormatsTest, RenamedAttributesStayDistinctAndReadBack)
         EXPECT_EQ(nonbloppy::writtenAttributeNames(particles, file), names) << ext;
         nonbloppy::writeParticles(particles, file);
         const ParticleSet back = nonbloppy::readParticles(file);
+        ASSERT_EQ(back.size(), particles.size()) << ext;
         for (size_t i = 0; i < names.size(); ++i) {
             const ParticleAttribute* a = back.findAttribute(names[i]);
             ASSERT_NE(a, nullptr) << ext << " " << names[i];
