@@ -4,10 +4,11 @@
 // there needs an entry in kExpected below (FuzzRegressions.EveryFileHasAnEntry checks it).
 //
 // The header bombs (billion_points_header.*) claim a billion points in about 1 KB; the
-// reader must reject them before allocating for those points. This file replaces the global
-// operator new to record the largest single request made while a file is being read.
+// reader must reject them before allocating for those points: the largest single request
+// made while a file is read is recorded (support/AllocationRecorder.h).
 
 #include "TestUtil.h"
+#include "support/AllocationRecorder.h"
 #include "support/OpenVdbPoints.h"
 
 #include <nonbloppy/Error.h>
@@ -20,53 +21,11 @@
 #include <dirent.h>
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
-#include <cstdlib>
-#include <new>
 #include <random>
 #include <string>
+#include <thread>
 #include <vector>
-
-namespace {
-
-// Recording happens on the reading thread only, and only while it is armed.
-thread_local bool tRecordAllocations = false;
-thread_local size_t tLargestAllocation = 0;
-
-void*
-recordedAllocation(std::size_t size) noexcept
-{
-    if (tRecordAllocations && size > tLargestAllocation) tLargestAllocation = size;
-    return std::malloc(size == 0 ? 1 : size);
-}
-
-} // namespace
-
-// Every non-aligned form is replaced, so all of them pair malloc with free (AddressSanitizer
-// checks that allocation and deallocation functions match); aligned forms stay the library's.
-void*
-operator new(std::size_t size)
-{
-    if (void* p = recordedAllocation(size)) return p;
-    throw std::bad_alloc();
-}
-
-void*
-operator new[](std::size_t size)
-{
-    if (void* p = recordedAllocation(size)) return p;
-    throw std::bad_alloc();
-}
-
-void* operator new(std::size_t size, const std::nothrow_t&) noexcept { return recordedAllocation(size); }
-void* operator new[](std::size_t size, const std::nothrow_t&) noexcept { return recordedAllocation(size); }
-void operator delete(void* p) noexcept { std::free(p); }
-void operator delete[](void* p) noexcept { std::free(p); }
-void operator delete(void* p, std::size_t) noexcept { std::free(p); }
-void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
-void operator delete(void* p, const std::nothrow_t&) noexcept { std::free(p); }
-void operator delete[](void* p, const std::nothrow_t&) noexcept { std::free(p); }
 
 namespace {
 
@@ -86,18 +45,16 @@ ReadOutcome
 readFuzzFile(const std::string& path)
 {
     ReadOutcome outcome;
-    tLargestAllocation = 0;
-    tRecordAllocations = true;
-    try {
-        nonbloppy::readParticles(path);
-        outcome.message = "(no FileError)";
-    } catch (const nonbloppy::FileError& e) {
-        outcome.message = e.what();
-    } catch (const std::exception& e) {
-        outcome.message = std::string("(other exception) ") + e.what();
-    }
-    tRecordAllocations = false;
-    outcome.largestAllocation = tLargestAllocation;
+    outcome.largestAllocation = nonbloppy_test::largestAllocationDuring([&] {
+        try {
+            nonbloppy::readParticles(path);
+            outcome.message = "(no FileError)";
+        } catch (const nonbloppy::FileError& e) {
+            outcome.message = e.what();
+        } catch (const std::exception& e) {
+            outcome.message = std::string("(other exception) ") + e.what();
+        }
+    });
     return outcome;
 }
 
@@ -253,6 +210,23 @@ expectMessage(const std::string& file)
     const std::string path = fuzzPath(file);
     const ReadOutcome outcome = readFuzzFile(path);
     EXPECT_EQ(outcome.message, std::string(expected->message) + " (" + path + ")") << file;
+}
+
+TEST(FuzzRegressions, TheAllocationRecorderSeesRequestsOfThisThreadOnly)
+{
+    // Every "refused before allocating" check rests on this: a large request is seen, one of
+    // another thread is not, and nothing is recorded outside the work.
+    const size_t mine = nonbloppy_test::largestAllocationDuring([] {
+        std::vector<char> block(size_t(5) << 20);
+        EXPECT_EQ(block.size(), size_t(5) << 20);
+    });
+    EXPECT_GE(mine, size_t(5) << 20);
+    const size_t other = nonbloppy_test::largestAllocationDuring([] {
+        std::thread([] { std::vector<char> block(size_t(5) << 20); }).join();
+    });
+    EXPECT_LT(other, size_t(1) << 20);
+    std::vector<char> outside(size_t(6) << 20);
+    EXPECT_LT(nonbloppy_test::largestAllocationDuring([] {}), size_t(1) << 20);
 }
 
 TEST(FuzzRegressions, EveryFileHasAnEntry)

@@ -336,6 +336,7 @@ TEST_F(ReadVtuStreamingTest, MillionsOfParticlesInEveryEncodingWithBoundedMemory
                           {"appended base64", b64, 2000000 / kScale}, {"appended base64 zlib", b64Zlib, 2000000 / kScale},
                           {"inline base64", inlineB64, 2000000 / kScale}, {"inline base64 zlib", inlineZlib, 2000000 / kScale},
                           {"ascii", ascii, 600000 / kScale}};
+    bool unmeasured = false;
     for (const Case& c : cases) {
         const std::string file = path("big.vtu");
         {
@@ -357,6 +358,11 @@ TEST_F(ReadVtuStreamingTest, MillionsOfParticlesInEveryEncodingWithBoundedMemory
                                                  << " MiB for " << arraysMiB << " MiB of particles";
         }
         ::remove(file.c_str());
+        unmeasured = unmeasured || !measured;
+    }
+    // The records were checked; say so rather than pass a bound that was never measured.
+    if (kMeasureMemory && unmeasured) {
+        GTEST_SKIP() << "peak RSS cannot be reset here (/proc/self/clear_refs): memory bound not checked";
     }
 }
 
