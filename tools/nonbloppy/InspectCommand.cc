@@ -192,7 +192,9 @@ int inspectParticles(const std::string& path, const nonbloppy::ParticleSet& part
                                      + " -> "
                                      + formatVec3(bbox->second.x(), bbox->second.y(), bbox->second.z()));
     }
-    printRow("spacing", spacing ? formatNumber(*spacing) + " (estimated: volume per particle inside the fluid)"
+    // estimateSpacing() does not say which of its two measures it gave: name both.
+    printRow("spacing", spacing ? formatNumber(*spacing) + " (estimated: volume per particle inside the fluid, "
+                                                           "or the median neighbour distance where no particle is surrounded)"
                                 : "- (" + spacingNote + ")");
     if (particles.attributes.empty()) {
         printRow("attributes", "none");
