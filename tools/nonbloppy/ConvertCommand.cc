@@ -71,7 +71,8 @@ Command setupConvertCommand(CLI::App& parent)
     CLI::App* cmd = parent.add_subcommand(
         "convert", "Convert a particle file to another format, keeping its attributes");
     cmd->footer("Reads .vtk, .vtu, .vtp, .ply, .xyz, .bgeo, .vdb (points), .csv, .txt, .json;\n"
-                "writes .ply, .vtk, .vtu, .xyz (positions only), .csv, .vdb (PointDataGrid).");
+                "writes .ply, .vtk, .vtu, .xyz (positions only), .csv, .vdb (PointDataGrid).\n"
+                ".xyz is raw binary: little-endian float32 x y z triples (text goes in .csv or .txt).");
     cmd->add_option("IN", options->input, "Particle file to read")->required()->group(kGroupInputOutput);
     cmd->add_option("OUT", options->output, "Particle file to write")->required()->group(kGroupInputOutput);
     cmd->add_flag("--no-direct-io", options->noDirectIo,
