@@ -9,6 +9,10 @@
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
 
+#include <string>
+#include <thread>
+#include <vector>
+
 using namespace nonbloppy;
 using nonbloppy_test::dataPath;
 using nonbloppy_test::latticeParticles;
@@ -91,6 +95,44 @@ TEST(BuildSurface, IdenticalWithOneAndTwoThreads)
     EXPECT_EQ(serial.mesh.quads, parallel.mesh.quads);
     EXPECT_EQ(serial.mesh.triangles, parallel.mesh.triangles);
     EXPECT_EQ(serial.density->activeVoxelCount(), parallel.density->activeVoxelCount());
+}
+
+TEST(BuildSurface, ConcurrentCallsOnDifferentFramesGiveTheirOwnResults)
+{
+    // The header's promise to a studio meshing several frames from its own threads: each
+    // call's result is the one it gets alone (no shared state), whichever finishes first.
+    const std::vector<std::string> names = {"double_dam_break_frame_26_4732_particles.vtk",
+                                            "bunny_frame_14_7705_particles.vtk", "cube_2366_particles.vtk"};
+    std::vector<ParticleSet> frames;
+    std::vector<SurfaceMesh> alone;
+    SurfaceParameters params;
+    params.keepDensity = false;  // the region-by-region release path too
+    for (const std::string& name : names) {
+        frames.push_back(readParticles(dataPath(name)));
+        alone.push_back(buildSurface(frames.back(), params).mesh);
+        ASSERT_GT(alone.back().points.size(), 1000u) << name;
+    }
+    std::vector<SurfaceMesh> together(names.size());
+    std::vector<std::string> errors(names.size());
+    {
+        std::vector<std::thread> threads;
+        for (size_t f = 0; f < names.size(); ++f) {
+            threads.emplace_back([&, f] {
+                try {
+                    for (int round = 0; round < 2; ++round) together[f] = buildSurface(frames[f], params).mesh;
+                } catch (const std::exception& e) {
+                    errors[f] = e.what();
+                }
+            });
+        }
+        for (std::thread& t : threads) t.join();
+    }
+    for (size_t f = 0; f < names.size(); ++f) {
+        EXPECT_EQ(errors[f], "") << names[f];
+        EXPECT_TRUE(together[f].points == alone[f].points) << names[f];
+        EXPECT_TRUE(together[f].normals == alone[f].normals) << names[f];
+        EXPECT_TRUE(together[f].quads == alone[f].quads && together[f].triangles == alone[f].triangles) << names[f];
+    }
 }
 
 TEST(BuildSurface, DroppingTheDensityTilesTheInteriorAndKeepsTheMeshBitForBit)
