@@ -320,6 +320,7 @@ TEST_F(CliTest, BadParameters)
     // An empty value was read as 0.
     expectUsageError(base + "--blend ''", "--blend needs a number, got ''");
     expectUsageError(base + "--adaptivity ''", "--adaptivity needs a number, got ''");
+    expectUsageError(base + "--max-step ''", "--max-step needs a number, got ''");  // was "no cap"
     // Given lengths judged against each other or OpenVDB's limits: also before the input is
     // read (these exited 1 after reading it).
     expectUsageError(base + "--voxel-size 0.001 --radius 1",

@@ -367,7 +367,7 @@ void validateParameters(const MeshOptions& o)
     // CLI11 reads an empty value ('--blend ""') as 0 without a word.
     for (const CLI::Option* option : {o.spacingOpt, o.radiusOpt, o.thresholdOpt, o.voxelSizeOpt, o.blendOpt,
                                       o.iterationsOpt, o.adaptivityOpt, o.regionLeavesOpt, o.threadsOpt,
-                                      o.frameJobsOpt}) {
+                                      o.frameJobsOpt, o.maxStepOpt}) {
         if (!option) continue;
         for (const std::string& value : option->results()) {
             if (value.find_first_not_of(" \t") == std::string::npos) {
