@@ -59,6 +59,14 @@ std::string versionLine();
 void warnRenamedAttributes(const std::vector<std::string>& original, const std::vector<std::string>& written,
                            const std::string& path);
 
+/// @throw UsageError("<@a name> needs a file name, got ''") if @a path is empty, say a shell
+///        variable left unset: "cannot open : No such file or directory" named nothing, and
+///        an empty --vdb wrote no grid without a word.
+inline void requireFileName(const std::string& path, const std::string& name)
+{
+    if (path.empty()) throw UsageError(name + " needs a file name, got ''");
+}
+
 /// The extension of @a path's last component with its dot, lower-cased (".vtk"), or "".
 inline std::string lowerExtension(const std::string& path)
 {

@@ -31,7 +31,7 @@ int runConvert(const ConvertOptions& o)
 {
     // Everything that can be checked before reading: a name for each file, the output
     // format, and not overwriting the input.
-    if (o.input.empty()) throw UsageError("IN needs a file name, got ''");
+    requireFileName(o.input, "IN");
     requireAsUsage([&] { nonbloppy::requireParticleOutputFile(o.output); });
     std::error_code ec;
     if (o.input == o.output || std::filesystem::equivalent(o.input, o.output, ec)) {

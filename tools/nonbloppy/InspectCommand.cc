@@ -474,8 +474,7 @@ int inspectVdb(const std::string& path, bool json)
 
 int runInspect(const std::string& path, bool json)
 {
-    // An unset shell variable: "cannot open : No such file or directory" named nothing.
-    if (path.empty()) throw UsageError("FILE needs a file name, got ''");
+    requireFileName(path, "FILE");
     struct stat info;
     if (::stat(path.c_str(), &info) != 0) {
         throw nonbloppy::FileError("cannot open " + path + ": " + std::strerror(errno));

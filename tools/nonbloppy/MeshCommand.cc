@@ -361,8 +361,7 @@ void requireWritableDirectory(const std::string& path)
 /// validateParameters() checks the numbers, validatePaths() the files of one frame.
 void validateParameters(const MeshOptions& o)
 {
-    // An empty --vdb ('--vdb ""', a variable left unset) wrote no grid without a word.
-    if (o.vdbOpt->count() > 0 && o.vdbPath.empty()) throw UsageError("--vdb needs a file name, got ''");
+    if (o.vdbOpt->count() > 0) requireFileName(o.vdbPath, "--vdb");
     checkAttributeList(o.outputs);
     // CLI11 reads an empty value ('--blend ""') as 0 without a word.
     for (const CLI::Option* option : {o.spacingOpt, o.radiusOpt, o.thresholdOpt, o.voxelSizeOpt, o.blendOpt,
@@ -396,8 +395,7 @@ void validateParameters(const MeshOptions& o)
 
 void validatePaths(const MeshOptions& o)
 {
-    // An unset shell variable: "cannot open : No such file or directory" named nothing.
-    if (o.input.empty()) throw UsageError("IN needs a file name, got ''");
+    requireFileName(o.input, "IN");
     // writeMesh()'s own check, which would say the same after all the work.
     requireAsUsage([&] { nonbloppy::requireMeshFile(o.output); });
     if (!o.vdbPath.empty() && lowerExtension(o.vdbPath) != ".vdb") {
@@ -971,7 +969,7 @@ int runSequence(const MeshOptions& o)
         throw UsageError("--frame-jobs must be >= 1, got "
                                         + std::to_string(o.frameJobs));
     }
-    if (o.logOpt->count() > 0 && o.logPath.empty()) throw UsageError("--log needs a file name, got ''");
+    if (o.logOpt->count() > 0) requireFileName(o.logPath, "--log");
     const FramePattern input = parseFramePattern(o.input, "IN");
     requirePlaceholder(o.output, "--output", o);
     if (!o.vdbPath.empty()) requirePlaceholder(o.vdbPath, "--vdb", o);
