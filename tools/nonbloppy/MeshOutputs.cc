@@ -14,7 +14,6 @@
 
 #include <atomic>
 #include <cctype>
-#include <filesystem>
 #include <iostream>
 #include <vector>
 
@@ -77,8 +76,7 @@ void addSurfaceAttributes(nonbloppy::SurfaceResult& result, const nonbloppy::Par
     const std::vector<std::string> names = splitNames(o.attributes);
     nonbloppy::interpolateAttributes(result.mesh, particles, names,
                                      result.parameters.effectiveRadius, interrupter);
-    std::string ext = std::filesystem::path(meshPath).extension().string();
-    for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    const std::string ext = lowerExtension(meshPath);
     if (ext == ".obj" && !result.mesh.attributes.empty() && !gObjWarningPrinted.exchange(true)) {
         std::cerr << "nonbloppy: warning: OBJ cannot store vertex attributes; write .ply or .vtk "
                      "to keep --attributes" << std::endl;

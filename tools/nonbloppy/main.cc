@@ -100,8 +100,8 @@ std::string conversionMessage(const CLI::App& app, const std::string& message)
     const std::string type = option->get_type_name();
     const bool integer = type == "INT" || type == "UINT";
     // An integer too large for the option's type is one all the same: say so.
-    const size_t digits = value.find_first_not_of("+-") == 1 ? 1 : 0;
-    if (integer && value.size() > digits && value.find_first_not_of("0123456789", digits) == std::string::npos) {
+    const size_t sign = value.find_first_not_of("+-") == 1 ? 1 : 0;  // one leading sign
+    if (integer && value.size() > sign && value.find_first_not_of("0123456789", sign) == std::string::npos) {
         return name + " " + value + " is out of range";
     }
     return name + " needs " + (integer ? "an integer" : "a number") + ", got '" + value + "'";
