@@ -52,14 +52,13 @@ namespace nonbloppy_test {
 size_t
 largestAllocationDuring(const std::function<void()>& work)
 {
-    struct Disarm
+    struct Disarm  // on every way out, a throw from @a work included
     {
         ~Disarm() { tRecordAllocations = false; }
     } disarm;
     tLargestAllocation = 0;
     tRecordAllocations = true;
     work();
-    tRecordAllocations = false;
     return tLargestAllocation;
 }
 
