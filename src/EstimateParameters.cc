@@ -444,7 +444,7 @@ ResolvedParameters resolveParametersWith(const SurfaceParameters& params, const 
 {
     CancelPoll poll(interrupter, "estimate parameters");
     checkParameters(params);
-    if (positions.empty()) throw ParameterError("no particles to mesh");
+    surface_stages_internal::requireParticles(positions);
 
     ResolvedParameters out;
     out.blend = params.blend;

@@ -27,6 +27,11 @@
 namespace nonbloppy {
 namespace surface_stages_internal {
 
+void requireParticles(const std::vector<openvdb::Vec3f>& positions)
+{
+    if (positions.empty()) throw ParameterError("no particles to mesh");
+}
+
 void checkCancelled(openvdb::util::NullInterrupter* interrupter, const char* stage)
 {
     cancellation_internal::CancelPoll(interrupter, stage).throwIfStopped();
@@ -36,8 +41,7 @@ void resolveAndIndex(const SurfaceParameters& params, const ResolvedParameters* 
                      std::vector<openvdb::Vec3f>& positions, ParticleIndex& index, SurfaceResult& result,
                      openvdb::util::NullInterrupter* interrupter)
 {
-    // Kept parameters skip resolveParameters(), which refuses this for buildSurface().
-    if (positions.empty()) throw ParameterError("no particles to mesh");
+    requireParticles(positions);  // kept parameters skip resolveParameters(), which checks it too
     const auto indexParticles = [&](double effectiveRadius) {
         StageScope scope(result.timings, interrupter, "index particles");
         index = ParticleIndex::build(std::move(positions), kCellOverRadius * effectiveRadius, interrupter);

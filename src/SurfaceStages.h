@@ -42,6 +42,10 @@ struct LengthNames
 /// calibration (whose cost grows as (r_e/s)³).
 void requireVoxelsPerRadius(double effectiveRadius, double voxelSize, const LengthNames& names = {});
 
+/// Throw ParameterError("no particles to mesh") if @a positions is empty: the one check of
+/// resolveParameters() and of buildSurface() with kept parameters, which skips it.
+void requireParticles(const std::vector<openvdb::Vec3f>& positions);
+
 /// Throw CancelledError("interrupted during <stage>") if @a interrupter (may be null) asks to
 /// stop. Cost: one wasInterrupted() call. Thread-safety: as the interrupter's.
 void checkCancelled(openvdb::util::NullInterrupter* interrupter, const char* stage);
