@@ -315,6 +315,9 @@ TEST_F(CliTest, BadParameters)
     expectUsageError(base + "--iterations=-1", "--iterations must be >= 0, got -1");
     expectUsageError(base + "--adaptivity 1.5", "--adaptivity must lie in [0,1], got 1.5");
     expectUsageError(base + "--region-leaves -1", "--region-leaves must be >= 0, got -1");
+    // Options of the faithful method alone would be ignored by the paper's.
+    expectUsageError(base + "--method paper --max-step 0.01", "--max-step applies to --method faithful only, not paper");
+    expectUsageError(base + "--method paper --no-smooth", "--no-smooth applies to --method faithful only, not paper");
     expectUsageError(base + "--threads 0", "--threads must lie in [1, 4096], got 0");
     expectUsageError(base + "--threads 100000000", "--threads must lie in [1, 4096], got 100000000");
     // An empty value was read as 0.
@@ -500,6 +503,8 @@ TEST_F(CliTest, UnreadableNumbersAreNamed)
     expectUsageError(base + "--iterations 2.5", "--iterations needs an integer, got '2.5'");
     expectUsageError(base + "--iterations 99999999999", "--iterations 99999999999 is out of range");
     expectUsageError(base + "--threads -99999999999", "--threads -99999999999 is out of range");
+    // Past 2^63 it was clamped to 9223372036854775807 without a word.
+    expectUsageError(base + "--region-leaves 99999999999999999999", "--region-leaves 99999999999999999999 is out of range");
     expectUsageError(base + "--blend x", "--blend needs a number, got 'x'");
     expectUsageError(base + "--radius 0.1m", "--radius needs a number, got '0.1m'");
     expectUsageError(base + "--frame-jobs 1e3", "--frame-jobs needs an integer, got '1e3'");
@@ -668,6 +673,52 @@ TEST_F(CliTest, ASignalASecondAfterTheFirstEndsAStuckRun)
         SIGTERM, 2, std::chrono::milliseconds(1300));
     EXPECT_EQ(r.killedBy, SIGTERM);
     EXPECT_TRUE(listDir(dir() + "/out").empty());
+}
+
+TEST_F(CliTest, ConvertStopsOnASignalAndLeavesItsOutputAsItWas)
+{
+    // convert took the signals' default action: Ctrl-C while it wrote killed it and left its
+    // temporary file beside OUT. Now a signal ends it with exit 130, OUT as it was. The input
+    // is a FIFO, so the signal arrives (once the handler is installed, which /proc tells)
+    // while convert waits for it, and the data only after.
+    const std::string fifo = in("fifo.vtk");
+    ASSERT_EQ(::mkfifo(fifo.c_str(), 0644), 0);
+    writeText(out("p.ply"), "old particles\n");
+    const std::string errFile = dir() + "/stderr.txt";
+    const std::string output = out("p.ply");
+    std::vector<char*> argv{const_cast<char*>(kCli.c_str()), const_cast<char*>("convert"),
+                            const_cast<char*>(fifo.c_str()), const_cast<char*>(output.c_str()), nullptr};
+    posix_spawn_file_actions_t actions;
+    posix_spawn_file_actions_init(&actions);
+    posix_spawn_file_actions_addopen(&actions, 2, errFile.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    pid_t pid = 0;
+    const int spawned = posix_spawn(&pid, kCli.c_str(), &actions, nullptr, argv.data(), environ);
+    posix_spawn_file_actions_destroy(&actions);
+    ASSERT_EQ(spawned, 0);
+    // SigCgt: the signals the process catches, in hex; SIGINT is bit 1.
+    const auto catchesSigint = [&] {
+        std::istringstream status(readText("/proc/" + std::to_string(pid) + "/status"));
+        for (std::string line; std::getline(status, line);) {
+            if (line.rfind("SigCgt:", 0) == 0) return (std::stoull(line.substr(7), nullptr, 16) >> (SIGINT - 1)) & 1;
+        }
+        return 0ull;
+    };
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+    while (!catchesSigint() && std::chrono::steady_clock::now() < deadline) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    }
+    ASSERT_EQ(::kill(pid, SIGINT), 0);
+    {
+        std::ofstream feed(fifo, std::ios::binary);  // opens once convert opens its end
+        feed << readText(kCube);
+    }
+    int status = 0;
+    ASSERT_EQ(::waitpid(pid, &status, 0), pid);
+    ASSERT_TRUE(WIFEXITED(status)) << "killed by signal " << WTERMSIG(status);
+    EXPECT_EQ(WEXITSTATUS(status), 130);
+    EXPECT_EQ(readText(errFile), "nonbloppy: interrupted\n");
+    EXPECT_EQ(listDir(dir() + "/out"), std::vector<std::string>{"p.ply"});
+    EXPECT_EQ(readText(out("p.ply")), "old particles\n");
 }
 
 TEST_F(CliTest, AnOutputThatIsNotARegularFileIsRefusedBeforeAnyWork)

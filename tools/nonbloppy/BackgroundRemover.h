@@ -14,9 +14,9 @@
 /// Why: on this project's test machine (ext4 mounted with `discard`), unlinking a 120 MB file
 /// written with O_DIRECT blocks for 16-17 ms while using no CPU (`rm` of a `dd oflag=direct`
 /// file, strace -T; /usr/bin/time shows 0.00 s of system time). A mesh replacing an earlier
-/// run's drops the old one's last link when the run succeeds (OutputCleanup in
-/// MeshCommand.cc), so every re-meshed frame used to wait for that. The thread only waits
-/// in the kernel, so it does not count against --threads.
+/// run's drops the old one's last link when the run succeeds (OutputCleanup.h), so every
+/// re-meshed frame used to wait for that. The thread only waits in the kernel, so it does
+/// not count against --threads.
 
 #ifndef NONBLOPPY_TOOL_BACKGROUND_REMOVER_H
 #define NONBLOPPY_TOOL_BACKGROUND_REMOVER_H

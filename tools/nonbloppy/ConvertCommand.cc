@@ -6,6 +6,10 @@
 
 #include "Commands.h"
 
+#include "BackgroundRemover.h"
+#include "Interrupts.h"
+#include "OutputCleanup.h"
+
 #include <nonbloppy/Error.h>
 #include <nonbloppy/ReadParticles.h>
 #include <nonbloppy/WriteParticles.h>
@@ -38,7 +42,12 @@ int runConvert(const ConvertOptions& o)
         throw UsageError("cannot write " + o.output + ": it is the input file");
     }
 
+    // A stop signal ends the conversion with exit 130 and OUT as it was: seen after the
+    // read (which nothing written waits on), and after the write, which then is undone. It
+    // used to kill the process, leaving the writer's temporary file beside OUT.
+    SignalHandlerScope signals;
     const nonbloppy::ParticleSet particles = nonbloppy::readParticles(o.input);
+    throwIfInterrupted();
     const bool positionsOnly = lowerExtension(o.output) == ".xyz";
     if (positionsOnly && !particles.attributes.empty()) {
         std::string names;
@@ -53,7 +62,13 @@ int runConvert(const ConvertOptions& o)
     }
     nonbloppy::ParticleWriteSettings settings;
     settings.directIo = !o.noDirectIo;
+    BackgroundRemover remover;
+    OutputCleanup cleanup;
+    cleanup.willWrite(o.output);
     nonbloppy::writeParticles(particles, o.output, settings);
+    cleanup.written();
+    throwIfInterrupted();
+    cleanup.keep(remover);
     if (!o.quiet) {
         // As written: .xyz keeps none of them (the warning above names those dropped).
         std::cout << "converted " << particles.size() << " particles with "

@@ -9,7 +9,9 @@
 #include "BackgroundRemover.h"
 #include "BatchRun.h"
 #include "FrameSequence.h"
+#include "Interrupts.h"
 #include "Json.h"
+#include "OutputCleanup.h"
 
 #include <nonbloppy/BuildSurface.h>
 #include <nonbloppy/Error.h>
@@ -25,12 +27,10 @@
 #include <tbb/parallel_reduce.h>
 
 #include <algorithm>
-#include <array>
 #include <atomic>
 #include <cerrno>
 #include <chrono>
 #include <cmath>
-#include <csignal>
 #include <cstdio>
 #include <cstring>
 #include <exception>
@@ -46,7 +46,6 @@
 #include <vector>
 
 #include <sys/stat.h>
-#include <time.h>
 #ifdef __GLIBC__
 #include <malloc.h>
 #endif
@@ -60,75 +59,6 @@ namespace fs = std::filesystem;
 
 // ---------------------------------------------------------------------------------------
 // Cancellation and progress
-
-/// Set by SIGINT, SIGTERM or SIGHUP; the interrupter reports it to the library, which then
-/// throws CancelledError at its next check.
-std::atomic<bool> gInterruptRequested{false};
-static_assert(std::atomic<bool>::is_always_lock_free, "the signal handler needs a lock-free flag");
-
-/// When the first stop signal of the run arrived (CLOCK_MONOTONIC nanoseconds, never 0), or 0.
-std::atomic<int64_t> gFirstStopSignalAt{0};
-static_assert(std::atomic<int64_t>::is_always_lock_free, "the signal handler needs a lock-free clock");
-
-/// Repeats of a stop signal within this time of the first are the same request: timeout(1)
-/// signals its child and then its whole process group, and a double key press sends two
-/// SIGINTs. Ending the run at once on the second of those cut short the clean-up and left this
-/// run's mesh beside the previous run's .vdb (and a stray backup of the old mesh).
-constexpr int64_t kRepeatedSignalNanoseconds = 1'000'000'000;
-
-extern "C" void onInterruptSignal(int signalNumber)
-{
-    timespec now{};
-    ::clock_gettime(CLOCK_MONOTONIC, &now);  // async-signal-safe
-    const int64_t at = std::max<int64_t>(1, int64_t(now.tv_sec) * 1'000'000'000 + now.tv_nsec);
-    int64_t first = 0;
-    if (gFirstStopSignalAt.compare_exchange_strong(first, at)) {
-        gInterruptRequested = true;
-        return;
-    }
-    // A signal a second or more after the first means "stop now": the run has not stopped on
-    // its own (it may be blocked, say reading a FIFO that nobody writes). Default action.
-    if (at - first >= kRepeatedSignalNanoseconds) {
-        std::signal(signalNumber, SIG_DFL);
-        std::raise(signalNumber);
-    }
-}
-
-/// For the command's duration: SIGINT, SIGTERM and SIGHUP (a closed terminal or ssh session)
-/// stop the run cleanly, as an interrupt (exit 130, no partial files, the log's summary
-/// written); repeats within a second are absorbed, a later one ends the process at once (the
-/// signal's default action); a SIGHUP that was ignored (nohup) stays ignored. SIGPIPE is
-/// ignored: a reader of stdout that went away ('| head -1') used to end the run silently with
-/// exit 141 and the log unfinished; now only the lost stdout lines are lost. The previous
-/// handlers are restored at the end.
-class SignalHandlerScope
-{
-public:
-    SignalHandlerScope()
-    {
-        gInterruptRequested = false;
-        gFirstStopSignalAt = 0;
-        for (size_t n = 0; n < kStopSignals.size(); ++n) {
-            mOld[n] = std::signal(kStopSignals[n], onInterruptSignal);
-            if (kStopSignals[n] == SIGHUP && mOld[n] == SIG_IGN) std::signal(SIGHUP, SIG_IGN);
-        }
-        mOldPipe = std::signal(SIGPIPE, SIG_IGN);
-    }
-    ~SignalHandlerScope()
-    {
-        for (size_t n = 0; n < kStopSignals.size(); ++n) {
-            std::signal(kStopSignals[n], mOld[n] == SIG_ERR ? SIG_DFL : mOld[n]);
-        }
-        std::signal(SIGPIPE, mOldPipe == SIG_ERR ? SIG_DFL : mOldPipe);
-    }
-    SignalHandlerScope(const SignalHandlerScope&) = delete;
-    SignalHandlerScope& operator=(const SignalHandlerScope&) = delete;
-
-private:
-    static constexpr std::array<int, 3> kStopSignals{SIGINT, SIGTERM, SIGHUP};
-    std::array<void (*)(int), 3> mOld{SIG_DFL, SIG_DFL, SIG_DFL};
-    void (*mOldPipe)(int) = SIG_DFL;
-};
 
 /// The library's interrupter: says "stop" after SIGINT/SIGTERM/SIGHUP and shows progress.
 /// - verbose (-v): each stage's name, its progress in quarters and its duration, one line
@@ -174,7 +104,7 @@ public:
             std::snprintf(seconds, sizeof(seconds), "%.3f", elapsed.count());
             // A stage a signal cut short, or an error, ends too (its scope unwinds): not
             // "done" just before "truncated POINTS section". The error's own line follows.
-            const char* how = gInterruptRequested.load() ? " stopped ("
+            const char* how = interruptRequested() ? " stopped ("
                               : std::uncaught_exceptions() > 0 ? " failed (" : " done (";
             std::cerr << ("[progress] " + mFrame + mStages.back().name + how + seconds + " s)\n") << std::flush;
         }
@@ -198,7 +128,7 @@ public:
             std::unique_lock<std::mutex> lock(outputMutex(), std::try_to_lock);
             if (lock.owns_lock() && now - mLastDraw >= std::chrono::milliseconds(100)) draw(percent);
         }
-        return gInterruptRequested.load(std::memory_order_relaxed);
+        return interruptRequested();
     }
 
     /// Erase the live line, if one is shown.
@@ -257,10 +187,6 @@ private:
     nonbloppy::ScopedStageTimer mTimer;
 };
 
-void throwIfInterrupted()
-{
-    if (gInterruptRequested) throw nonbloppy::CancelledError("interrupted");
-}
 
 // ---------------------------------------------------------------------------------------
 // Options and their validation
@@ -273,7 +199,9 @@ struct MeshOptions
     double blend = nonbloppy::kDefaultBlend;
     int iterations = nonbloppy::kDefaultIterations;
     double adaptivity = nonbloppy::kDefaultAdaptivity;
-    long long regionLeaves = nonbloppy::kDefaultRegionLeaves;  ///< signed, so that -1 is refused
+    /// Signed, so that -1 is refused; an int, so that CLI11 refuses a value past its range (it
+    /// clamped a 64-bit one to 2^63-1 without a word).
+    int regionLeaves = int(nonbloppy::kDefaultRegionLeaves);
     std::string method = "faithful";  ///< --method: faithful (default) or paper
     CLI::Option* methodOpt = nullptr;
     bool noSmooth = false;  ///< --no-smooth: skip smoothSurface() after the volume correction
@@ -292,7 +220,7 @@ struct MeshOptions
     CLI::Option *spacingOpt = nullptr, *radiusOpt = nullptr, *thresholdOpt = nullptr,
                 *voxelSizeOpt = nullptr, *blendOpt = nullptr, *iterationsOpt = nullptr,
                 *adaptivityOpt = nullptr, *threadsOpt = nullptr, *vdbOpt = nullptr,
-                *regionLeavesOpt = nullptr, *maxStepOpt = nullptr;
+                *regionLeavesOpt = nullptr, *maxStepOpt = nullptr, *noSmoothOpt = nullptr;
 };
 
 std::optional<double> ifGiven(const CLI::Option* option, double value)
@@ -382,8 +310,15 @@ void validateParameters(const MeshOptions& o)
         throw UsageError(e.what());
     }
     if (o.regionLeaves < 0) {
-        throw UsageError("--region-leaves must be >= 0, got "
-                                        + std::to_string(o.regionLeaves));
+        throw UsageError("--region-leaves must be >= 0, got " + std::to_string(o.regionLeaves));
+    }
+    // The paper's method has no step cap and no smoothing: these would be ignored.
+    if (o.method == "paper") {
+        for (const CLI::Option* option : {o.maxStepOpt, o.noSmoothOpt}) {
+            if (option->count() > 0) {
+                throw UsageError(option->get_name() + " applies to --method faithful only, not paper");
+            }
+        }
     }
     // TBB takes any count; at 10^8 the run took 13 GB and 18 s, at 10^9 it ran out of memory.
     constexpr int kMaxThreads = 4096;
@@ -514,75 +449,6 @@ void printSummary(const MeshOptions& o, const nonbloppy::SurfaceResult& result,
 
 // ---------------------------------------------------------------------------------------
 // The command
-
-/// The outputs of one frame, put back as they were unless the frame succeeds. Each output
-/// is written atomically, but the mesh is in place before the .vdb is written: when that
-/// failed, removing the new mesh used to leave neither it nor the mesh an earlier run had
-/// written there. So before an output is written, the file it will replace (symbolic links
-/// followed, as the writers do) gets a hard link beside it; on failure that link is renamed
-/// back over the new file, or, where nothing was replaced, the new file is removed.
-/// Cost: a link() and an unlink() per existing output, the unlink() off the frame's path
-/// (BackgroundRemover). Where the file system has no hard links, a failed run still removes
-/// the new file (the old one is then lost, as before).
-class OutputCleanup
-{
-public:
-    /// Call before writing @a path.
-    void willWrite(const std::string& path)
-    {
-        Output output{path, path, "", false};
-        std::error_code error;
-        if (std::filesystem::exists(path, error)) {
-            const std::filesystem::path target = std::filesystem::canonical(path, error);
-            if (!error) {
-                output.target = target.string();
-                const std::string backup = output.target + ".nonbloppy-old-" + std::to_string(::getpid());
-                if (::link(output.target.c_str(), backup.c_str()) == 0) output.backup = backup;
-            }
-        }
-        mOutputs.push_back(output);
-    }
-    /// Call once the output last announced by willWrite() is written.
-    void written() { mOutputs.back().written = true; }
-    /// The frame succeeded: keep the new files, drop the links to the old ones. The old
-    /// files' blocks are freed on @a remover's thread (see BackgroundRemover.h for the wait).
-    void keep(BackgroundRemover& remover)
-    {
-        for (const Output& output : mOutputs) {
-            if (!output.backup.empty()) remover.remove(output.backup);
-        }
-        mOutputs.clear();
-    }
-    ~OutputCleanup()
-    {
-        for (const Output& output : mOutputs) {
-            if (!output.backup.empty()) {
-                // Renaming a link over the same file would leave both names (POSIX).
-                struct stat now{}, old{};
-                const bool replaced = ::stat(output.target.c_str(), &now) != 0 ||
-                                      ::stat(output.backup.c_str(), &old) != 0 || now.st_ino != old.st_ino ||
-                                      now.st_dev != old.st_dev;
-                if (replaced) {
-                    std::rename(output.backup.c_str(), output.target.c_str());
-                } else {
-                    ::unlink(output.backup.c_str());
-                }
-            } else if (output.written) {
-                std::remove(output.path.c_str());
-            }
-        }
-    }
-
-private:
-    struct Output
-    {
-        std::string path;    ///< as given
-        std::string target;  ///< the file it names (links followed)
-        std::string backup;  ///< hard link to the replaced file, or empty
-        bool written;
-    };
-    std::vector<Output> mOutputs;
-};
 
 /// What meshing one frame produced: the library's result and every stage's seconds
 /// (the tool's own "read particles", "write mesh", "write vdb" included).
@@ -1075,7 +941,7 @@ int runSequence(const MeshOptions& o)
             return report;
         });
     };
-    return runBatch(jobs, settings, meshOne, [] { return gInterruptRequested.load(); });
+    return runBatch(jobs, settings, meshOne, [] { return interruptRequested(); });
 }
 
 int runMesh(const MeshOptions& o)
@@ -1176,7 +1042,7 @@ Command setupMeshCommand(CLI::App& parent)
         "faithful: the farthest one relaxation step moves a vertex; 0: no cap (default: s/2; no "
         "cap when --radius, --threshold and --voxel-size are all given without --spacing)")
         ->group(kGroupNumerical);
-    cmd->add_flag("--no-smooth", o.noSmooth,
+    o.noSmoothOpt = cmd->add_flag("--no-smooth", o.noSmooth,
         "faithful: skip the edge-preserving smoothing that follows the volume correction "
         "(on when --spacing is given)")->group(kGroupNumerical);
 
