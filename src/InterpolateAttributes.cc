@@ -47,8 +47,15 @@ struct SortedAttribute
 {
     std::string name;
     int components = 1;
+    bool nearest = false;        ///< integer: the nearest particle's value, not a weighted mean
     std::vector<double> values;  ///< sorted slot × components
 };
+
+/// Integers name or count things (ids, flags, material indices): a mean of two ids is neither.
+bool isInteger(ScalarType type)
+{
+    return type != ScalarType::Float32 && type != ScalarType::Float64;
+}
 
 /// Fill the attribute values of a range of vertices.
 struct InterpolateOp
@@ -61,6 +68,8 @@ struct InterpolateOp
     float effectiveRadius;
     cancellation_internal::CancelPoll& poll;
 
+    static constexpr uint32_t kNone = ~uint32_t(0);
+
     void operator()(const tbb::blocked_range<size_t>& range) const
     {
         if (poll.stopped()) return;
@@ -72,15 +81,29 @@ struct InterpolateOp
             const openvdb::Vec3f v = mesh.points[i];
             std::fill(sums.begin(), sums.end(), 0.0);
             double weightSum = 0.0;
+            // The nearest particle with a weight: smallest squared distance, then smallest
+            // index in the input (so neither the index's order nor the threads decide).
+            float nearestDistanceSqr = 0.0f;
+            uint32_t nearest = kNone;
             particle_index_internal::forEachRunInBox(index, accessor,
                 openvdb::Vec3d(v) - openvdb::Vec3d(r), openvdb::Vec3d(v) + openvdb::Vec3d(r),
                 [&](uint32_t first, uint32_t end) {
                     for (uint32_t k = first; k < end; ++k) {
-                        const float w = mpsWeightSquared((v - positions[k]).lengthSqr(), effectiveRadius);
+                        const float distanceSqr = (v - positions[k]).lengthSqr();
+                        const float w = mpsWeightSquared(distanceSqr, effectiveRadius);
                         if (w == 0.0f) continue;
                         weightSum += w;
+                        if (nearest == kNone || distanceSqr < nearestDistanceSqr
+                            || (distanceSqr == nearestDistanceSqr && index.originalIndex[k] < index.originalIndex[nearest])) {
+                            nearestDistanceSqr = distanceSqr;
+                            nearest = k;
+                        }
                         size_t s = 0;
                         for (const SortedAttribute& a : attributes) {
+                            if (a.nearest) {
+                                s += size_t(a.components);
+                                continue;
+                            }
                             const double* value = a.values.data() + size_t(k) * size_t(a.components);
                             for (int c = 0; c < a.components; ++c) sums[s++] += double(w) * value[c];
                         }
@@ -88,9 +111,16 @@ struct InterpolateOp
                 });
             size_t s = 0;
             for (size_t a = 0; a < attributes.size(); ++a) {
-                float* dst = out[a].values.data() + i * size_t(attributes[a].components);
-                for (int c = 0; c < attributes[a].components; ++c, ++s) {
-                    dst[c] = weightSum > 0.0 ? float(sums[s] / weightSum) : 0.0f;
+                const SortedAttribute& attribute = attributes[a];
+                float* dst = out[a].values.data() + i * size_t(attribute.components);
+                for (int c = 0; c < attribute.components; ++c, ++s) {
+                    if (nearest == kNone) {
+                        dst[c] = 0.0f;
+                    } else if (attribute.nearest) {
+                        dst[c] = float(attribute.values[size_t(nearest) * size_t(attribute.components) + size_t(c)]);
+                    } else {
+                        dst[c] = float(sums[s] / weightSum);
+                    }
                 }
             }
         }
@@ -136,6 +166,7 @@ interpolateAttributes(SurfaceMesh& mesh, const ParticleSet& particles,
             const ParticleAttribute& attribute = *attributes[a];
             sorted[a].name = attribute.name;
             sorted[a].components = attribute.components;
+            sorted[a].nearest = isInteger(attribute.type);
             sorted[a].values.resize(particles.size() * size_t(attribute.components));
             totalComponents += attribute.components;
             const std::vector<uint32_t>& original = index.originalIndex;

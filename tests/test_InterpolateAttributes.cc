@@ -132,6 +132,46 @@ TEST(InterpolateAttributes, LinearFieldGivesTheFieldAtTheWeightedMean)
     EXPECT_EQ(checked, fx.mesh.points.size() - 1);
 }
 
+TEST(InterpolateAttributes, IntegersTakeTheNearestParticlesValue)
+{
+    // An id is a name, not a quantity: the weighted mean of ids 17 and 18 named no particle.
+    // Each vertex gets the id of the nearest particle within r_e, exactly, by brute force.
+    Fixture fx;
+    interpolateAttributes(fx.mesh, fx.particles, {"id", "c"}, fx.radius);
+    const MeshAttribute& id = fx.mesh.attributes.at(0);
+    ASSERT_EQ(id.name, "id");
+    ASSERT_EQ(id.values.size(), fx.mesh.points.size());
+    const float re = float(fx.radius);
+    size_t betweenTwoIds = 0;
+    for (size_t i = 0; i < fx.mesh.points.size(); ++i) {
+        const openvdb::Vec3f v = fx.mesh.points[i];
+        float nearestSqr = re * re;
+        int32_t nearest = -1;
+        double weights = 0.0, weightedIds = 0.0;
+        for (size_t j = 0; j < fx.particles.size(); ++j) {
+            const float d2 = (v - fx.particles.positions[j]).lengthSqr();
+            const float w = mpsWeightSquared(d2, re);
+            if (w == 0.0f) continue;
+            weights += w;
+            weightedIds += double(w) * double(j);
+            if (nearest < 0 || d2 < nearestSqr) {
+                nearestSqr = d2;
+                nearest = int32_t(j);  // ids are the particle numbers
+            }
+        }
+        if (nearest < 0) {
+            EXPECT_EQ(id.values[i], 0.0f) << "vertex " << i;
+            continue;
+        }
+        ASSERT_EQ(id.values[i], float(nearest)) << "vertex " << i;
+        betweenTwoIds += std::floor(weightedIds / weights) != weightedIds / weights;
+    }
+    // The mean would have given values between ids at almost every vertex.
+    EXPECT_GT(betweenTwoIds, fx.mesh.points.size() / 2);
+    // A float attribute beside it is still a weighted mean.
+    for (size_t i = 0; i + 1 < fx.mesh.points.size(); ++i) ASSERT_EQ(fx.mesh.attributes.at(1).values[i], 2.5f);
+}
+
 TEST(InterpolateAttributes, SameBytesForAnyThreadCount)
 {
     Fixture fx;

@@ -20,6 +20,7 @@
 #include "CliTestUtil.h"
 #include "TestUtil.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -216,6 +217,43 @@ TEST_F(CliFormatsTest, MeshAttributesReachPlyAndVtk)
         EXPECT_EQ(none.exitCode, 2) << list;
         EXPECT_EQ(none.err, "nonbloppy: --attributes names no attribute, got '" + list + "'\n");
     }
+}
+
+TEST_F(CliFormatsTest, IntegerAttributesReachTheMeshAsTheNearestParticlesValue)
+{
+    // The int64 "index" of each vertex is that of a particle within r_e, not a mean of several.
+    const std::string source = kData + "/fluid_250_particles.vtu";
+    const RunResult r = run("mesh -q " + quote(source) + " -o " + quote(path("m.ply")) + " --attributes index");
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_EQ(r.err, "");
+    const ParticleSet vertices = nonbloppy::readParticles(path("m.ply"));
+    const ParticleSet particles = nonbloppy::readParticles(source);
+    const ParticleAttribute* index = vertices.findAttribute("index");
+    ASSERT_NE(index, nullptr);
+    std::vector<double> particleIndices;
+    for (size_t j = 0; j < particles.size(); ++j) particleIndices.push_back(particles.findAttribute("index")->asDouble(j));
+    ASSERT_GT(vertices.size(), 100u);
+    for (size_t i = 0; i < vertices.size(); ++i) {
+        EXPECT_NE(std::find(particleIndices.begin(), particleIndices.end(), index->asDouble(i)), particleIndices.end())
+            << "vertex " << i << ": " << index->asDouble(i);
+    }
+
+    // Past 2^24 a float32 value rounds the ids: said once.
+    ParticleSet big = particles;
+    ParticleAttribute id;
+    id.name = "id";
+    id.type = nonbloppy::ScalarType::Int64;
+    for (size_t j = 0; j < big.size(); ++j) {
+        const int64_t value = (int64_t(1) << 24) + 1 + int64_t(j);
+        const auto* bytes = reinterpret_cast<const unsigned char*>(&value);
+        id.bytes.insert(id.bytes.end(), bytes, bytes + sizeof(value));
+    }
+    big.attributes = {id};
+    nonbloppy::writeParticles(big, path("big.vtu"));  // PLY has no 64-bit integers
+    const RunResult warned = run("mesh -q " + quote(path("big.vtu")) + " -o " + quote(path("b.ply")) + " --attributes id");
+    ASSERT_EQ(warned.exitCode, 0) << warned.err;
+    EXPECT_EQ(warned.err, "nonbloppy: warning: attribute 'id' holds integers beyond 2^24 = 16777216, which the "
+                          "mesh's float32 values round\n");
 }
 
 TEST_F(CliFormatsTest, APlyMeshGivenAsParticlesIsSaidToBeOne)

@@ -36,9 +36,12 @@ NONBLOPPY_API std::vector<std::string> resolveAttributeNames(const ParticleSet& 
 /// values at every vertex v_i of @a mesh (as positioned now, i.e. after relaxation):
 ///   f(v_i) = Σ_j w(|v_i − r_j|) f_j / Σ_j w(|v_i − r_j|),
 /// with the MPS weight w of Kernel.h over r_e = @a effectiveRadius, the same weights as the
-/// relaxation's weighted mean t_i. A vertex with no particle within r_e gets 0. Values are
-/// converted to float; every component is interpolated independently. An attribute already
-/// on the mesh under the same name is replaced (also on a mesh without vertices).
+/// relaxation's weighted mean t_i. Integer attributes (ids, flags, material indices), whose
+/// means would name nothing, take instead the value of the nearest particle within r_e (of
+/// equally near ones, the first in @a particles). A vertex with no particle within r_e gets
+/// 0. Values are converted to float (integers beyond ±2^24 are rounded); every component is
+/// interpolated independently. An attribute already on the mesh under the same name is
+/// replaced (also on a mesh without vertices).
 /// Cost: a ParticleIndex of the particles with cells of r_e (O(N), not interruptible), then
 /// V · (particles within r_e) kernel evaluations, parallel over vertices; sums run in a
 /// fixed order in double, so the result does not depend on the thread count.

@@ -14,6 +14,7 @@
 
 #include <atomic>
 #include <cctype>
+#include <cmath>
 #include <iostream>
 #include <vector>
 
@@ -38,14 +39,15 @@ std::vector<std::string> splitNames(const std::string& list)
 
 std::atomic<bool> gObjWarningPrinted{false};
 std::atomic<bool> gRenameWarningPrinted{false};
+std::atomic<bool> gRoundingWarningPrinted{false};
 
 } // namespace
 
 void addMeshOutputOptions(CLI::App* cmd, MeshOutputOptions& o, CLI::Option* vdbOption)
 {
     o.attributesOpt = cmd->add_option("--attributes", o.attributes,
-        "Particle attributes to carry to the mesh vertices, e.g. velocity,id, or all "
-        "(PLY properties, VTK point data; OBJ cannot store them)")
+        "Particle attributes to carry to the mesh vertices, e.g. velocity,id, or all: kernel-weighted "
+        "means, integers the nearest particle's value (PLY properties, VTK point data; OBJ cannot store them)")
         ->group(kGroupInputOutput);
     cmd->add_flag("--vdb-surface", o.vdbSurface,
         "Also store the final surface as a level set grid 'surface' in the --vdb file")
@@ -68,6 +70,28 @@ void requireAttributes(const nonbloppy::ParticleSet& particles, const MeshOutput
     if (!o.attributes.empty()) nonbloppy::resolveAttributeNames(particles, splitNames(o.attributes));
 }
 
+/// Once per run: an integer attribute past ±2^24 (large ids) reaches the mesh rounded, as
+/// its values are float32 there.
+void warnIfIntegersRound(const nonbloppy::ParticleSet& particles, const std::vector<std::string>& names)
+{
+    constexpr double kExactFloatIntegers = 16777216.0;  // 2^24
+    if (gRoundingWarningPrinted) return;  // the scan is for the first frame that needs it
+    for (const std::string& name : nonbloppy::resolveAttributeNames(particles, names)) {
+        const nonbloppy::ParticleAttribute& a = *particles.findAttribute(name);
+        if (a.type == nonbloppy::ScalarType::Float32 || a.type == nonbloppy::ScalarType::Float64) continue;
+        const size_t values = a.size() * size_t(a.components);
+        for (size_t v = 0; v < values; ++v) {
+            if (std::abs(a.asDouble(v / size_t(a.components), int(v % size_t(a.components)))) > kExactFloatIntegers) {
+                if (!gRoundingWarningPrinted.exchange(true)) {
+                    std::cerr << "nonbloppy: warning: attribute '" << name << "' holds integers beyond 2^24 = "
+                                 "16777216, which the mesh's float32 values round" << std::endl;
+                }
+                return;
+            }
+        }
+    }
+}
+
 void addSurfaceAttributes(nonbloppy::SurfaceResult& result, const nonbloppy::ParticleSet& particles,
                           const MeshOutputOptions& o, const std::string& meshPath,
                           openvdb::util::NullInterrupter* interrupter)
@@ -76,6 +100,7 @@ void addSurfaceAttributes(nonbloppy::SurfaceResult& result, const nonbloppy::Par
     const std::vector<std::string> names = splitNames(o.attributes);
     nonbloppy::interpolateAttributes(result.mesh, particles, names,
                                      result.parameters.effectiveRadius, interrupter);
+    warnIfIntegersRound(particles, names);
     const std::string ext = lowerExtension(meshPath);
     if (ext == ".obj" && !result.mesh.attributes.empty() && !gObjWarningPrinted.exchange(true)) {
         std::cerr << "nonbloppy: warning: OBJ cannot store vertex attributes; write .ply or .vtk "
