@@ -139,6 +139,7 @@ TEST_F(CliTest, InspectMeshIsClosedManifoldWithPositiveVolume)
     EXPECT_GT(jsonNumber(r.out, "vertices"), 0.0) << r.out;
     EXPECT_GT(jsonNumber(r.out, "faces"), 0.0) << r.out;
     EXPECT_GT(jsonNumber(r.out, "area"), 0.0) << r.out;
+    EXPECT_NE(r.out.find("\"attributes\": []"), std::string::npos) << r.out;  // OBJ holds none
     const double volume = jsonNumber(r.out, "volume");
     // The calibrated r_0 ends flat faces s/2 outside the outer layer, so the cube encloses
     // N s³ (s = 0.0498381, the estimate), less what relaxation takes from edges and corners.

@@ -15,6 +15,7 @@
 #include <openvdb/tools/Interpolation.h>
 
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include "../src/AtomicFile.h"
 #include "CliTestUtil.h"
@@ -199,6 +200,17 @@ TEST_F(CliFormatsTest, MeshAttributesReachPlyAndVtk)
             maxPressure = std::max(maxPressure, pressure->asDouble(i));
         }
         EXPECT_GT(maxPressure, 0.0);
+        // inspect lists them (not the normals), as it lists a particle file's.
+        const RunResult shown = run("inspect " + quote(mesh));
+        ASSERT_EQ(shown.exitCode, 0) << shown.err;
+        EXPECT_NE(shown.out.find("\n  attributes       velocity  float32 x3\n"
+                                 "                   pressure  float32\n"), std::string::npos) << shown.out;
+        const RunResult json = run("inspect --json " + quote(mesh));
+        ASSERT_EQ(json.exitCode, 0) << json.err;
+        const nlohmann::json report = nlohmann::json::parse(json.out);
+        ASSERT_EQ(report.at("attributes").size(), 2u) << json.out;
+        EXPECT_EQ(report["attributes"][0], (nlohmann::json{{"name", "velocity"}, {"type", "float32"}, {"components", 3}}));
+        EXPECT_EQ(report["attributes"][1], (nlohmann::json{{"name", "pressure"}, {"type", "float32"}, {"components", 1}}));
     }
     const RunResult obj = run("mesh -q " + quote(source) + " -o " + quote(path("m.obj")) + " --attributes all");
     EXPECT_EQ(obj.exitCode, 0);

@@ -147,6 +147,36 @@ void printRow(const std::string& label, const std::string& value)
 // ---------------------------------------------------------------------------------------
 // Particle files
 
+/// The "attributes" rows: name, type and components, one attribute a row, or "none".
+void printAttributes(const std::vector<nonbloppy::ParticleAttribute>& attributes)
+{
+    if (attributes.empty()) {
+        printRow("attributes", "none");
+        return;
+    }
+    bool first = true;
+    for (const nonbloppy::ParticleAttribute& a : attributes) {
+        std::string text = a.name + "  " + nonbloppy::scalarTypeName(a.type);
+        if (a.components != 1) text += " x" + std::to_string(a.components);
+        printRow(first ? "attributes" : "", text);
+        first = false;
+    }
+}
+
+/// The "attributes" array of the JSON report: {"name", "type", "components"} each.
+void writeAttributes(JsonWriter& w, const std::vector<nonbloppy::ParticleAttribute>& attributes)
+{
+    w.beginArray("attributes");
+    for (const nonbloppy::ParticleAttribute& a : attributes) {
+        w.beginObject();
+        w.string("name", a.name);
+        w.string("type", nonbloppy::scalarTypeName(a.type));
+        w.integer("components", a.components);
+        w.endObject();
+    }
+    w.endArray();
+}
+
 int inspectParticles(const std::string& path, const nonbloppy::ParticleSet& particles, bool json)
 {
     const auto bbox = boundingBox(particles.positions);
@@ -171,15 +201,7 @@ int inspectParticles(const std::string& path, const nonbloppy::ParticleSet& part
         w.boundingBox(bbox);
         if (spacing) w.number("spacing", *spacing);
         else w.raw("spacing", "null");
-        w.beginArray("attributes");
-        for (const nonbloppy::ParticleAttribute& a : particles.attributes) {
-            w.beginObject();
-            w.string("name", a.name);
-            w.string("type", nonbloppy::scalarTypeName(a.type));
-            w.integer("components", a.components);
-            w.endObject();
-        }
-        w.endArray();
+        writeAttributes(w, particles.attributes);
         w.endObject();
         std::cout << w.str();
         return 0;
@@ -196,17 +218,7 @@ int inspectParticles(const std::string& path, const nonbloppy::ParticleSet& part
     printRow("spacing", spacing ? formatNumber(*spacing) + " (estimated: volume per particle inside the fluid, "
                                                            "or the median neighbour distance where no particle is surrounded)"
                                 : "- (" + spacingNote + ")");
-    if (particles.attributes.empty()) {
-        printRow("attributes", "none");
-    } else {
-        bool first = true;
-        for (const nonbloppy::ParticleAttribute& a : particles.attributes) {
-            std::string text = a.name + "  " + nonbloppy::scalarTypeName(a.type);
-            if (a.components != 1) text += " x" + std::to_string(a.components);
-            printRow(first ? "attributes" : "", text);
-            first = false;
-        }
-    }
+    printAttributes(particles.attributes);
     std::cout.flush();
     return 0;
 }
@@ -214,8 +226,31 @@ int inspectParticles(const std::string& path, const nonbloppy::ParticleSet& part
 // ---------------------------------------------------------------------------------------
 // Meshes
 
+/// The vertex attributes of the mesh file @a path (PLY properties, VTK point data; OBJ has
+/// none) other than its normals, as the particle readers see them. Cost: a second read of
+/// the file, as particles.
+std::vector<nonbloppy::ParticleAttribute> meshVertexAttributes(const std::string& path, const nonbloppy::SurfaceMesh& mesh)
+{
+    const std::string ext = lowerExtension(path);
+    if (ext != ".ply" && ext != ".vtk") return {};
+    std::vector<nonbloppy::ParticleAttribute> attributes;
+    try {
+        attributes = nonbloppy::readParticles(path).attributes;
+    } catch (const nonbloppy::Error&) {
+        return {};  // readMesh() read it; a layout the particle readers refuse has none they see
+    }
+    const auto isNormal = [&](const nonbloppy::ParticleAttribute& a) {
+        if (mesh.normals.empty()) return false;
+        return ext == ".ply" ? a.name == "nx" || a.name == "ny" || a.name == "nz" : a.name == "normals";
+    };
+    attributes.erase(std::remove_if(attributes.begin(), attributes.end(), isNormal), attributes.end());
+    for (nonbloppy::ParticleAttribute& a : attributes) a.bytes = {};  // only the names and types are shown
+    return attributes;
+}
+
 int inspectMesh(const std::string& path, const nonbloppy::SurfaceMesh& mesh, bool json)
 {
+    const std::vector<nonbloppy::ParticleAttribute> attributes = meshVertexAttributes(path, mesh);
     const nonbloppy::MeshMeasures m = nonbloppy::measureMesh(mesh);
     const auto bbox = boundingBox(mesh.points);
 
@@ -238,6 +273,7 @@ int inspectMesh(const std::string& path, const nonbloppy::SurfaceMesh& mesh, boo
         w.number("area", m.area);
         w.number("volume", m.volume);
         w.boundingBox(bbox);
+        writeAttributes(w, attributes);
         w.endObject();
         std::cout << w.str();
         return 0;
@@ -269,6 +305,7 @@ int inspectMesh(const std::string& path, const nonbloppy::SurfaceMesh& mesh, boo
                                      + " -> "
                                      + formatVec3(bbox->second.x(), bbox->second.y(), bbox->second.z()));
     }
+    printAttributes(attributes);
     std::cout.flush();
     return 0;
 }
