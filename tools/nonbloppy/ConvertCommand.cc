@@ -42,9 +42,9 @@ int runConvert(const ConvertOptions& o)
         throw UsageError("cannot write " + o.output + ": it is the input file");
     }
 
-    // A stop signal ends the conversion with exit 130 and OUT as it was: seen after the
-    // read (which nothing written waits on), and after the write, which then is undone. It
-    // used to kill the process, leaving the writer's temporary file beside OUT.
+    // A stop signal ends the conversion with exit 130 and OUT as it was: it is acted on once
+    // IN is read, before anything is written, or once OUT is written, which is then undone.
+    // It used to kill the process, leaving the writer's temporary file beside OUT.
     SignalHandlerScope signals;
     const nonbloppy::ParticleSet particles = nonbloppy::readParticles(o.input);
     throwIfInterrupted();

@@ -100,8 +100,8 @@ void addSurfaceAttributes(nonbloppy::SurfaceResult& result, const nonbloppy::Par
     const std::vector<std::string> names = splitNames(o.attributes);
     nonbloppy::interpolateAttributes(result.mesh, particles, names,
                                      result.parameters.effectiveRadius, interrupter);
-    warnIfIntegersRound(particles, names);
     const std::string ext = lowerExtension(meshPath);
+    if (ext != ".obj") warnIfIntegersRound(particles, names);  // OBJ keeps none: warned below
     if (ext == ".obj" && !result.mesh.attributes.empty() && !gObjWarningPrinted.exchange(true)) {
         std::cerr << "nonbloppy: warning: OBJ cannot store vertex attributes; write .ply or .vtk "
                      "to keep --attributes" << std::endl;
