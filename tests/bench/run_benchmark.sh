@@ -40,6 +40,7 @@ nonbloppy="$PWD/build/nonbloppy"
 tile="$PWD/build/nonbloppy_tile"
 frame="$PWD/tests/data/dam_break_frame_23_24389_particles.vtk"
 mkdir -p "$out"
+rm -f "$out"/*.usersys  # run_timed appends to them: this invocation's runs only
 report="$out/benchmark.md"
 : > "$report"
 say() { printf '%s\n' "$*" | tee -a "$report"; }
@@ -60,6 +61,9 @@ run_timed() {
   sync
   /usr/bin/time -f "%e %U %S %M" -o "$log.time" "$@" > "$log.out" 2> "$log.err"
   awk '{printf "%s %.2f %s\n", $1, $2 + $3, $4}' "$log.time" >> "$log"
+  # User and system seconds apart: the system time (page faults, mostly) need not grow as
+  # the user time does, and tells the program's own cost from the kernel's.
+  awk '{printf "%s %s\n", $2, $3}' "$log.time" >> "$log.usersys"
 }
 
 # compute_time OUT: the stage times nonbloppy printed to OUT, without reading and writing.
@@ -134,6 +138,11 @@ say "Per-particle wall time, 512x relative to 64x (1.00 = linear): $(
     awk -v a="${nb_cpu[512]}" -v b="${nb_cpu[64]}" 'BEGIN {printf "%.2f", (a / 512) / (b / 64)}'
     printf '; each round (512x and 64x runs of one round): '
     paste -d' ' "$out/nb_512" "$out/nb_64" | awk '{printf "%s%.2f", (NR > 1 ? " " : ""), ($1 / 512) / ($4 / 64)}'
+    # growth COLUMN TOOL: the per-particle growth of TOOL's (nb, vt) user (1) or system (2) time.
+    growth() { awk -v a="$(median "$1" "$out/${2}_512.usersys")" -v b="$(median "$1" "$out/${2}_64.usersys")" \
+                 'BEGIN {printf "%.2f", (a / 512) / (b / 64)}'; }
+    printf '; user time alone: %s (vdb_tool: %s); system time alone: %s (vdb_tool: %s)' \
+      "$(growth 1 nb)" "$(growth 1 vt)" "$(growth 2 nb)" "$(growth 2 vt)"
   else echo "not measured (--quick)"; fi)"
 
 # Stages of the last 64x run, as nonbloppy prints them.
