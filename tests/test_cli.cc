@@ -163,6 +163,26 @@ TEST_F(CliTest, InspectSaysWhyAnOpenOrEmptyMeshIsNotManifold)
         << r.out;
 }
 
+TEST_F(CliTest, InspectListsAMeshsAttributesOnlyWhenTheyCanBeRead)
+{
+    // A mesh's vertex attributes are read as particles, which refuse a NaN vertex that the
+    // mesh reader takes: then they are unknown, not "none".
+    const std::string header = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+                               "property float z\nproperty float temp\nelement face 1\n"
+                               "property list uchar int vertex_indices\nend_header\n";
+    writeText(out("fine.ply"), header + "0 0 0 1\n1 0 0 2\n0 1 0 3\n3 0 1 2\n");
+    writeText(out("nan.ply"), header + "0 0 0 1\n1 0 0 2\nnan 1 0 3\n3 0 1 2\n");
+    RunResult r = run("inspect " + quote(out("fine.ply")));
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_NE(r.out.find("\n  attributes       temp  float32\n"), std::string::npos) << r.out;
+    r = run("inspect " + quote(out("nan.ply")));
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_NE(r.out.find("\n  attributes       - (the particle readers refuse this file)\n"), std::string::npos) << r.out;
+    r = run("inspect --json " + quote(out("nan.ply")));
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_NE(r.out.find("\"attributes\": null"), std::string::npos) << r.out;
+}
+
 TEST_F(CliTest, InspectVdbListsDensityGrid)
 {
     ASSERT_EQ(meshCube("cube", "-q").exitCode, 0);

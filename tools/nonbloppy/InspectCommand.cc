@@ -228,16 +228,18 @@ int inspectParticles(const std::string& path, const nonbloppy::ParticleSet& part
 
 /// The vertex attributes of the mesh file @a path (PLY properties, VTK point data; OBJ has
 /// none) other than its normals, as the particle readers see them. Cost: a second read of
-/// the file, as particles.
-std::vector<nonbloppy::ParticleAttribute> meshVertexAttributes(const std::string& path, const nonbloppy::SurfaceMesh& mesh)
+/// the file, as particles. Unknown (nullopt) where the particle readers refuse the file
+/// (a NaN vertex, say) that readMesh() read.
+std::optional<std::vector<nonbloppy::ParticleAttribute>> meshVertexAttributes(const std::string& path,
+                                                                              const nonbloppy::SurfaceMesh& mesh)
 {
     const std::string ext = lowerExtension(path);
-    if (ext != ".ply" && ext != ".vtk") return {};
+    if (ext != ".ply" && ext != ".vtk") return std::vector<nonbloppy::ParticleAttribute>();
     std::vector<nonbloppy::ParticleAttribute> attributes;
     try {
         attributes = nonbloppy::readParticles(path).attributes;
     } catch (const nonbloppy::Error&) {
-        return {};  // readMesh() read it; a layout the particle readers refuse has none they see
+        return std::nullopt;
     }
     const auto isNormal = [&](const nonbloppy::ParticleAttribute& a) {
         if (mesh.normals.empty()) return false;
@@ -250,7 +252,7 @@ std::vector<nonbloppy::ParticleAttribute> meshVertexAttributes(const std::string
 
 int inspectMesh(const std::string& path, const nonbloppy::SurfaceMesh& mesh, bool json)
 {
-    const std::vector<nonbloppy::ParticleAttribute> attributes = meshVertexAttributes(path, mesh);
+    const std::optional<std::vector<nonbloppy::ParticleAttribute>> attributes = meshVertexAttributes(path, mesh);
     const nonbloppy::MeshMeasures m = nonbloppy::measureMesh(mesh);
     const auto bbox = boundingBox(mesh.points);
 
@@ -273,7 +275,8 @@ int inspectMesh(const std::string& path, const nonbloppy::SurfaceMesh& mesh, boo
         w.number("area", m.area);
         w.number("volume", m.volume);
         w.boundingBox(bbox);
-        writeAttributes(w, attributes);
+        if (attributes) writeAttributes(w, *attributes);
+        else w.raw("attributes", "null");
         w.endObject();
         std::cout << w.str();
         return 0;
@@ -305,7 +308,8 @@ int inspectMesh(const std::string& path, const nonbloppy::SurfaceMesh& mesh, boo
                                      + " -> "
                                      + formatVec3(bbox->second.x(), bbox->second.y(), bbox->second.z()));
     }
-    printAttributes(attributes);
+    if (attributes) printAttributes(*attributes);
+    else printRow("attributes", "- (the particle readers refuse this file)");
     std::cout.flush();
     return 0;
 }
