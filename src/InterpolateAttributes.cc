@@ -152,6 +152,7 @@ interpolateAttributes(SurfaceMesh& mesh, const ParticleSet& particles,
     for (size_t a = 0; a < attributes.size(); ++a) {
         out[a].name = attributes[a]->name;
         out[a].components = attributes[a]->components;
+        out[a].integer = isInteger(attributes[a]->type);
         out[a].values.resize(mesh.points.size() * size_t(attributes[a]->components));  // zeros
     }
     if (!attributes.empty() && !mesh.points.empty()) {

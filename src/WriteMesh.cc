@@ -24,6 +24,7 @@
 #include <tbb/task_group.h>
 
 #include <algorithm>
+#include <cmath>
 #include <charconv>
 #include <cstdint>
 #include <cstring>
@@ -128,6 +129,24 @@ inline char* put4(char* at, T value)
     if ((__BYTE_ORDER__ == __ORDER_BIG_ENDIAN__) != BigEndian) bits = __builtin_bswap32(bits);
     std::memcpy(at, &bits, 4);
     return at + 4;
+}
+
+/// True if @a attribute is to be stored as 32-bit ints: flagged as integer, and every value
+/// a whole number within int32's range (else floats, which hold any value it has).
+bool
+storedAsInt(const MeshAttribute& attribute)
+{
+    if (!attribute.integer) return false;
+    return std::all_of(attribute.values.begin(), attribute.values.end(), [](float v) {
+        return v == std::trunc(v) && v >= -2147483648.0f && v < 2147483648.0f;  // NaN fails the first test
+    });
+}
+
+/// Stores @a value (a float, or a whole number as a 4-byte int when @a asInt) at @a at.
+template<bool BigEndian>
+inline char* putValue(char* at, float value, bool asInt)
+{
+    return asInt ? put4<BigEndian>(at, int32_t(value)) : put4<BigEndian>(at, value);
 }
 
 /// Writes @a count records of @a recordBytes each, record i encoded by
@@ -316,9 +335,11 @@ writePly(const SurfaceMesh& mesh, const PolygonView& polygons, const std::string
     out.text("property float x\nproperty float y\nproperty float z\n");
     if (withNormals) out.text("property float nx\nproperty float ny\nproperty float nz\n");
     const std::vector<std::string> names = attributeNamesFor(mesh, ".ply");
+    std::vector<char> asInt(mesh.attributes.size());
     for (size_t i = 0; i < mesh.attributes.size(); ++i) {
+        asInt[i] = storedAsInt(mesh.attributes[i]);
         for (const std::string& column : attribute_names_internal::plyColumns(names[i], mesh.attributes[i].components)) {
-            out.text("property float " + column + "\n");
+            out.text(std::string(asInt[i] ? "property int " : "property float ") + column + "\n");
         }
     }
     out.text("element face " + std::to_string(polygons.polygonCount()) + "\n");
@@ -330,9 +351,10 @@ writePly(const SurfaceMesh& mesh, const PolygonView& polygons, const std::string
         if (withNormals) {
             for (int axis = 0; axis < 3; ++axis) at = put4<false>(at, float(mesh.normals[i][axis]));
         }
-        for (const MeshAttribute& attribute : mesh.attributes) {
+        for (size_t a = 0; a < mesh.attributes.size(); ++a) {
+            const MeshAttribute& attribute = mesh.attributes[a];
             const float* values = attribute.values.data() + i * size_t(attribute.components);
-            for (int c = 0; c < attribute.components; ++c) at = put4<false>(at, values[c]);
+            for (int c = 0; c < attribute.components; ++c) at = putValue<false>(at, values[c], asInt[a]);
         }
     });
     writePolygonRecords</*BigEndian=*/false, uint8_t>(out, polygons);
@@ -369,17 +391,19 @@ writeVtk(const SurfaceMesh& mesh, const PolygonView& polygons, const std::string
     for (size_t i = 0; i < mesh.attributes.size(); ++i) {
         const MeshAttribute& attribute = mesh.attributes[i];
         const std::string& name = names[i];
+        const bool asInt = storedAsInt(attribute);
+        const std::string type = asInt ? "int" : "float";
         if (attribute.components == 3) {
-            out.text("VECTORS " + name + " float\n");
+            out.text("VECTORS " + name + " " + type + "\n");
         } else if (attribute.components <= 4) {
-            out.text("SCALARS " + name + " float " + std::to_string(attribute.components) +
+            out.text("SCALARS " + name + " " + type + " " + std::to_string(attribute.components) +
                 "\nLOOKUP_TABLE default\n");
         } else {
             out.text("FIELD FieldData 1\n" + name + " " + std::to_string(attribute.components) +
-                " " + std::to_string(mesh.points.size()) + " float\n");
+                " " + std::to_string(mesh.points.size()) + " " + type + "\n");
         }
         writeRecords(out, attribute.values.size(), 4,
-                     [&](size_t i, char* at) { put4<true>(at, attribute.values[i]); });
+                     [&](size_t i, char* at) { putValue<true>(at, attribute.values[i], asInt); });
         out.text("\n");
     }
     out.flush();

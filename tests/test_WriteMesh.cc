@@ -315,6 +315,52 @@ TEST_F(WriteMeshTest, AttributeNamesStayDistinctFromEachOtherAndFromTheFormatsCo
     EXPECT_EQ(nonbloppy::writtenAttributeNames(mesh, path("m.ply"))[2], "nx");
 }
 
+TEST_F(WriteMeshTest, IntegerAttributesAreStoredAsIntsWhereEveryValueIsOne)
+{
+    // Ids carried to the vertices (MeshAttribute::integer) were float properties, which a
+    // reader takes for a measured quantity. Now int, where every value is a whole number in
+    // int32's range; otherwise float, which holds whatever the values are.
+    SurfaceMesh mesh = mixedMesh();
+    const size_t n = mesh.points.size();
+    const auto add = [&](const std::string& name, int components, bool integer, const std::function<float(size_t)>& value) {
+        nonbloppy::MeshAttribute a;
+        a.name = name;
+        a.components = components;
+        a.integer = integer;
+        for (size_t k = 0; k < n * size_t(components); ++k) a.values.push_back(value(k));
+        mesh.attributes.push_back(a);
+    };
+    add("id", 1, true, [](size_t k) { return float(16777216 - int(k)); });          // int
+    add("cell", 3, true, [](size_t k) { return -float(k); });                         // int, VECTORS
+    add("half", 1, true, [](size_t k) { return k == 1 ? 2.5f : float(k); });          // not whole: float
+    add("huge", 1, true, [](size_t k) { return k == 0 ? 3e9f : float(k); });          // past int32: float
+    add("count", 1, false, [](size_t k) { return float(k); });                        // not flagged: float
+
+    writeMesh(mesh, path("m.ply"));
+    const std::string bytes = readBytes(path("m.ply"));
+    EXPECT_NE(bytes.find("property int id\nproperty int cell_x\nproperty int cell_y\nproperty int cell_z\n"
+                         "property float half\nproperty float huge\nproperty float count\nelement face"),
+              std::string::npos);
+    writeMesh(mesh, path("m.vtk"));
+    const std::string vtk = readBytes(path("m.vtk"));
+    for (const char* header : {"SCALARS id int 1\n", "VECTORS cell int\n", "SCALARS half float 1\n",
+                               "SCALARS huge float 1\n", "SCALARS count float 1\n"}) {
+        EXPECT_NE(vtk.find(header), std::string::npos) << header;
+    }
+    // Read back as particles: ints, each value exact.
+    for (const std::string file : {"m.ply", "m.vtk"}) {
+        const nonbloppy::ParticleSet back = nonbloppy::readParticles(path(file));
+        const nonbloppy::ParticleAttribute* id = back.findAttribute("id");
+        ASSERT_NE(id, nullptr) << file;
+        EXPECT_EQ(id->type, nonbloppy::ScalarType::Int32) << file;
+        for (size_t k = 0; k < n; ++k) EXPECT_EQ(id->asDouble(k), 16777216.0 - double(k)) << file;
+        const nonbloppy::ParticleAttribute* half = back.findAttribute("half");
+        ASSERT_NE(half, nullptr) << file;
+        EXPECT_EQ(half->type, nonbloppy::ScalarType::Float32) << file;
+        EXPECT_EQ(half->asDouble(1), 2.5) << file;
+    }
+}
+
 TEST_F(WriteMeshTest, ObjTextIsExact)
 {
     SurfaceMesh mesh;

@@ -242,6 +242,7 @@ TEST_F(CliFormatsTest, IntegerAttributesReachTheMeshAsTheNearestParticlesValue)
     const ParticleSet particles = nonbloppy::readParticles(source);
     const ParticleAttribute* index = vertices.findAttribute("index");
     ASSERT_NE(index, nullptr);
+    EXPECT_EQ(index->type, nonbloppy::ScalarType::Int32);  // "property int index"
     std::vector<double> particleIndices;
     for (size_t j = 0; j < particles.size(); ++j) particleIndices.push_back(particles.findAttribute("index")->asDouble(j));
     ASSERT_GT(vertices.size(), 100u);
@@ -453,7 +454,8 @@ TEST_F(CliFormatsTest, RenamedAttributesAreNamedInAWarning)
     EXPECT_EQ(r.err, "nonbloppy: warning: attribute 'a b' is written to " + path("m.ply") + " as 'a_b_2'\n"
                      "nonbloppy: warning: attribute 'nx' is written to " + path("m.ply") + " as 'nx_2'\n");
     const std::string header = readText(path("m.ply")).substr(0, 400);
-    EXPECT_NE(header.find("property float nz\nproperty float a_b_2\nproperty float a_b\nproperty float nx_2\n"
+    // (Whole numbers in every row: the CSV reader makes them integers, carried as ints.)
+    EXPECT_NE(header.find("property float nz\nproperty int a_b_2\nproperty int a_b\nproperty int nx_2\n"
                           "element face"), std::string::npos) << header;
     // Only the renamed ones are named; OBJ keeps its own warning.
     r = run("mesh -q " + quote(source) + " -o " + quote(path("m2.ply")) + " --attributes a_b");

@@ -38,8 +38,9 @@ NONBLOPPY_API std::vector<std::string> resolveAttributeNames(const ParticleSet& 
 /// with the MPS weight w of Kernel.h over r_e = @a effectiveRadius, the same weights as the
 /// relaxation's weighted mean t_i. Integer attributes (ids, flags, material indices), whose
 /// means would name nothing, take instead the value of the nearest particle within r_e (of
-/// equally near ones, the first in @a particles). A vertex with no particle within r_e gets
-/// 0. Values are converted to float (integers beyond ±2^24 are rounded); every component is
+/// equally near ones, the first in @a particles), and are flagged MeshAttribute::integer
+/// (writeMesh() stores them as ints). A vertex with no particle within r_e gets 0. Values
+/// are converted to float (integers beyond ±2^24 are rounded); every component is
 /// interpolated independently. An attribute already on the mesh under the same name is
 /// replaced (also on a mesh without vertices).
 /// Cost: a ParticleIndex of the particles with cells of r_e (O(N), not interruptible), then

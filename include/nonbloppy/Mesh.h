@@ -19,6 +19,10 @@ struct MeshAttribute
     std::string name;            ///< as the particles' attribute, e.g. "velocity"
     int components = 1;          ///< 1 for scalars, 3 for vectors, ...
     std::vector<float> values;   ///< points.size() × components values, vertex-major
+    /// The values count or name things (ids, flags: an integer particle attribute, which
+    /// interpolateAttributes() carries as the nearest particle's value). writeMesh() then
+    /// stores them as 32-bit integers, if every one is a whole number in that range.
+    bool integer = false;
 };
 
 /// A polygon mesh of triangles and quads sharing one vertex array, in world units.
