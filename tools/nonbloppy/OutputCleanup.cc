@@ -15,17 +15,36 @@
 
 namespace nonbloppy_tool {
 
+namespace {
+
+/// The file a writer writes for @a path: symbolic links followed, also to a target that does
+/// not exist yet, as the library's writers (and a shell's '>') follow them. A loop of links
+/// stops at the 40th, where the writer fails anyway.
+std::string writtenFile(const std::string& path)
+{
+    namespace fs = std::filesystem;
+    fs::path target = path;
+    for (int links = 0; links < 40; ++links) {
+        std::error_code error;
+        if (!fs::is_symlink(fs::symlink_status(target, error))) break;
+        const fs::path next = fs::read_symlink(target, error);
+        if (error) break;
+        target = next.is_absolute() ? next : target.parent_path() / next;
+    }
+    return target.string();
+}
+
+} // namespace
+
 void OutputCleanup::willWrite(const std::string& path)
 {
-    Output output{path, path, "", false};
-    std::error_code error;
-    if (std::filesystem::exists(path, error)) {
-        const std::filesystem::path target = std::filesystem::canonical(path, error);
-        if (!error) {
-            output.target = target.string();
-            const std::string backup = output.target + ".nonbloppy-old-" + std::to_string(::getpid());
-            if (::link(output.target.c_str(), backup.c_str()) == 0) output.backup = backup;
-        }
+    // Undone through the target: removing @a path itself would delete the user's link to a
+    // file that did not exist yet and leave the new file behind.
+    Output output{path, writtenFile(path), "", false};
+    struct stat existing{};
+    if (::stat(output.target.c_str(), &existing) == 0) {
+        const std::string backup = output.target + ".nonbloppy-old-" + std::to_string(::getpid());
+        if (::link(output.target.c_str(), backup.c_str()) == 0) output.backup = backup;
     }
     mOutputs.push_back(output);
 }
@@ -53,7 +72,7 @@ OutputCleanup::~OutputCleanup()
                 ::unlink(output.backup.c_str());
             }
         } else if (output.written) {
-            std::remove(output.path.c_str());
+            std::remove(output.target.c_str());
         }
     }
 }

@@ -43,7 +43,7 @@ private:
     struct Output
     {
         std::string path;    ///< as given
-        std::string target;  ///< the file it names (links followed)
+        std::string target;  ///< the file it names (links followed, also to a file yet to be)
         std::string backup;  ///< hard link to the replaced file, or empty
         bool written;
     };
