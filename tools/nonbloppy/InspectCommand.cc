@@ -241,11 +241,30 @@ std::optional<std::vector<nonbloppy::ParticleAttribute>> meshVertexAttributes(co
     } catch (const nonbloppy::Error&) {
         return std::nullopt;
     }
-    const auto isNormal = [&](const nonbloppy::ParticleAttribute& a) {
-        if (mesh.normals.empty()) return false;
-        return ext == ".ply" ? a.name == "nx" || a.name == "ny" || a.name == "nz" : a.name == "normals";
-    };
-    attributes.erase(std::remove_if(attributes.begin(), attributes.end(), isNormal), attributes.end());
+    if (!mesh.normals.empty()) {
+        // PLY normals are the properties nx, ny, nz; a VTK file's are the array readMesh()
+        // took for them, whatever its name (a NORMALS section, or an array called normals or
+        // Normals): the first of three components that holds the same values.
+        const auto holdsTheNormals = [&](const nonbloppy::ParticleAttribute& a) {
+            if (a.components != 3 || a.size() != mesh.normals.size()) return false;
+            for (size_t n = 0; n < a.size(); ++n) {
+                for (int c = 0; c < 3; ++c) {
+                    if (float(a.asDouble(n, c)) != mesh.normals[n][c]) return false;
+                }
+            }
+            return true;
+        };
+        if (ext == ".ply") {
+            attributes.erase(std::remove_if(attributes.begin(), attributes.end(),
+                                            [](const nonbloppy::ParticleAttribute& a) {
+                                                return a.name == "nx" || a.name == "ny" || a.name == "nz";
+                                            }),
+                             attributes.end());
+        } else {
+            const auto normals = std::find_if(attributes.begin(), attributes.end(), holdsTheNormals);
+            if (normals != attributes.end()) attributes.erase(normals);
+        }
+    }
     for (nonbloppy::ParticleAttribute& a : attributes) a.bytes = {};  // only the names and types are shown
     return attributes;
 }
