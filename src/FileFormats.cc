@@ -388,12 +388,6 @@ valueAsDouble(const unsigned char* p, ScalarType type)
     }
 }
 
-bool
-isIntegerType(ScalarType type)
-{
-    return type != ScalarType::Float32 && type != ScalarType::Float64;
-}
-
 /// Integer value of @a p (native bytes of integer @a type); false if it does not fit int64.
 bool
 integerValue(const unsigned char* p, ScalarType type, int64_t& value)

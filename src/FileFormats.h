@@ -168,9 +168,6 @@ bool parseTextValue(std::string_view text, ScalarType type, unsigned char* out);
 /// Reverse the bytes of each of @a count values of @a width (1, 2, 4 or 8) bytes at @a data.
 void swapInPlace(unsigned char* data, size_t count, size_t width);
 
-/// True for the eight integer ScalarTypes.
-bool isIntegerType(ScalarType type);
-
 /// Integer value of @a p (native bytes of integer @a type); false if it does not fit int64.
 bool integerValue(const unsigned char* p, ScalarType type, int64_t& value);
 

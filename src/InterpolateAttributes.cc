@@ -47,15 +47,12 @@ struct SortedAttribute
 {
     std::string name;
     int components = 1;
-    bool nearest = false;        ///< integer: the nearest particle's value, not a weighted mean
+    /// Integers name or count things (ids, flags, material indices), and a mean of two ids
+    /// is neither: they take the nearest particle's value instead.
+    bool nearest = false;
     std::vector<double> values;  ///< sorted slot × components
 };
 
-/// Integers name or count things (ids, flags, material indices): a mean of two ids is neither.
-bool isInteger(ScalarType type)
-{
-    return type != ScalarType::Float32 && type != ScalarType::Float64;
-}
 
 /// Fill the attribute values of a range of vertices.
 struct InterpolateOp
@@ -152,7 +149,7 @@ interpolateAttributes(SurfaceMesh& mesh, const ParticleSet& particles,
     for (size_t a = 0; a < attributes.size(); ++a) {
         out[a].name = attributes[a]->name;
         out[a].components = attributes[a]->components;
-        out[a].integer = isInteger(attributes[a]->type);
+        out[a].integer = isIntegerType(attributes[a]->type);
         out[a].values.resize(mesh.points.size() * size_t(attributes[a]->components));  // zeros
     }
     if (!attributes.empty() && !mesh.points.empty()) {
@@ -167,7 +164,7 @@ interpolateAttributes(SurfaceMesh& mesh, const ParticleSet& particles,
             const ParticleAttribute& attribute = *attributes[a];
             sorted[a].name = attribute.name;
             sorted[a].components = attribute.components;
-            sorted[a].nearest = isInteger(attribute.type);
+            sorted[a].nearest = isIntegerType(attribute.type);
             sorted[a].values.resize(particles.size() * size_t(attribute.components));
             totalComponents += attribute.components;
             const std::vector<uint32_t>& original = index.originalIndex;

@@ -45,6 +45,12 @@ scalarTypeName(ScalarType type)
     return "unknown";
 }
 
+bool
+isIntegerType(ScalarType type)
+{
+    return type != ScalarType::Float32 && type != ScalarType::Float64;
+}
+
 size_t
 ParticleAttribute::size() const
 {

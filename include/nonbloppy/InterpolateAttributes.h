@@ -39,7 +39,9 @@ NONBLOPPY_API std::vector<std::string> resolveAttributeNames(const ParticleSet& 
 /// relaxation's weighted mean t_i. Integer attributes (ids, flags, material indices), whose
 /// means would name nothing, take instead the value of the nearest particle within r_e (of
 /// equally near ones, the first in @a particles), and are flagged MeshAttribute::integer
-/// (writeMesh() stores them as ints). A vertex with no particle within r_e gets 0. Values
+/// (writeMesh() stores them as ints). The type is the file's (readParticles()); CSV and JSON
+/// declare none, and a column of whole numbers there reads as Int64: write 300.0, not 300,
+/// for a quantity to be averaged. A vertex with no particle within r_e gets 0. Values
 /// are converted to float (integers beyond ±2^24 are rounded); every component is
 /// interpolated independently. An attribute already on the mesh under the same name is
 /// replaced (also on a mesh without vertices).

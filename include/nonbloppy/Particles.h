@@ -67,6 +67,8 @@ enum class ScalarType { Int8, UInt8, Int16, UInt16, Int32, UInt32, Int64, UInt64
 NONBLOPPY_API size_t scalarSize(ScalarType type);
 /// Lower-case name of @a type ("float32", "int64", ...), as used by `nonbloppy inspect`.
 NONBLOPPY_API const char* scalarTypeName(ScalarType type);
+/// True for the eight integer types, false for Float32 and Float64.
+NONBLOPPY_API bool isIntegerType(ScalarType type);
 
 /// One named per-particle attribute (e.g. "velocity", 3 × Float32), stored in its own
 /// type so nothing is lost on the way from reader to writer.

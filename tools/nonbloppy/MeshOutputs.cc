@@ -78,7 +78,7 @@ void warnIfIntegersRound(const nonbloppy::ParticleSet& particles, const std::vec
     if (gRoundingWarningPrinted) return;  // the scan is for the first frame that needs it
     for (const std::string& name : nonbloppy::resolveAttributeNames(particles, names)) {
         const nonbloppy::ParticleAttribute& a = *particles.findAttribute(name);
-        if (a.type == nonbloppy::ScalarType::Float32 || a.type == nonbloppy::ScalarType::Float64) continue;
+        if (!nonbloppy::isIntegerType(a.type)) continue;
         const size_t values = a.size() * size_t(a.components);
         for (size_t v = 0; v < values; ++v) {
             if (std::abs(a.asDouble(v / size_t(a.components), int(v % size_t(a.components)))) > kExactFloatIntegers) {
