@@ -170,6 +170,28 @@ TEST(InterpolateAttributes, IntegersTakeTheNearestParticlesValue)
     EXPECT_GT(betweenTwoIds, fx.mesh.points.size() / 2);
     // A float attribute beside it is still a weighted mean.
     for (size_t i = 0; i + 1 < fx.mesh.points.size(); ++i) ASSERT_EQ(fx.mesh.attributes.at(1).values[i], 2.5f);
+    EXPECT_TRUE(id.integer);  // writeMesh() stores it as ints
+    EXPECT_FALSE(fx.mesh.attributes.at(1).integer);
+}
+
+TEST(InterpolateAttributes, OfEquallyNearParticlesTheFirstGivesItsValue)
+{
+    // A vertex halfway between two particles: the first in the input gives every component
+    // of a vector integer attribute, whichever order the index keeps them in.
+    for (const bool swapped : {false, true}) {
+        SCOPED_TRACE(swapped);
+        ParticleSet particles;
+        particles.positions = {openvdb::Vec3f(0.1f, 0.0f, 0.0f), openvdb::Vec3f(-0.1f, 0.0f, 0.0f),
+                               openvdb::Vec3f(0.0f, 0.3f, 0.0f)};
+        std::vector<int16_t> cell{7, 8, 9, 3, 2, 1, 5, 5, 5};
+        if (swapped) std::swap(particles.positions[0], particles.positions[1]);
+        particles.attributes.push_back(makeAttribute("cell", ScalarType::Int16, 3, cell));
+        SurfaceMesh mesh;
+        mesh.points = {openvdb::Vec3s(0.0f, 0.0f, 0.0f), openvdb::Vec3s(0.0f, 0.29f, 0.0f)};
+        interpolateAttributes(mesh, particles, {"cell"}, 0.5);
+        const std::vector<float>& values = mesh.attributes.at(0).values;
+        EXPECT_EQ(values, (std::vector<float>{7, 8, 9, 5, 5, 5}));  // the first particle, either way
+    }
 }
 
 TEST(InterpolateAttributes, SameBytesForAnyThreadCount)

@@ -335,16 +335,18 @@ TEST_F(WriteMeshTest, IntegerAttributesAreStoredAsIntsWhereEveryValueIsOne)
     add("half", 1, true, [](size_t k) { return k == 1 ? 2.5f : float(k); });          // not whole: float
     add("huge", 1, true, [](size_t k) { return k == 0 ? 3e9f : float(k); });          // past int32: float
     add("count", 1, false, [](size_t k) { return float(k); });                        // not flagged: float
+    add("five", 5, true, [](size_t k) { return float(k % 7); });                      // int, a FIELD array
 
     writeMesh(mesh, path("m.ply"));
     const std::string bytes = readBytes(path("m.ply"));
     EXPECT_NE(bytes.find("property int id\nproperty int cell_x\nproperty int cell_y\nproperty int cell_z\n"
-                         "property float half\nproperty float huge\nproperty float count\nelement face"),
+                         "property float half\nproperty float huge\nproperty float count\nproperty int five_0\n"),
               std::string::npos);
     writeMesh(mesh, path("m.vtk"));
     const std::string vtk = readBytes(path("m.vtk"));
-    for (const char* header : {"SCALARS id int 1\n", "VECTORS cell int\n", "SCALARS half float 1\n",
-                               "SCALARS huge float 1\n", "SCALARS count float 1\n"}) {
+    const std::string field = "FIELD FieldData 1\nfive 5 " + std::to_string(n) + " int\n";
+    for (const std::string header : {"SCALARS id int 1\n", "VECTORS cell int\n", "SCALARS half float 1\n",
+                                     "SCALARS huge float 1\n", "SCALARS count float 1\n", field.c_str()}) {
         EXPECT_NE(vtk.find(header), std::string::npos) << header;
     }
     // Read back as particles: ints, each value exact.
@@ -358,6 +360,11 @@ TEST_F(WriteMeshTest, IntegerAttributesAreStoredAsIntsWhereEveryValueIsOne)
         ASSERT_NE(half, nullptr) << file;
         EXPECT_EQ(half->type, nonbloppy::ScalarType::Float32) << file;
         EXPECT_EQ(half->asDouble(1), 2.5) << file;
+        const nonbloppy::ParticleAttribute* five = back.findAttribute("five");  // PLY five_0..five_4, one attribute again
+        ASSERT_NE(five, nullptr) << file;
+        EXPECT_EQ(five->type, nonbloppy::ScalarType::Int32) << file;
+        EXPECT_EQ(five->components, 5) << file;
+        EXPECT_EQ(five->asDouble(1, 4), double((5 + 4) % 7)) << file;
     }
 }
 

@@ -181,6 +181,15 @@ TEST_F(CliTest, InspectListsAMeshsAttributesOnlyWhenTheyCanBeRead)
     r = run("inspect --json " + quote(out("nan.ply")));
     ASSERT_EQ(r.exitCode, 0) << r.err;
     EXPECT_NE(r.out.find("\"attributes\": null"), std::string::npos) << r.out;
+    // A VTK mesh's normals are not an attribute, whatever their array's name.
+    writeText(out("normals.vtk"), "# vtk DataFile Version 3.0\nm\nASCII\nDATASET POLYDATA\nPOINTS 3 float\n"
+                                  "0 0 0 1 0 0 0 1 0\nPOLYGONS 1 4\n3 0 1 2\nPOINT_DATA 3\nVECTORS vel float\n"
+                                  "1 2 3 4 5 6 7 8 9\nNORMALS Normals float\n0 0 2 0 0 1 0 0.5 1\n");
+    r = run("inspect " + quote(out("normals.vtk")));
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_NE(r.out.find("(with normals)"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("\n  attributes       vel  float32 x3\n"), std::string::npos) << r.out;
+    EXPECT_EQ(r.out.find("Normals"), std::string::npos) << r.out;
 }
 
 TEST_F(CliTest, InspectVdbListsDensityGrid)
@@ -568,6 +577,12 @@ TEST_F(CliTest, AFailedVdbWriteLeavesTheEarlierMeshInPlace)
     fs::remove(mesh);
     EXPECT_EQ(run("mesh " + quote(kCube) + " -q -o " + quote(mesh) + " --vdb /proc/nonbloppy.vdb").exitCode, 1);
     EXPECT_TRUE(listDir(out("")).empty());
+    // Through a link to a file yet to be written, which the writers follow: the undo removed
+    // the link and left the new file.
+    fs::create_symlink("target.obj", out("link.obj"));
+    EXPECT_EQ(run("mesh " + quote(kCube) + " -q -o " + quote(out("link.obj")) + " --vdb /proc/nonbloppy.vdb").exitCode, 1);
+    EXPECT_EQ(listDir(out("")), std::vector<std::string>{"link.obj"});
+    EXPECT_TRUE(fs::is_symlink(fs::symlink_status(out("link.obj"))));
 }
 
 TEST_F(CliTest, ASuccessfulRunOverEarlierOutputsLeavesOnlyTheNewOnes)

@@ -140,7 +140,7 @@ say "Per-particle wall time, 512x relative to 64x (1.00 = linear): $(
     paste -d' ' "$out/nb_512" "$out/nb_64" | awk '{printf "%s%.2f", (NR > 1 ? " " : ""), ($1 / 512) / ($4 / 64)}'
     # growth COLUMN TOOL: the per-particle growth of TOOL's (nb, vt) user (1) or system (2) time.
     growth() { awk -v a="$(median "$1" "$out/${2}_512.usersys")" -v b="$(median "$1" "$out/${2}_64.usersys")" \
-                 'BEGIN {printf "%.2f", (a / 512) / (b / 64)}'; }
+                 'BEGIN {if (b > 0) printf "%.2f", (a / 512) / (b / 64); else printf "-"}'; }
     printf '; user time alone: %s (vdb_tool: %s); system time alone: %s (vdb_tool: %s)' \
       "$(growth 1 nb)" "$(growth 1 vt)" "$(growth 2 nb)" "$(growth 2 vt)"
   else echo "not measured (--quick)"; fi)"
