@@ -10,6 +10,7 @@
 #include "../src/AtomicFile.h"
 #include "CliTestUtil.h"
 
+#include <nonbloppy/WriteParticles.h>
 #include <openvdb/version.h>
 
 #include <cmath>
@@ -30,6 +31,33 @@ const std::string kCube = kData + "/cube_2366_particles.vtk";
 class CliTest : public CliFixture
 {
 protected:
+    /// Starts `nonbloppy ARGS` with stderr to @a errFile; returns its pid, or 0 (a failure
+    /// added) if it could not be started.
+    pid_t spawnCli(const std::vector<std::string>& args, const std::string& errFile) const
+    {
+        std::vector<std::string> full{kCli};
+        full.insert(full.end(), args.begin(), args.end());
+        std::vector<char*> argv;
+        for (const std::string& a : full) argv.push_back(const_cast<char*>(a.c_str()));
+        argv.push_back(nullptr);
+        posix_spawn_file_actions_t actions;
+        posix_spawn_file_actions_init(&actions);
+        posix_spawn_file_actions_addopen(&actions, 2, errFile.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+        pid_t pid = 0;
+        const int spawned = posix_spawn(&pid, kCli.c_str(), &actions, nullptr, argv.data(), environ);
+        posix_spawn_file_actions_destroy(&actions);
+        if (spawned != 0) ADD_FAILURE() << "posix_spawn failed: " << spawned;
+        return spawned == 0 ? pid : 0;
+    }
+
+    /// Waits for @a pid; its exit status, or 128 + the signal that ended it.
+    static int exitStatusOf(pid_t pid)
+    {
+        int status = 0;
+        if (::waitpid(pid, &status, 0) != pid) ADD_FAILURE() << "waitpid failed";
+        return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+    }
+
     /// Mesh the cube into out/NAME.obj and out/NAME.vdb; returns the run.
     RunResult meshCube(const std::string& name, const std::string& extra = "") const
     {
@@ -721,16 +749,8 @@ TEST_F(CliTest, ConvertStopsOnASignalAndLeavesItsOutputAsItWas)
     ASSERT_EQ(::mkfifo(fifo.c_str(), 0644), 0);
     writeText(out("p.ply"), "old particles\n");
     const std::string errFile = dir() + "/stderr.txt";
-    const std::string output = out("p.ply");
-    std::vector<char*> argv{const_cast<char*>(kCli.c_str()), const_cast<char*>("convert"),
-                            const_cast<char*>(fifo.c_str()), const_cast<char*>(output.c_str()), nullptr};
-    posix_spawn_file_actions_t actions;
-    posix_spawn_file_actions_init(&actions);
-    posix_spawn_file_actions_addopen(&actions, 2, errFile.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    pid_t pid = 0;
-    const int spawned = posix_spawn(&pid, kCli.c_str(), &actions, nullptr, argv.data(), environ);
-    posix_spawn_file_actions_destroy(&actions);
-    ASSERT_EQ(spawned, 0);
+    const pid_t pid = spawnCli({"convert", fifo, out("p.ply")}, errFile);
+    ASSERT_NE(pid, 0);
     // SigCgt: the signals the process catches, in hex; SIGINT is bit 1.
     const auto catchesSigint = [&] {
         std::istringstream status(readText("/proc/" + std::to_string(pid) + "/status"));
@@ -748,13 +768,44 @@ TEST_F(CliTest, ConvertStopsOnASignalAndLeavesItsOutputAsItWas)
         std::ofstream feed(fifo, std::ios::binary);  // opens once convert opens its end
         feed << readText(kCube);
     }
-    int status = 0;
-    ASSERT_EQ(::waitpid(pid, &status, 0), pid);
-    ASSERT_TRUE(WIFEXITED(status)) << "killed by signal " << WTERMSIG(status);
-    EXPECT_EQ(WEXITSTATUS(status), 130);
+    EXPECT_EQ(exitStatusOf(pid), 130);
     EXPECT_EQ(readText(errFile), "nonbloppy: interrupted\n");
     EXPECT_EQ(listDir(dir() + "/out"), std::vector<std::string>{"p.ply"});
     EXPECT_EQ(readText(out("p.ply")), "old particles\n");
+}
+
+TEST_F(CliTest, ASignalWhileConvertWritesUndoesTheWrite)
+{
+    // A signal seen only once OUT is in place: the old OUT is put back. 400,000 particles
+    // to CSV (about 40 MB of text) take long enough to be caught writing, which the
+    // temporary file beside OUT shows. A machine so fast that the write ends before the
+    // signal lands gives exit 0 and the new OUT; never the new OUT with exit 130, nor a
+    // file left beside it.
+    nonbloppy::ParticleSet many;
+    for (int n = 0; n < 400000; ++n) many.positions.emplace_back(0.001f * float(n % 1000), 0.37f * float(n), 0.5f);
+    nonbloppy::writeParticles(many, in("many.xyz"));
+    writeText(out("p.csv"), "old particles\n");
+    const std::string errFile = dir() + "/stderr.txt";
+    const pid_t pid = spawnCli({"convert", "-q", in("many.xyz"), out("p.csv")}, errFile);
+    ASSERT_NE(pid, 0);
+    const auto writing = [&] {
+        for (const std::string& name : listDir(dir() + "/out")) {
+            if (name.find(".tmp-") != std::string::npos) return true;
+        }
+        return false;
+    };
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+    while (!writing() && std::chrono::steady_clock::now() < deadline) std::this_thread::yield();
+    ASSERT_EQ(::kill(pid, SIGINT), 0);
+    const int status = exitStatusOf(pid);
+    ASSERT_TRUE(status == 130 || status == 0) << status << ": " << readText(errFile);
+    EXPECT_EQ(listDir(dir() + "/out"), std::vector<std::string>{"p.csv"});
+    if (status == 130) {
+        EXPECT_EQ(readText(errFile), "nonbloppy: interrupted\n");
+        EXPECT_EQ(readText(out("p.csv")), "old particles\n");
+    } else {
+        EXPECT_EQ(readText(out("p.csv")).rfind("x,y,z\n", 0), 0u);
+    }
 }
 
 TEST_F(CliTest, AnOutputThatIsNotARegularFileIsRefusedBeforeAnyWork)
