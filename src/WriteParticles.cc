@@ -22,8 +22,10 @@
 #include <openvdb/points/PointDataGrid.h>
 #pragma GCC visibility pop
 
+#include <algorithm>
 #include <cctype>
 #include <charconv>
+#include <cstdint>
 #include <cstring>
 #include <functional>
 #include <limits>
@@ -152,6 +154,26 @@ writeXyz(const ParticleSet& particles, std::ostream& os)
     os.write(bytes.data(), std::streamsize(bytes.size()));
 }
 
+/// The type a 64-bit integer attribute @a a is written as in PLY, which has no 64-bit type:
+/// Int32 or UInt32 when every value fits (they stay integers, exact), else Float64.
+ScalarType
+plyTypeOf64(const ParticleAttribute& a)
+{
+    const size_t values = a.size() * size_t(a.components);
+    if (a.type == ScalarType::Int64) {
+        std::vector<int64_t> v(values);
+        std::memcpy(v.data(), a.bytes.data(), values * sizeof(int64_t));
+        const bool fits = std::all_of(v.begin(), v.end(), [](int64_t x) {
+            return x >= std::numeric_limits<int32_t>::min() && x <= std::numeric_limits<int32_t>::max();
+        });
+        return fits ? ScalarType::Int32 : ScalarType::Float64;
+    }
+    std::vector<uint64_t> v(values);
+    std::memcpy(v.data(), a.bytes.data(), values * sizeof(uint64_t));
+    const bool fits = std::all_of(v.begin(), v.end(), [](uint64_t x) { return x <= std::numeric_limits<uint32_t>::max(); });
+    return fits ? ScalarType::UInt32 : ScalarType::Float64;
+}
+
 const char*
 plyTypeName(ScalarType type)
 {
@@ -174,10 +196,13 @@ writePly(const ParticleSet& particles, std::ostream& os)
     header += "element vertex " + std::to_string(particles.size()) + "\n";
     header += "property float x\nproperty float y\nproperty float z\n";
     const std::vector<std::string> names = namesForExtension(particles, ".ply");
+    std::vector<ScalarType> written(particles.attributes.size());
     for (size_t i = 0; i < particles.attributes.size(); ++i) {
         const ParticleAttribute& a = particles.attributes[i];
+        const bool wide = a.type == ScalarType::Int64 || a.type == ScalarType::UInt64;
+        written[i] = wide ? plyTypeOf64(a) : a.type;
         for (const std::string& column : plyColumns(names[i], a.components)) {
-            header += std::string("property ") + plyTypeName(a.type) + " " + column + "\n";
+            header += std::string("property ") + plyTypeName(written[i]) + " " + column + "\n";
         }
     }
     header += "end_header\n";
@@ -186,16 +211,25 @@ writePly(const ParticleSet& particles, std::ostream& os)
     for (size_t n = 0; n < particles.size(); ++n) {
         row.clear();
         appendSwapped(row, reinterpret_cast<const unsigned char*>(&particles.positions[n]), 3, 4, false);
-        for (const ParticleAttribute& a : particles.attributes) {
+        for (size_t i = 0; i < particles.attributes.size(); ++i) {
+            const ParticleAttribute& a = particles.attributes[i];
             const size_t width = scalarSize(a.type);
             const unsigned char* values = a.bytes.data() + n * size_t(a.components) * width;
-            if (a.type == ScalarType::Int64 || a.type == ScalarType::UInt64) {
-                for (int c = 0; c < a.components; ++c) {
-                    const double value = a.asDouble(n, c);
-                    appendSwapped(row, reinterpret_cast<const unsigned char*>(&value), 1, 8, false);
-                }
-            } else {
+            if (written[i] == a.type) {
                 appendSwapped(row, values, size_t(a.components), width, false);
+                continue;
+            }
+            for (int c = 0; c < a.components; ++c) {  // a 64-bit integer, narrowed
+                const double value = a.asDouble(n, c);
+                if (written[i] == ScalarType::Float64) {
+                    appendSwapped(row, reinterpret_cast<const unsigned char*>(&value), 1, 8, false);
+                } else if (written[i] == ScalarType::Int32) {
+                    const int32_t narrow = int32_t(value);  // exact: it fits
+                    appendSwapped(row, reinterpret_cast<const unsigned char*>(&narrow), 1, 4, false);
+                } else {
+                    const uint32_t narrow = uint32_t(value);
+                    appendSwapped(row, reinterpret_cast<const unsigned char*>(&narrow), 1, 4, false);
+                }
             }
         }
         os.write(row.data(), std::streamsize(row.size()));

@@ -29,6 +29,7 @@
 #include <map>
 #include <sstream>
 #include <string>
+#include <tuple>
 #include <vector>
 
 namespace {
@@ -543,6 +544,43 @@ TEST_F(CliFormatsTest, WideIntegersSurviveAVdbOrAreRefused)
     EXPECT_EQ(message, "attribute 'h' holds 18446744073709551615, above 9223372036854775807, the largest integer "
                        "a .vdb stores");
     EXPECT_FALSE(std::filesystem::exists(path("huge.vdb")));
+}
+
+TEST_F(CliFormatsTest, PlyKeeps64BitIntegersAsIntegersWhereTheyFit32Bits)
+{
+    // PLY has no 64-bit type. They went out as double, so ids read back as floats (and were
+    // averaged by mesh --attributes); now as int or uint where every value fits.
+    ParticleSet particles;
+    particles.positions = {{0.0f, 0.0f, 0.0f}, {1.0f, 0.0f, 0.0f}};
+    const auto add = [&](const std::string& name, nonbloppy::ScalarType type, const void* values) {
+        ParticleAttribute a;
+        a.name = name;
+        a.type = type;
+        a.bytes.resize(2 * 8);
+        std::memcpy(a.bytes.data(), values, a.bytes.size());
+        particles.attributes.push_back(a);
+    };
+    const int64_t small[2] = {-2147483648LL, 2147483647LL};
+    const int64_t large[2] = {0, int64_t(1) << 40};
+    const uint64_t smallUnsigned[2] = {0, 4294967295ULL};
+    add("id", nonbloppy::ScalarType::Int64, small);
+    add("big", nonbloppy::ScalarType::Int64, large);
+    add("count", nonbloppy::ScalarType::UInt64, smallUnsigned);
+    nonbloppy::writeParticles(particles, path("p.ply"));
+    const std::string header = readText(path("p.ply")).substr(0, 200);
+    EXPECT_NE(header.find("property int id\nproperty double big\nproperty uint count\n"), std::string::npos) << header;
+    const ParticleSet back = nonbloppy::readParticles(path("p.ply"));
+    const std::vector<std::tuple<const char*, nonbloppy::ScalarType, double, double>> expected{
+        {"id", nonbloppy::ScalarType::Int32, -2147483648.0, 2147483647.0},
+        {"big", nonbloppy::ScalarType::Float64, 0.0, 1099511627776.0},
+        {"count", nonbloppy::ScalarType::UInt32, 0.0, 4294967295.0}};
+    for (const auto& [name, type, first, second] : expected) {
+        const ParticleAttribute* a = back.findAttribute(name);
+        ASSERT_NE(a, nullptr) << name;
+        EXPECT_EQ(a->type, type) << name;
+        EXPECT_EQ(a->asDouble(0), first) << name;
+        EXPECT_EQ(a->asDouble(1), second) << name;
+    }
 }
 
 TEST_F(CliFormatsTest, AVdbCannotHoldANonFinitePositionAndSaysSo)

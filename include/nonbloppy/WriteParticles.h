@@ -28,7 +28,8 @@ struct ParticleWriteSettings
 /// Write @a particles to @a path; the format follows the extension:
 /// - `.ply`  binary little-endian; float x y z, then each attribute component as a vertex
 ///           property in its type ("velocity_x/_y/_z" for 3-vectors, "name_<c>" for other
-///           multi-component attributes); 64-bit integers as double (PLY has none).
+///           multi-component attributes); 64-bit integers (PLY has none) as int or uint
+///           when every value fits 32 bits, which keeps them integers, else as double.
 /// - `.vtk`  legacy binary UNSTRUCTURED_GRID, float POINTS, one VTK_VERTEX cell per
 ///           particle, every attribute as a FIELD array in its type.
 /// - `.vtu`  VTK XML UnstructuredGrid, raw appended data with UInt64 headers, Float32
