@@ -53,7 +53,6 @@ struct SortedAttribute
     std::vector<double> values;  ///< sorted slot × components
 };
 
-
 /// Fill the attribute values of a range of vertices.
 struct InterpolateOp
 {
