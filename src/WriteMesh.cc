@@ -132,13 +132,15 @@ inline char* put4(char* at, T value)
 }
 
 /// True if @a attribute is to be stored as 32-bit ints: flagged as integer, and every value
-/// a whole number within int32's range (else floats, which hold any value it has).
+/// a whole number a float holds exactly (|v| ≤ 2^24). Past that, a float value may be an id
+/// rounded to its neighbour's, and an int column would pass it off as exact: floats then.
 bool
 storedAsInt(const MeshAttribute& attribute)
 {
     if (!attribute.integer) return false;
+    constexpr float kExactIntegers = 16777216.0f;  // 2^24
     return std::all_of(attribute.values.begin(), attribute.values.end(), [](float v) {
-        return v == std::trunc(v) && v >= -2147483648.0f && v < 2147483648.0f;  // NaN fails the first test
+        return v == std::trunc(v) && std::abs(v) <= kExactIntegers;  // NaN fails the first test
     });
 }
 

@@ -318,8 +318,8 @@ TEST_F(WriteMeshTest, AttributeNamesStayDistinctFromEachOtherAndFromTheFormatsCo
 TEST_F(WriteMeshTest, IntegerAttributesAreStoredAsIntsWhereEveryValueIsOne)
 {
     // Ids carried to the vertices (MeshAttribute::integer) were float properties, which a
-    // reader takes for a measured quantity. Now int, where every value is a whole number in
-    // int32's range; otherwise float, which holds whatever the values are.
+    // reader takes for a measured quantity. Now int, where every value is a whole number a
+    // float holds exactly (up to 2^24); otherwise float, which does not claim exactness.
     SurfaceMesh mesh = mixedMesh();
     const size_t n = mesh.points.size();
     const auto add = [&](const std::string& name, int components, bool integer, const std::function<float(size_t)>& value) {
@@ -333,7 +333,7 @@ TEST_F(WriteMeshTest, IntegerAttributesAreStoredAsIntsWhereEveryValueIsOne)
     add("id", 1, true, [](size_t k) { return float(16777216 - int(k)); });          // int
     add("cell", 3, true, [](size_t k) { return -float(k); });                         // int, VECTORS
     add("half", 1, true, [](size_t k) { return k == 1 ? 2.5f : float(k); });          // not whole: float
-    add("huge", 1, true, [](size_t k) { return k == 0 ? 3e9f : float(k); });          // past int32: float
+    add("huge", 1, true, [](size_t k) { return k == 0 ? 16777218.0f : float(k); });   // past 2^24: float
     add("count", 1, false, [](size_t k) { return float(k); });                        // not flagged: float
     add("five", 5, true, [](size_t k) { return float(k % 7); });                      // int, a FIELD array
 

@@ -21,7 +21,8 @@ struct MeshAttribute
     std::vector<float> values;   ///< points.size() × components values, vertex-major
     /// The values count or name things (ids, flags: an integer particle attribute, which
     /// interpolateAttributes() carries as the nearest particle's value). writeMesh() then
-    /// stores them as 32-bit integers, if every one is a whole number in that range.
+    /// stores them as 32-bit integers if every one is a whole number within ±2^24, which
+    /// float values hold exactly (beyond, they may have been rounded: floats then).
     bool integer = false;
 };
 
