@@ -159,6 +159,36 @@ protected:
     }
 
     /// Starts `nonbloppy ARGS` (unquoted arguments) with stdout to /dev/null and stderr to
+    /// @a errFile; returns its pid, or 0 (a failure added) if it could not be started.
+    pid_t spawnCli(const std::vector<std::string>& args, const std::string& errFile) const
+    {
+        std::vector<std::string> full = {kCli};
+        full.insert(full.end(), args.begin(), args.end());
+        std::vector<char*> argv;
+        for (const std::string& a : full) argv.push_back(const_cast<char*>(a.c_str()));
+        argv.push_back(nullptr);
+        posix_spawn_file_actions_t actions;
+        posix_spawn_file_actions_init(&actions);
+        posix_spawn_file_actions_addopen(&actions, 1, "/dev/null", O_WRONLY, 0);
+        posix_spawn_file_actions_addopen(&actions, 2, errFile.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+        pid_t pid = 0;
+        const int spawned = posix_spawn(&pid, kCli.c_str(), &actions, nullptr, argv.data(), environ);
+        posix_spawn_file_actions_destroy(&actions);
+        if (spawned != 0) ADD_FAILURE() << "posix_spawn failed: " << spawned;
+        return spawned == 0 ? pid : 0;
+    }
+
+    /// Waits for @a pid: its exit status, or 128 + the signal that ended it (also stored in
+    /// @a killedBy, 0 for an exit).
+    static int waitForExit(pid_t pid, int* killedBy = nullptr)
+    {
+        int status = 0;
+        if (::waitpid(pid, &status, 0) != pid) ADD_FAILURE() << "waitpid failed";
+        if (killedBy) *killedBy = WIFSIGNALED(status) ? WTERMSIG(status) : 0;
+        return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+    }
+
+    /// Starts `nonbloppy ARGS` (unquoted arguments) with stdout to /dev/null and stderr to
     /// stderr.txt; waits until @a ready holds for that stderr (at most 30 s), sends @a signal
     /// @a times times, @a gap apart, and waits for the exit. Returns how it ended and the
     /// stderr text.
@@ -167,24 +197,9 @@ protected:
                             int times = 1, std::chrono::milliseconds gap = std::chrono::milliseconds(0)) const
     {
         const std::string errFile = mDir + "/stderr.txt";
-        std::vector<std::string> full = {kCli};
-        full.insert(full.end(), args.begin(), args.end());
-        std::vector<char*> argv;
-        for (const std::string& a : full) argv.push_back(const_cast<char*>(a.c_str()));
-        argv.push_back(nullptr);
-
-        posix_spawn_file_actions_t actions;
-        posix_spawn_file_actions_init(&actions);
-        posix_spawn_file_actions_addopen(&actions, 1, "/dev/null", O_WRONLY, 0);
-        posix_spawn_file_actions_addopen(&actions, 2, errFile.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-        pid_t pid = 0;
         RunResult result;
-        const int spawned = posix_spawn(&pid, kCli.c_str(), &actions, nullptr, argv.data(), environ);
-        posix_spawn_file_actions_destroy(&actions);
-        if (spawned != 0) {
-            ADD_FAILURE() << "posix_spawn failed: " << spawned;
-            return result;
-        }
+        const pid_t pid = spawnCli(args, errFile);
+        if (pid == 0) return result;
         const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(30);
         while (!ready(readText(errFile)) && std::chrono::steady_clock::now() < deadline) {
             std::this_thread::sleep_for(std::chrono::milliseconds(5));
@@ -193,10 +208,7 @@ protected:
             if (n > 0) std::this_thread::sleep_for(gap);
             ::kill(pid, signal);
         }
-        int status = 0;
-        if (::waitpid(pid, &status, 0) != pid) ADD_FAILURE() << "waitpid failed";
-        result.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-        result.killedBy = WIFSIGNALED(status) ? WTERMSIG(status) : 0;
+        result.exitCode = waitForExit(pid, &result.killedBy);
         result.err = readText(errFile);
         return result;
     }

@@ -31,33 +31,6 @@ const std::string kCube = kData + "/cube_2366_particles.vtk";
 class CliTest : public CliFixture
 {
 protected:
-    /// Starts `nonbloppy ARGS` with stderr to @a errFile; returns its pid, or 0 (a failure
-    /// added) if it could not be started.
-    pid_t spawnCli(const std::vector<std::string>& args, const std::string& errFile) const
-    {
-        std::vector<std::string> full{kCli};
-        full.insert(full.end(), args.begin(), args.end());
-        std::vector<char*> argv;
-        for (const std::string& a : full) argv.push_back(const_cast<char*>(a.c_str()));
-        argv.push_back(nullptr);
-        posix_spawn_file_actions_t actions;
-        posix_spawn_file_actions_init(&actions);
-        posix_spawn_file_actions_addopen(&actions, 2, errFile.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-        pid_t pid = 0;
-        const int spawned = posix_spawn(&pid, kCli.c_str(), &actions, nullptr, argv.data(), environ);
-        posix_spawn_file_actions_destroy(&actions);
-        if (spawned != 0) ADD_FAILURE() << "posix_spawn failed: " << spawned;
-        return spawned == 0 ? pid : 0;
-    }
-
-    /// Waits for @a pid; its exit status, or 128 + the signal that ended it.
-    static int exitStatusOf(pid_t pid)
-    {
-        int status = 0;
-        if (::waitpid(pid, &status, 0) != pid) ADD_FAILURE() << "waitpid failed";
-        return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-    }
-
     /// Mesh the cube into out/NAME.obj and out/NAME.vdb; returns the run.
     RunResult meshCube(const std::string& name, const std::string& extra = "") const
     {
@@ -768,7 +741,7 @@ TEST_F(CliTest, ConvertStopsOnASignalAndLeavesItsOutputAsItWas)
         std::ofstream feed(fifo, std::ios::binary);  // opens once convert opens its end
         feed << readText(kCube);
     }
-    EXPECT_EQ(exitStatusOf(pid), 130);
+    EXPECT_EQ(waitForExit(pid), 130);
     EXPECT_EQ(readText(errFile), "nonbloppy: interrupted\n");
     EXPECT_EQ(listDir(dir() + "/out"), std::vector<std::string>{"p.ply"});
     EXPECT_EQ(readText(out("p.ply")), "old particles\n");
@@ -797,7 +770,7 @@ TEST_F(CliTest, ASignalWhileConvertWritesUndoesTheWrite)
     const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(30);
     while (!writing() && std::chrono::steady_clock::now() < deadline) std::this_thread::yield();
     ASSERT_EQ(::kill(pid, SIGINT), 0);
-    const int status = exitStatusOf(pid);
+    const int status = waitForExit(pid);
     ASSERT_TRUE(status == 130 || status == 0) << status << ": " << readText(errFile);
     EXPECT_EQ(listDir(dir() + "/out"), std::vector<std::string>{"p.csv"});
     if (status == 130) {
