@@ -40,7 +40,7 @@ void OutputCleanup::willWrite(const std::string& path)
 {
     // Undone through the target: removing @a path itself would delete the user's link to a
     // file that did not exist yet and leave the new file behind.
-    Output output{path, writtenFile(path), "", false};
+    Output output{writtenFile(path), "", false};
     struct stat existing{};
     if (::stat(output.target.c_str(), &existing) == 0) {
         const std::string backup = output.target + ".nonbloppy-old-" + std::to_string(::getpid());

@@ -42,7 +42,6 @@ public:
 private:
     struct Output
     {
-        std::string path;    ///< as given
         std::string target;  ///< the file it names (links followed, also to a file yet to be)
         std::string backup;  ///< hard link to the replaced file, or empty
         bool written;
