@@ -159,19 +159,16 @@ writeXyz(const ParticleSet& particles, std::ostream& os)
 ScalarType
 plyTypeOf64(const ParticleAttribute& a)
 {
-    const size_t values = a.size() * size_t(a.components);
-    if (a.type == ScalarType::Int64) {
-        std::vector<int64_t> v(values);
-        std::memcpy(v.data(), a.bytes.data(), values * sizeof(int64_t));
-        const bool fits = std::all_of(v.begin(), v.end(), [](int64_t x) {
-            return x >= std::numeric_limits<int32_t>::min() && x <= std::numeric_limits<int32_t>::max();
-        });
-        return fits ? ScalarType::Int32 : ScalarType::Float64;
+    const bool isSigned = a.type == ScalarType::Int64;
+    const int64_t lowest = isSigned ? std::numeric_limits<int32_t>::min() : 0;
+    const int64_t highest = isSigned ? std::numeric_limits<int32_t>::max() : std::numeric_limits<uint32_t>::max();
+    for (size_t at = 0; at < a.bytes.size(); at += 8) {
+        int64_t value = 0;  // integerValue() is false for a uint64 past int64
+        if (!io_internal::integerValue(a.bytes.data() + at, a.type, value) || value < lowest || value > highest) {
+            return ScalarType::Float64;
+        }
     }
-    std::vector<uint64_t> v(values);
-    std::memcpy(v.data(), a.bytes.data(), values * sizeof(uint64_t));
-    const bool fits = std::all_of(v.begin(), v.end(), [](uint64_t x) { return x <= std::numeric_limits<uint32_t>::max(); });
-    return fits ? ScalarType::UInt32 : ScalarType::Float64;
+    return isSigned ? ScalarType::Int32 : ScalarType::UInt32;
 }
 
 const char*
