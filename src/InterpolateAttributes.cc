@@ -163,7 +163,7 @@ interpolateAttributes(SurfaceMesh& mesh, const ParticleSet& particles,
             const ParticleAttribute& attribute = *attributes[a];
             sorted[a].name = attribute.name;
             sorted[a].components = attribute.components;
-            sorted[a].nearest = isIntegerType(attribute.type);
+            sorted[a].nearest = out[a].integer;
             sorted[a].values.resize(particles.size() * size_t(attribute.components));
             totalComponents += attribute.components;
             const std::vector<uint32_t>& original = index.originalIndex;

@@ -138,9 +138,8 @@ bool
 storedAsInt(const MeshAttribute& attribute)
 {
     if (!attribute.integer) return false;
-    constexpr float kExactIntegers = 16777216.0f;  // 2^24
     return std::all_of(attribute.values.begin(), attribute.values.end(), [](float v) {
-        return v == std::trunc(v) && std::abs(v) <= kExactIntegers;  // NaN fails the first test
+        return v == std::trunc(v) && std::abs(v) <= kMaxExactAttributeInteger;  // NaN fails the first test
     });
 }
 

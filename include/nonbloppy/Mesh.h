@@ -12,6 +12,10 @@
 
 namespace nonbloppy {
 
+/// The largest magnitude up to which every integer is exact as a MeshAttribute value
+/// (float32): 2^24. Ids beyond it may round to a neighbour's.
+constexpr float kMaxExactAttributeInteger = 16777216.0f;
+
 /// A per-vertex attribute carried by a mesh (e.g. "velocity" interpolated from the
 /// particles): values[i * components + c] is component c of vertex i.
 struct MeshAttribute
@@ -21,8 +25,8 @@ struct MeshAttribute
     std::vector<float> values;   ///< points.size() × components values, vertex-major
     /// The values count or name things (ids, flags: an integer particle attribute, which
     /// interpolateAttributes() carries as the nearest particle's value). writeMesh() then
-    /// stores them as 32-bit integers if every one is a whole number within ±2^24, which
-    /// float values hold exactly (beyond, they may have been rounded: floats then).
+    /// stores them as 32-bit integers if every one is a whole number within
+    /// ±kMaxExactAttributeInteger (beyond, they may have been rounded: floats then).
     bool integer = false;
 };
 

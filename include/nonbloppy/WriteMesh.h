@@ -39,11 +39,12 @@ struct MeshWriteSettings
 /// float vertex properties ("density"; a 3-vector "velocity" as velocity_x, velocity_y,
 /// velocity_z) and as VTK POINT_DATA (VECTORS for 3 components, SCALARS for 1, 2 or 4, a
 /// FIELD array otherwise); as int instead of float where MeshAttribute::integer is set and
-/// every value is a whole number within ±2^24 (ids; beyond, float values may be rounded). OBJ has no place for them: they are left out. Names are written
-/// as writeParticles() writes them (whitespace, control and non-ASCII bytes, ',', '"', '<',
-/// '>' and '&' become '_') and kept distinct from one another and from the format's own
-/// columns (PLY x, y, z and, with normals, nx, ny, nz; the VTK normals array "normals"):
-/// such a name gets _2, _3, ... (writtenAttributeNames() tells which).
+/// every value is a whole number within ±kMaxExactAttributeInteger (2^24; ids). OBJ has no
+/// place for them: they are left out. Names are written as writeParticles() writes them
+/// (whitespace, control and non-ASCII bytes, ',', '"', '<', '>' and '&' become '_') and
+/// kept distinct from one another and from the format's own columns (PLY x, y, z and,
+/// with normals, nx, ny, nz; the VTK normals array "normals"): such a name gets _2, _3,
+/// ... (writtenAttributeNames() tells which).
 /// Cost: one pass; output is formatted into multi-megabyte chunks.
 /// Thread-safety: reentrant; concurrent calls must write different paths.
 /// @throw FileError for an unknown extension or a file that cannot be written, e.g.

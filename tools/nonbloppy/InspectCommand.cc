@@ -245,15 +245,6 @@ std::optional<std::vector<nonbloppy::ParticleAttribute>> meshVertexAttributes(co
         // PLY normals are the properties nx, ny, nz; a VTK file's are the array readMesh()
         // took for them, whatever its name (a NORMALS section, or an array called normals or
         // Normals): the first of three components that holds the same values.
-        const auto holdsTheNormals = [&](const nonbloppy::ParticleAttribute& a) {
-            if (a.components != 3 || a.size() != mesh.normals.size()) return false;
-            for (size_t n = 0; n < a.size(); ++n) {
-                for (int c = 0; c < 3; ++c) {
-                    if (float(a.asDouble(n, c)) != mesh.normals[n][c]) return false;
-                }
-            }
-            return true;
-        };
         if (ext == ".ply") {
             attributes.erase(std::remove_if(attributes.begin(), attributes.end(),
                                             [](const nonbloppy::ParticleAttribute& a) {
@@ -261,6 +252,15 @@ std::optional<std::vector<nonbloppy::ParticleAttribute>> meshVertexAttributes(co
                                             }),
                              attributes.end());
         } else {
+            const auto holdsTheNormals = [&](const nonbloppy::ParticleAttribute& a) {
+                if (a.components != 3 || a.size() != mesh.normals.size()) return false;
+                for (size_t n = 0; n < a.size(); ++n) {
+                    for (int c = 0; c < 3; ++c) {
+                        if (float(a.asDouble(n, c)) != mesh.normals[n][c]) return false;
+                    }
+                }
+                return true;
+            };
             const auto normals = std::find_if(attributes.begin(), attributes.end(), holdsTheNormals);
             if (normals != attributes.end()) attributes.erase(normals);
         }

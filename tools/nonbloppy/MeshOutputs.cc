@@ -74,14 +74,13 @@ void requireAttributes(const nonbloppy::ParticleSet& particles, const MeshOutput
 /// its values are float32 there.
 void warnIfIntegersRound(const nonbloppy::ParticleSet& particles, const std::vector<std::string>& names)
 {
-    constexpr double kExactFloatIntegers = 16777216.0;  // 2^24
     if (gRoundingWarningPrinted) return;  // the scan is for the first frame that needs it
     for (const std::string& name : nonbloppy::resolveAttributeNames(particles, names)) {
         const nonbloppy::ParticleAttribute& a = *particles.findAttribute(name);
         if (!nonbloppy::isIntegerType(a.type)) continue;
-        const size_t values = a.size() * size_t(a.components);
-        for (size_t v = 0; v < values; ++v) {
-            if (std::abs(a.asDouble(v / size_t(a.components), int(v % size_t(a.components)))) > kExactFloatIntegers) {
+        for (size_t n = 0; n < a.size(); ++n) {
+            for (int c = 0; c < a.components; ++c) {
+                if (std::abs(a.asDouble(n, c)) <= nonbloppy::kMaxExactAttributeInteger) continue;
                 if (!gRoundingWarningPrinted.exchange(true)) {
                     std::cerr << "nonbloppy: warning: attribute '" << name << "' holds integers beyond 2^24 = "
                                  "16777216, which the mesh's float32 values round" << std::endl;
