@@ -410,6 +410,49 @@ integerValue(const unsigned char* p, ScalarType type, int64_t& value)
     }
 }
 
+ScalarType
+plyIntegerType(int64_t lowest, int64_t highest)
+{
+    if (lowest >= std::numeric_limits<int32_t>::min() && highest <= std::numeric_limits<int32_t>::max()) {
+        return ScalarType::Int32;
+    }
+    if (lowest >= 0 && highest <= int64_t(std::numeric_limits<uint32_t>::max())) return ScalarType::UInt32;
+    return ScalarType::Float64;
+}
+
+const char*
+plyTypeName(ScalarType type)
+{
+    switch (type) {
+    case ScalarType::Int8: return "char";
+    case ScalarType::UInt8: return "uchar";
+    case ScalarType::Int16: return "short";
+    case ScalarType::UInt16: return "ushort";
+    case ScalarType::Int32: return "int";
+    case ScalarType::UInt32: return "uint";
+    case ScalarType::Float32: return "float";
+    default: return "double";  // Float64, and 64-bit integers (PLY has none)
+    }
+}
+
+const char*
+vtkTypeName(ScalarType type)
+{
+    switch (type) {
+    case ScalarType::Int8: return "char";
+    case ScalarType::UInt8: return "unsigned_char";
+    case ScalarType::Int16: return "short";
+    case ScalarType::UInt16: return "unsigned_short";
+    case ScalarType::Int32: return "int";
+    case ScalarType::UInt32: return "unsigned_int";
+    case ScalarType::Int64: return "vtktypeint64";
+    case ScalarType::UInt64: return "vtktypeuint64";
+    case ScalarType::Float32: return "float";
+    case ScalarType::Float64: return "double";
+    }
+    return "double";
+}
+
 // ------------------------------------------------------------------------------------------
 // Inputs and typed values
 

@@ -171,6 +171,18 @@ void swapInPlace(unsigned char* data, size_t count, size_t width);
 /// Integer value of @a p (native bytes of integer @a type); false if it does not fit int64.
 bool integerValue(const unsigned char* p, ScalarType type, int64_t& value);
 
+/// The type integers within [@a lowest, @a highest] are written as in PLY, which has no
+/// 64-bit integers: Int32, else UInt32, where every one fits (exact), else Float64 (exact
+/// within ±2^53). An empty range (lowest > highest) gives Int32.
+ScalarType plyIntegerType(int64_t lowest, int64_t highest);
+
+/// The PLY property type name of @a type ("float", "int", ...); "double" for the 64-bit
+/// integers, which PLY lacks (see plyIntegerType()).
+const char* plyTypeName(ScalarType type);
+
+/// The legacy VTK data type name of @a type ("float", "unsigned_int", "vtktypeint64", ...).
+const char* vtkTypeName(ScalarType type);
+
 /// The native value of @a type at @a p as double.
 double valueAsDouble(const unsigned char* p, ScalarType type);
 

@@ -3,6 +3,7 @@
 /// @brief Kernel-weighted particle attributes at mesh vertices, through the particle index.
 
 #include "Cancellation.h"
+#include "FileFormats.h"
 #include "ParameterChecks.h"
 #include "ParticleIndexImpl.h"
 
@@ -14,6 +15,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
+#include <limits>
 #include <sstream>
 
 namespace nonbloppy {
@@ -45,12 +48,12 @@ namespace {
 /// One attribute's values in the index's sorted order, so the inner loop streams.
 struct SortedAttribute
 {
-    std::string name;
     int components = 1;
     /// Integers name or count things (ids, flags, material indices), and a mean of two ids
-    /// is neither: they take the nearest particle's value instead.
+    /// is neither: they take the nearest particle's value instead, exactly.
     bool nearest = false;
-    std::vector<double> values;  ///< sorted slot × components
+    std::vector<double> values;     ///< sorted slot × components, unless nearest
+    std::vector<int64_t> integers;  ///< sorted slot × components, if nearest
 };
 
 /// Fill the attribute values of a range of vertices.
@@ -60,7 +63,8 @@ struct InterpolateOp
     const ParticleIndex::Impl& index;
     const std::vector<SortedAttribute>& attributes;
     std::vector<MeshAttribute>& out;
-    int totalComponents;
+    int meanComponents;   ///< components of the attributes that are means
+    bool anyNearest;      ///< whether some attribute takes the nearest particle's value
     float effectiveRadius;
     cancellation_internal::CancelPoll& poll;
 
@@ -71,7 +75,7 @@ struct InterpolateOp
         if (poll.stopped()) return;
         openvdb::tree::ValueAccessor<const particle_index_internal::IndexTree> accessor(index.grid->tree());
         const std::vector<openvdb::Vec3f>& positions = index.sortedPositions;
-        std::vector<double> sums(static_cast<size_t>(totalComponents));
+        std::vector<double> sums(static_cast<size_t>(meanComponents));
         const double r = effectiveRadius;
         for (size_t i = range.begin(); i < range.end(); ++i) {
             const openvdb::Vec3f v = mesh.points[i];
@@ -89,35 +93,32 @@ struct InterpolateOp
                         const float w = mpsWeightSquared(distanceSqr, effectiveRadius);
                         if (w == 0.0f) continue;
                         weightSum += w;
-                        if (nearest == kNone || distanceSqr < nearestDistanceSqr
-                            || (distanceSqr == nearestDistanceSqr && index.originalIndex[k] < index.originalIndex[nearest])) {
+                        if (anyNearest && (nearest == kNone || distanceSqr < nearestDistanceSqr
+                            || (distanceSqr == nearestDistanceSqr && index.originalIndex[k] < index.originalIndex[nearest]))) {
                             nearestDistanceSqr = distanceSqr;
                             nearest = k;
                         }
                         size_t s = 0;
                         for (const SortedAttribute& a : attributes) {
-                            if (a.nearest) {
-                                s += size_t(a.components);
-                                continue;
-                            }
+                            if (a.nearest) continue;
                             const double* value = a.values.data() + size_t(k) * size_t(a.components);
                             for (int c = 0; c < a.components; ++c) sums[s++] += double(w) * value[c];
                         }
                     }
                 });
+            // No particle within r_e (weightSum 0): the values stay the zeros they were made.
+            if (weightSum == 0.0) continue;
             size_t s = 0;
             for (size_t a = 0; a < attributes.size(); ++a) {
                 const SortedAttribute& attribute = attributes[a];
-                float* dst = out[a].values.data() + i * size_t(attribute.components);
-                for (int c = 0; c < attribute.components; ++c, ++s) {
-                    if (nearest == kNone) {
-                        dst[c] = 0.0f;
-                    } else if (attribute.nearest) {
-                        dst[c] = float(attribute.values[size_t(nearest) * size_t(attribute.components) + size_t(c)]);
-                    } else {
-                        dst[c] = float(sums[s] / weightSum);
-                    }
+                const size_t components = size_t(attribute.components);
+                if (attribute.nearest) {
+                    std::copy_n(attribute.integers.data() + size_t(nearest) * components, components,
+                                out[a].integers.data() + i * components);
+                    continue;
                 }
+                float* dst = out[a].values.data() + i * components;
+                for (size_t c = 0; c < components; ++c) dst[c] = float(sums[s++] / weightSum);
             }
         }
     }
@@ -141,6 +142,16 @@ interpolateAttributes(SurfaceMesh& mesh, const ParticleSet& particles,
                                  std::to_string(attribute.size()) + " values for " +
                                  std::to_string(particles.size()) + " particles");
         }
+        if (attribute.type == ScalarType::UInt64) {
+            for (size_t at = 0; at < attribute.bytes.size(); at += 8) {
+                uint64_t value;
+                std::memcpy(&value, attribute.bytes.data() + at, 8);
+                if (value > uint64_t(std::numeric_limits<int64_t>::max())) {
+                    throw ParameterError("attribute '" + attribute.name + "' holds " + std::to_string(value) +
+                                         ", above 9223372036854775807, the largest integer a mesh attribute holds");
+                }
+            }
+        }
         attributes.push_back(&attribute);
     }
 
@@ -149,7 +160,9 @@ interpolateAttributes(SurfaceMesh& mesh, const ParticleSet& particles,
         out[a].name = attributes[a]->name;
         out[a].components = attributes[a]->components;
         out[a].integer = isIntegerType(attributes[a]->type);
-        out[a].values.resize(mesh.points.size() * size_t(attributes[a]->components));  // zeros
+        const size_t count = mesh.points.size() * size_t(attributes[a]->components);
+        if (out[a].integer) out[a].integers.resize(count);  // zeros
+        else out[a].values.resize(count);
     }
     if (!attributes.empty() && !mesh.points.empty()) {
         const cancellation_internal::AnnouncedStage announced(interrupter, "interpolate attributes");
@@ -158,27 +171,40 @@ interpolateAttributes(SurfaceMesh& mesh, const ParticleSet& particles,
         const ParticleIndex particleIndex = ParticleIndex::build(particles.positions, effectiveRadius);
         const ParticleIndex::Impl& index = particleIndex.impl();
         std::vector<SortedAttribute> sorted(attributes.size());
-        int totalComponents = 0;
+        int meanComponents = 0;
+        bool anyNearest = false;
         for (size_t a = 0; a < attributes.size(); ++a) {
             const ParticleAttribute& attribute = *attributes[a];
-            sorted[a].name = attribute.name;
-            sorted[a].components = attribute.components;
-            sorted[a].nearest = out[a].integer;
-            sorted[a].values.resize(particles.size() * size_t(attribute.components));
-            totalComponents += attribute.components;
+            const size_t components = size_t(attribute.components);
+            SortedAttribute& to = sorted[a];
+            to.components = attribute.components;
+            to.nearest = out[a].integer;
+            if (to.nearest) {
+                to.integers.resize(particles.size() * components);
+                anyNearest = true;
+            } else {
+                to.values.resize(particles.size() * components);
+                meanComponents += attribute.components;
+            }
             const std::vector<uint32_t>& original = index.originalIndex;
+            const size_t width = scalarSize(attribute.type);
             tbb::parallel_for(tbb::blocked_range<size_t>(0, original.size()),
                 [&](const tbb::blocked_range<size_t>& range) {
                     for (size_t k = range.begin(); k < range.end(); ++k) {
-                        for (int c = 0; c < attribute.components; ++c) {
-                            sorted[a].values[k * size_t(attribute.components) + size_t(c)] =
-                                attribute.asDouble(original[k], c);
+                        for (size_t c = 0; c < components; ++c) {
+                            const size_t from = size_t(original[k]) * components + c;
+                            if (to.nearest) {  // exact: a uint64 past int64 was refused above
+                                io_internal::integerValue(attribute.bytes.data() + from * width, attribute.type,
+                                                          to.integers[k * components + c]);
+                            } else {
+                                to.values[k * components + c] = attribute.asDouble(original[k], int(c));
+                            }
                         }
                     }
                 });
         }
         tbb::parallel_for(tbb::blocked_range<size_t>(0, mesh.points.size(), 256),
-            InterpolateOp{mesh, index, sorted, out, totalComponents, float(effectiveRadius), poll});
+            InterpolateOp{mesh, index, sorted, out, meanComponents, anyNearest, float(effectiveRadius), poll});
         poll.throwIfStopped();
     }
 

@@ -131,23 +131,43 @@ inline char* put4(char* at, T value)
     return at + 4;
 }
 
-/// True if @a attribute is to be stored as 32-bit ints: flagged as integer, and every value
-/// a whole number a float holds exactly (|v| ≤ 2^24). Past that, a float value may be an id
-/// rounded to its neighbour's, and an int column would pass it off as exact: floats then.
-bool
-storedAsInt(const MeshAttribute& attribute)
+/// Stores @a value's 8 bytes at @a at in the given byte order; returns the next position.
+template<bool BigEndian, typename T>
+inline char* put8(char* at, T value)
 {
-    if (!attribute.integer) return false;
-    return std::all_of(attribute.values.begin(), attribute.values.end(), [](float v) {
-        return v == std::trunc(v) && std::abs(v) <= kMaxExactAttributeInteger;  // NaN fails the first test
-    });
+    static_assert(sizeof(T) == 8, "8-byte values only");
+    uint64_t bits;
+    std::memcpy(&bits, &value, 8);
+    if ((__BYTE_ORDER__ == __ORDER_BIG_ENDIAN__) != BigEndian) bits = __builtin_bswap64(bits);
+    std::memcpy(at, &bits, 8);
+    return at + 8;
 }
 
-/// Stores @a value (a float, or a whole number as a 4-byte int when @a asInt) at @a at.
-template<bool BigEndian>
-inline char* putValue(char* at, float value, bool asInt)
+/// The type @a attribute's values are stored as: Float32 for floats; for integers the
+/// narrowest that holds every one exactly, Int32 or (VTK: Int64, PLY: UInt32 or Float64).
+ScalarType
+storedType(const MeshAttribute& attribute, bool vtk)
 {
-    return asInt ? put4<BigEndian>(at, int32_t(value)) : put4<BigEndian>(at, value);
+    if (!attribute.integer) return ScalarType::Float32;
+    const auto range = std::minmax_element(attribute.integers.begin(), attribute.integers.end());
+    const int64_t lowest = attribute.integers.empty() ? 0 : *range.first;
+    const int64_t highest = attribute.integers.empty() ? 0 : *range.second;
+    const ScalarType ply = io_internal::plyIntegerType(lowest, highest);
+    return vtk && ply != ScalarType::Int32 ? ScalarType::Int64 : ply;
+}
+
+/// Stores element @a i of @a attribute as @a type (storedType()) at @a at; returns the next
+/// position.
+template<bool BigEndian>
+inline char* putValue(char* at, const MeshAttribute& attribute, size_t i, ScalarType type)
+{
+    switch (type) {
+    case ScalarType::Float32: return put4<BigEndian>(at, attribute.values[i]);
+    case ScalarType::Int32: return put4<BigEndian>(at, int32_t(attribute.integers[i]));
+    case ScalarType::UInt32: return put4<BigEndian>(at, uint32_t(attribute.integers[i]));
+    case ScalarType::Int64: return put8<BigEndian>(at, attribute.integers[i]);
+    default: return put8<BigEndian>(at, double(attribute.integers[i]));
+    }
 }
 
 /// Writes @a count records of @a recordBytes each, record i encoded by
@@ -237,12 +257,16 @@ validateMesh(const SurfaceMesh& mesh, const std::string& path)
             " normals for " + std::to_string(vertexCount) + " vertices (" + path + ")");
     }
     for (const MeshAttribute& attribute : mesh.attributes) {
-        if (attribute.components < 1
-            || attribute.values.size() != vertexCount * size_t(attribute.components)) {
+        if (attribute.components < 1 || attribute.size() != vertexCount * size_t(attribute.components)) {
             throw ParameterError("mesh attribute '" + attribute.name + "' has " +
-                std::to_string(attribute.values.size()) + " values for " +
+                std::to_string(attribute.size()) + " values for " +
                 std::to_string(vertexCount) + " vertices of " +
                 std::to_string(attribute.components) + " components (" + path + ")");
+        }
+        if (attribute.integer ? !attribute.values.empty() : !attribute.integers.empty()) {
+            throw ParameterError("mesh attribute '" + attribute.name + "' has " +
+                (attribute.integer ? "float values but is marked integer" : "integers but is not marked integer") +
+                " (" + path + ")");
         }
     }
     const std::string badIndex = polygon_indices_internal::firstBadIndex(mesh);
@@ -336,26 +360,26 @@ writePly(const SurfaceMesh& mesh, const PolygonView& polygons, const std::string
     out.text("property float x\nproperty float y\nproperty float z\n");
     if (withNormals) out.text("property float nx\nproperty float ny\nproperty float nz\n");
     const std::vector<std::string> names = attributeNamesFor(mesh, ".ply");
-    std::vector<char> asInt(mesh.attributes.size());
+    std::vector<ScalarType> types(mesh.attributes.size());
+    size_t vertexBytes = withNormals ? 24 : 12;
     for (size_t i = 0; i < mesh.attributes.size(); ++i) {
-        asInt[i] = storedAsInt(mesh.attributes[i]);
+        types[i] = storedType(mesh.attributes[i], /*vtk=*/false);
+        vertexBytes += scalarSize(types[i]) * size_t(mesh.attributes[i].components);
         for (const std::string& column : attribute_names_internal::plyColumns(names[i], mesh.attributes[i].components)) {
-            out.text(std::string(asInt[i] ? "property int " : "property float ") + column + "\n");
+            out.text(std::string("property ") + io_internal::plyTypeName(types[i]) + " " + column + "\n");
         }
     }
     out.text("element face " + std::to_string(polygons.polygonCount()) + "\n");
     out.text("property list uchar int vertex_indices\nend_header\n");
-    size_t floatsPerVertex = withNormals ? 6 : 3;
-    for (const MeshAttribute& attribute : mesh.attributes) floatsPerVertex += size_t(attribute.components);
-    writeRecords(out, mesh.points.size(), 4 * floatsPerVertex, [&](size_t i, char* at) {
+    writeRecords(out, mesh.points.size(), vertexBytes, [&](size_t i, char* at) {
         for (int axis = 0; axis < 3; ++axis) at = put4<false>(at, float(mesh.points[i][axis]));
         if (withNormals) {
             for (int axis = 0; axis < 3; ++axis) at = put4<false>(at, float(mesh.normals[i][axis]));
         }
         for (size_t a = 0; a < mesh.attributes.size(); ++a) {
             const MeshAttribute& attribute = mesh.attributes[a];
-            const float* values = attribute.values.data() + i * size_t(attribute.components);
-            for (int c = 0; c < attribute.components; ++c) at = putValue<false>(at, values[c], asInt[a]);
+            const size_t first = i * size_t(attribute.components);
+            for (int c = 0; c < attribute.components; ++c) at = putValue<false>(at, attribute, first + size_t(c), types[a]);
         }
     });
     writePolygonRecords</*BigEndian=*/false, uint8_t>(out, polygons);
@@ -392,8 +416,8 @@ writeVtk(const SurfaceMesh& mesh, const PolygonView& polygons, const std::string
     for (size_t i = 0; i < mesh.attributes.size(); ++i) {
         const MeshAttribute& attribute = mesh.attributes[i];
         const std::string& name = names[i];
-        const bool asInt = storedAsInt(attribute);
-        const std::string type = asInt ? "int" : "float";
+        const ScalarType stored = storedType(attribute, /*vtk=*/true);
+        const std::string type = io_internal::vtkTypeName(stored);
         if (attribute.components == 3) {
             out.text("VECTORS " + name + " " + type + "\n");
         } else if (attribute.components <= 4) {
@@ -403,8 +427,8 @@ writeVtk(const SurfaceMesh& mesh, const PolygonView& polygons, const std::string
             out.text("FIELD FieldData 1\n" + name + " " + std::to_string(attribute.components) +
                 " " + std::to_string(mesh.points.size()) + " " + type + "\n");
         }
-        writeRecords(out, attribute.values.size(), 4,
-                     [&](size_t i, char* at) { putValue<true>(at, attribute.values[i], asInt); });
+        writeRecords(out, attribute.size(), scalarSize(stored),
+                     [&](size_t i, char* at) { putValue<true>(at, attribute, i, stored); });
         out.text("\n");
     }
     out.flush();

@@ -154,36 +154,20 @@ writeXyz(const ParticleSet& particles, std::ostream& os)
     os.write(bytes.data(), std::streamsize(bytes.size()));
 }
 
-/// The type a 64-bit integer attribute @a a is written as in PLY, which has no 64-bit type:
-/// Int32 or UInt32 when every value fits (they stay integers, exact), else Float64.
+/// The type a 64-bit integer attribute @a a is written as in PLY, which has no 64-bit type
+/// (io_internal::plyIntegerType of its range).
 ScalarType
 plyTypeOf64(const ParticleAttribute& a)
 {
-    const bool isSigned = a.type == ScalarType::Int64;
-    const int64_t lowest = isSigned ? std::numeric_limits<int32_t>::min() : 0;
-    const int64_t highest = isSigned ? std::numeric_limits<int32_t>::max() : std::numeric_limits<uint32_t>::max();
+    int64_t lowest = std::numeric_limits<int64_t>::max();
+    int64_t highest = std::numeric_limits<int64_t>::min();
     for (size_t at = 0; at < a.bytes.size(); at += 8) {
-        int64_t value = 0;  // integerValue() is false for a uint64 past int64
-        if (!io_internal::integerValue(a.bytes.data() + at, a.type, value) || value < lowest || value > highest) {
-            return ScalarType::Float64;
-        }
+        int64_t value = 0;
+        if (!io_internal::integerValue(a.bytes.data() + at, a.type, value)) return ScalarType::Float64;  // a uint64 past int64
+        lowest = std::min(lowest, value);
+        highest = std::max(highest, value);
     }
-    return isSigned ? ScalarType::Int32 : ScalarType::UInt32;
-}
-
-const char*
-plyTypeName(ScalarType type)
-{
-    switch (type) {
-    case ScalarType::Int8: return "char";
-    case ScalarType::UInt8: return "uchar";
-    case ScalarType::Int16: return "short";
-    case ScalarType::UInt16: return "ushort";
-    case ScalarType::Int32: return "int";
-    case ScalarType::UInt32: return "uint";
-    case ScalarType::Float32: return "float";
-    default: return "double";  // Float64, and 64-bit integers (PLY has none)
-    }
+    return io_internal::plyIntegerType(lowest, highest);
 }
 
 void
@@ -199,7 +183,7 @@ writePly(const ParticleSet& particles, std::ostream& os)
         const bool wide = a.type == ScalarType::Int64 || a.type == ScalarType::UInt64;
         written[i] = wide ? plyTypeOf64(a) : a.type;
         for (const std::string& column : plyColumns(names[i], a.components)) {
-            header += std::string("property ") + plyTypeName(written[i]) + " " + column + "\n";
+            header += std::string("property ") + io_internal::plyTypeName(written[i]) + " " + column + "\n";
         }
     }
     header += "end_header\n";
@@ -233,24 +217,6 @@ writePly(const ParticleSet& particles, std::ostream& os)
     }
 }
 
-const char*
-vtkTypeName(ScalarType type)
-{
-    switch (type) {
-    case ScalarType::Int8: return "char";
-    case ScalarType::UInt8: return "unsigned_char";
-    case ScalarType::Int16: return "short";
-    case ScalarType::UInt16: return "unsigned_short";
-    case ScalarType::Int32: return "int";
-    case ScalarType::UInt32: return "unsigned_int";
-    case ScalarType::Int64: return "vtktypeint64";
-    case ScalarType::UInt64: return "vtktypeuint64";
-    case ScalarType::Float32: return "float";
-    case ScalarType::Float64: return "double";
-    }
-    return "double";
-}
-
 void
 writeVtk(const ParticleSet& particles, std::ostream& os)
 {
@@ -274,7 +240,7 @@ writeVtk(const ParticleSet& particles, std::ostream& os)
         for (size_t i = 0; i < particles.attributes.size(); ++i) {
             const ParticleAttribute& a = particles.attributes[i];
             out += names[i] + " " + std::to_string(a.components) + " " + std::to_string(n) +
-                   " " + vtkTypeName(a.type) + "\n";
+                   " " + io_internal::vtkTypeName(a.type) + "\n";
             appendSwapped(out, a.bytes.data(), n * size_t(a.components), scalarSize(a.type), true);
             out += "\n";
         }

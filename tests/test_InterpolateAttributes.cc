@@ -45,8 +45,11 @@ const openvdb::Mat3d kA(0.5, -1.0, 2.0, 3.0, 0.25, -0.75, 1.5, 1.0, -2.0);
 const openvdb::Vec3d kB(0.1, -0.2, 0.3);
 constexpr double kSpacing = 0.1;
 
+/// Ids past 2^24 (where floats skip integers) and past 2^32, as a big simulation's are.
+constexpr int64_t kFirstId = int64_t(1) << 40;
+
 /// A jittered ball of particles with a constant scalar "c" = 2.5 (float32), a linear
-/// vector field "f" = A·r + b (float64) and an int32 "id".
+/// vector field "f" = A·r + b (float64) and an int64 "id" = kFirstId + particle number.
 ParticleSet
 ballWithFields()
 {
@@ -55,15 +58,15 @@ ballWithFields()
         [](const openvdb::Vec3d& x) { return x.length() < 0.5; }, 0.2);
     std::vector<float> c(particles.size(), 2.5f);
     std::vector<double> f;
-    std::vector<int32_t> id;
+    std::vector<int64_t> id;
     for (size_t j = 0; j < particles.size(); ++j) {
         const openvdb::Vec3d v = kA * openvdb::Vec3d(particles.positions[j]) + kB;
         f.insert(f.end(), {v[0], v[1], v[2]});
-        id.push_back(int32_t(j));
+        id.push_back(kFirstId + int64_t(j));
     }
     particles.attributes.push_back(makeAttribute("c", ScalarType::Float32, 1, c));
     particles.attributes.push_back(makeAttribute("f", ScalarType::Float64, 3, f));
-    particles.attributes.push_back(makeAttribute("id", ScalarType::Int32, 1, id));
+    particles.attributes.push_back(makeAttribute("id", ScalarType::Int64, 1, id));
     return particles;
 }
 
@@ -135,12 +138,15 @@ TEST(InterpolateAttributes, LinearFieldGivesTheFieldAtTheWeightedMean)
 TEST(InterpolateAttributes, IntegersTakeTheNearestParticlesValue)
 {
     // An id is a name, not a quantity: the weighted mean of ids 17 and 18 named no particle.
-    // Each vertex gets the id of the nearest particle within r_e, exactly, by brute force.
+    // Each vertex gets the id of the nearest particle within r_e, exactly (past 2^40, where
+    // a float holds every 131072nd integer only), by brute force.
     Fixture fx;
     interpolateAttributes(fx.mesh, fx.particles, {"id", "c"}, fx.radius);
     const MeshAttribute& id = fx.mesh.attributes.at(0);
     ASSERT_EQ(id.name, "id");
-    ASSERT_EQ(id.values.size(), fx.mesh.points.size());
+    ASSERT_TRUE(id.integer);  // writeMesh() stores it as integers
+    ASSERT_EQ(id.integers.size(), fx.mesh.points.size());
+    EXPECT_TRUE(id.values.empty());
     const float re = float(fx.radius);
     size_t betweenTwoIds = 0;
     for (size_t i = 0; i < fx.mesh.points.size(); ++i) {
@@ -153,25 +159,25 @@ TEST(InterpolateAttributes, IntegersTakeTheNearestParticlesValue)
             const float w = mpsWeightSquared(d2, re);
             if (w == 0.0f) continue;
             weights += w;
-            weightedIds += double(w) * double(j);
+            weightedIds += double(w) * double(j);  // the particle number: the mean of ids, less kFirstId
             if (nearest < 0 || d2 < nearestSqr) {
                 nearestSqr = d2;
-                nearest = int32_t(j);  // ids are the particle numbers
+                nearest = int32_t(j);
             }
         }
         if (nearest < 0) {
-            EXPECT_EQ(id.values[i], 0.0f) << "vertex " << i;
+            EXPECT_EQ(id.integers[i], 0) << "vertex " << i;
             continue;
         }
-        ASSERT_EQ(id.values[i], float(nearest)) << "vertex " << i;
+        ASSERT_EQ(id.integers[i], kFirstId + nearest) << "vertex " << i;
         betweenTwoIds += std::floor(weightedIds / weights) != weightedIds / weights;
     }
     // The mean would have given values between ids at almost every vertex.
     EXPECT_GT(betweenTwoIds, fx.mesh.points.size() / 2);
     // A float attribute beside it is still a weighted mean.
     for (size_t i = 0; i + 1 < fx.mesh.points.size(); ++i) ASSERT_EQ(fx.mesh.attributes.at(1).values[i], 2.5f);
-    EXPECT_TRUE(id.integer);  // writeMesh() stores it as ints
     EXPECT_FALSE(fx.mesh.attributes.at(1).integer);
+    EXPECT_TRUE(fx.mesh.attributes.at(1).integers.empty());
 }
 
 TEST(InterpolateAttributes, OfEquallyNearParticlesTheFirstGivesItsValue)
@@ -189,8 +195,8 @@ TEST(InterpolateAttributes, OfEquallyNearParticlesTheFirstGivesItsValue)
         SurfaceMesh mesh;
         mesh.points = {openvdb::Vec3s(0.0f, 0.0f, 0.0f), openvdb::Vec3s(0.0f, 0.29f, 0.0f)};
         interpolateAttributes(mesh, particles, {"cell"}, 0.5);
-        const std::vector<float>& values = mesh.attributes.at(0).values;
-        EXPECT_EQ(values, (std::vector<float>{7, 8, 9, 5, 5, 5}));  // the first particle, either way
+        const std::vector<int64_t>& values = mesh.attributes.at(0).integers;
+        EXPECT_EQ(values, (std::vector<int64_t>{7, 8, 9, 5, 5, 5}));  // the first particle, either way
     }
 }
 
@@ -207,6 +213,7 @@ TEST(InterpolateAttributes, SameBytesForAnyThreadCount)
     for (size_t a = 0; a < 3; ++a) {
         EXPECT_EQ(one.attributes[a].name, many.attributes[a].name);
         EXPECT_TRUE(one.attributes[a].values == many.attributes[a].values) << one.attributes[a].name;
+        EXPECT_TRUE(one.attributes[a].integers == many.attributes[a].integers) << one.attributes[a].name;
     }
 }
 
@@ -230,6 +237,18 @@ TEST(InterpolateAttributes, NamesAndErrors)
         EXPECT_STREQ(e.what(), "unknown attribute 'velocity'; the particles have no attributes");
     }
     EXPECT_THROW(interpolateAttributes(fx.mesh, fx.particles, {"c"}, 0.0), ParameterError);
+
+    // A uint64 past int64 (a hash, say) has no place in the 64-bit signed integers.
+    std::vector<uint64_t> hashes(fx.particles.size(), 5);
+    hashes[3] = std::numeric_limits<uint64_t>::max();
+    fx.particles.attributes.push_back(makeAttribute("h", ScalarType::UInt64, 1, hashes));
+    EXPECT_EQ(nonbloppy_test::messageOf<ParameterError>([&] { interpolateAttributes(fx.mesh, fx.particles, {"h"}, fx.radius); }),
+              "attribute 'h' holds 18446744073709551615, above 9223372036854775807, the largest integer a mesh "
+              "attribute holds");
+    hashes.assign(hashes.size(), uint64_t(std::numeric_limits<int64_t>::max()));  // the largest that fits
+    fx.particles.attributes.back() = makeAttribute("h", ScalarType::UInt64, 1, hashes);
+    interpolateAttributes(fx.mesh, fx.particles, {"h"}, fx.radius);
+    EXPECT_EQ(fx.mesh.attributes.back().integers.at(0), std::numeric_limits<int64_t>::max());
 }
 
 /// Counts start() and end() calls; says stop from the start of the stage when @a stop.

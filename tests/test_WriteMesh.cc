@@ -30,6 +30,7 @@
 #include <functional>
 #include <random>
 #include <iterator>
+#include <limits>
 #include <set>
 #include <stdexcept>
 #include <string>
@@ -315,57 +316,84 @@ TEST_F(WriteMeshTest, AttributeNamesStayDistinctFromEachOtherAndFromTheFormatsCo
     EXPECT_EQ(nonbloppy::writtenAttributeNames(mesh, path("m.ply"))[2], "nx");
 }
 
-TEST_F(WriteMeshTest, IntegerAttributesAreStoredAsIntsWhereEveryValueIsOne)
+TEST_F(WriteMeshTest, IntegerAttributesAreWrittenExactlyInTheNarrowestTypeThatHoldsThem)
 {
-    // Ids carried to the vertices (MeshAttribute::integer) were float properties, which a
-    // reader takes for a measured quantity. Now int, where every value is a whole number a
-    // float holds exactly (up to 2^24); otherwise float, which does not claim exactness.
+    // Ids carried to the vertices (MeshAttribute::integer) were float32 values, which skip
+    // integers past 2^24: a 20-million-particle frame's ids came out rounded to a
+    // neighbour's. They are 64-bit integers now, written as int where every value fits,
+    // else PLY uint or double (PLY has no 64-bit integer) and VTK vtktypeint64.
     SurfaceMesh mesh = mixedMesh();
     const size_t n = mesh.points.size();
-    const auto add = [&](const std::string& name, int components, bool integer, const std::function<float(size_t)>& value) {
+    const auto addIntegers = [&](const std::string& name, int components, const std::function<int64_t(size_t)>& value) {
         nonbloppy::MeshAttribute a;
         a.name = name;
         a.components = components;
-        a.integer = integer;
-        for (size_t k = 0; k < n * size_t(components); ++k) a.values.push_back(value(k));
+        a.integer = true;
+        for (size_t k = 0; k < n * size_t(components); ++k) a.integers.push_back(value(k));
         mesh.attributes.push_back(a);
     };
-    add("id", 1, true, [](size_t k) { return float(16777216 - int(k)); });          // int
-    add("cell", 3, true, [](size_t k) { return -float(k); });                         // int, VECTORS
-    add("half", 1, true, [](size_t k) { return k == 1 ? 2.5f : float(k); });          // not whole: float
-    add("huge", 1, true, [](size_t k) { return k == 0 ? 16777218.0f : float(k); });   // past 2^24: float
-    add("count", 1, false, [](size_t k) { return float(k); });                        // not flagged: float
-    add("five", 5, true, [](size_t k) { return float(k % 7); });                      // int, a FIELD array
+    const int64_t kInt32Max = std::numeric_limits<int32_t>::max();
+    const int64_t kTwoTo40 = int64_t(1) << 40;
+    addIntegers("id", 1, [&](size_t k) { return kInt32Max - int64_t(k); });             // int, past 2^24
+    addIntegers("cell", 3, [](size_t k) { return -int64_t(k); });                         // int, VECTORS
+    addIntegers("serial", 1, [&](size_t k) { return kInt32Max + 1 + int64_t(k); });       // PLY uint
+    addIntegers("huge", 1, [&](size_t k) { return k == 0 ? -kTwoTo40 - 1 : int64_t(k); }); // PLY double
+    addIntegers("five", 5, [](size_t k) { return int64_t(k % 7); });                       // int, a FIELD array
+    nonbloppy::MeshAttribute count;  // floats: not integer
+    count.name = "count";
+    for (size_t k = 0; k < n; ++k) count.values.push_back(float(k) + 0.5f);
+    mesh.attributes.push_back(count);
 
     writeMesh(mesh, path("m.ply"));
     const std::string bytes = readBytes(path("m.ply"));
     EXPECT_NE(bytes.find("property int id\nproperty int cell_x\nproperty int cell_y\nproperty int cell_z\n"
-                         "property float half\nproperty float huge\nproperty float count\nproperty int five_0\n"),
+                         "property uint serial\nproperty double huge\nproperty int five_0\n"),
               std::string::npos);
+    EXPECT_NE(bytes.find("property int five_4\nproperty float count\nelement face"), std::string::npos);
     writeMesh(mesh, path("m.vtk"));
     const std::string vtk = readBytes(path("m.vtk"));
     const std::string field = "FIELD FieldData 1\nfive 5 " + std::to_string(n) + " int\n";
-    for (const std::string header : {"SCALARS id int 1\n", "VECTORS cell int\n", "SCALARS half float 1\n",
-                                     "SCALARS huge float 1\n", "SCALARS count float 1\n", field.c_str()}) {
+    for (const std::string header : {"SCALARS id int 1\n", "VECTORS cell int\n", "SCALARS serial vtktypeint64 1\n",
+                                     "SCALARS huge vtktypeint64 1\n", "SCALARS count float 1\n", field.c_str()}) {
         EXPECT_NE(vtk.find(header), std::string::npos) << header;
     }
-    // Read back as particles: ints, each value exact.
+    // Read back as particles: every value exact.
+    using nonbloppy::ScalarType;
     for (const std::string file : {"m.ply", "m.vtk"}) {
+        const bool ply = file == "m.ply";
         const nonbloppy::ParticleSet back = nonbloppy::readParticles(path(file));
-        const nonbloppy::ParticleAttribute* id = back.findAttribute("id");
-        ASSERT_NE(id, nullptr) << file;
-        EXPECT_EQ(id->type, nonbloppy::ScalarType::Int32) << file;
-        for (size_t k = 0; k < n; ++k) EXPECT_EQ(id->asDouble(k), 16777216.0 - double(k)) << file;
-        const nonbloppy::ParticleAttribute* half = back.findAttribute("half");
-        ASSERT_NE(half, nullptr) << file;
-        EXPECT_EQ(half->type, nonbloppy::ScalarType::Float32) << file;
-        EXPECT_EQ(half->asDouble(1), 2.5) << file;
-        const nonbloppy::ParticleAttribute* five = back.findAttribute("five");  // PLY five_0..five_4, one attribute again
-        ASSERT_NE(five, nullptr) << file;
-        EXPECT_EQ(five->type, nonbloppy::ScalarType::Int32) << file;
-        EXPECT_EQ(five->components, 5) << file;
-        EXPECT_EQ(five->asDouble(1, 4), double((5 + 4) % 7)) << file;
+        for (const nonbloppy::MeshAttribute& written : mesh.attributes) {
+            const nonbloppy::ParticleAttribute* a = back.findAttribute(written.name);  // PLY five_0..five_4: one again
+            ASSERT_NE(a, nullptr) << file << " " << written.name;
+            EXPECT_EQ(a->components, written.components) << file << " " << written.name;
+            for (size_t k = 0; k < written.size(); ++k) {
+                ASSERT_EQ(a->asDouble(k / size_t(written.components), int(k % size_t(written.components))),
+                          written.asDouble(k)) << file << " " << written.name << " " << k;
+            }
+        }
+        EXPECT_EQ(back.findAttribute("id")->type, ScalarType::Int32) << file;
+        EXPECT_EQ(back.findAttribute("serial")->type, ply ? ScalarType::UInt32 : ScalarType::Int64) << file;
+        EXPECT_EQ(back.findAttribute("huge")->type, ply ? ScalarType::Float64 : ScalarType::Int64) << file;
+        EXPECT_EQ(back.findAttribute("count")->type, ScalarType::Float32) << file;
     }
+}
+
+TEST_F(WriteMeshTest, RefusesAnAttributeWhoseValuesAreInTheArrayItsFlagDoesNotName)
+{
+    SurfaceMesh mesh = mixedMesh();
+    nonbloppy::MeshAttribute id;
+    id.name = "id";
+    id.integer = true;
+    id.integers.assign(mesh.points.size(), 7);
+    id.values.assign(mesh.points.size(), 7.0f);
+    mesh.attributes.push_back(id);
+    EXPECT_EQ(messageOf<nonbloppy::ParameterError>([&] { writeMesh(mesh, path("m.ply")); }),
+              "mesh attribute 'id' has float values but is marked integer (" + path("m.ply") + ")");
+    mesh.attributes[0].integer = false;
+    mesh.attributes[0].integers.assign(mesh.points.size(), 7);
+    EXPECT_EQ(messageOf<nonbloppy::ParameterError>([&] { writeMesh(mesh, path("m.ply")); }),
+              "mesh attribute 'id' has integers but is not marked integer (" + path("m.ply") + ")");
+    EXPECT_TRUE(listDirectory(dir()).empty());
 }
 
 TEST_F(WriteMeshTest, ObjTextIsExact)

@@ -245,6 +245,7 @@ TEST_F(CliFormatsTest, IntegerAttributesReachTheMeshAsTheNearestParticlesValue)
     ASSERT_NE(index, nullptr);
     EXPECT_EQ(index->type, nonbloppy::ScalarType::Int32);  // "property int index"
     ASSERT_GT(vertices.size(), 100u);
+    std::vector<size_t> nearestOf(vertices.size());
     for (size_t i = 0; i < vertices.size(); ++i) {
         size_t nearest = 0;
         for (size_t j = 1; j < particles.size(); ++j) {
@@ -255,24 +256,37 @@ TEST_F(CliFormatsTest, IntegerAttributesReachTheMeshAsTheNearestParticlesValue)
         }
         ASSERT_LT((vertices.positions[i] - particles.positions[nearest]).length(), 0.3f) << "vertex " << i;
         ASSERT_EQ(index->asDouble(i), particles.findAttribute("index")->asDouble(nearest)) << "vertex " << i;
+        nearestOf[i] = nearest;
     }
 
-    // Past 2^24 a float32 value rounds the ids: said once.
+    // Ids past 2^32 (a float32 holds every integer only to 2^24) come through exact: PLY
+    // double, VTK vtktypeint64, without a word.
     ParticleSet big = particles;
     ParticleAttribute id;
     id.name = "id";
     id.type = nonbloppy::ScalarType::Int64;
+    const int64_t firstId = (int64_t(1) << 40) + 1;
     for (size_t j = 0; j < big.size(); ++j) {
-        const int64_t value = (int64_t(1) << 24) + 1 + int64_t(j);
+        const int64_t value = firstId + int64_t(j);
         const auto* bytes = reinterpret_cast<const unsigned char*>(&value);
         id.bytes.insert(id.bytes.end(), bytes, bytes + sizeof(value));
     }
     big.attributes = {id};
     nonbloppy::writeParticles(big, path("big.vtu"));  // PLY has no 64-bit integers
-    const RunResult warned = run("mesh -q " + quote(path("big.vtu")) + " -o " + quote(path("b.ply")) + " --attributes id");
-    ASSERT_EQ(warned.exitCode, 0) << warned.err;
-    EXPECT_EQ(warned.err, "nonbloppy: warning: attribute 'id' holds integers beyond 2^24 = 16777216, which the "
-                          "mesh's float32 values round\n");
+    for (const std::string out : {"b.ply", "b.vtk"}) {
+        const RunResult exact = run("mesh -q " + quote(path("big.vtu")) + " -o " + quote(path(out)) +
+                                    " --radius 0.3 --attributes id");
+        ASSERT_EQ(exact.exitCode, 0) << exact.err;
+        EXPECT_EQ(exact.err, "");
+        const ParticleSet back = nonbloppy::readParticles(path(out));
+        ASSERT_EQ(back.size(), vertices.size()) << out;
+        const ParticleAttribute* ids = back.findAttribute("id");
+        ASSERT_NE(ids, nullptr) << out;
+        EXPECT_EQ(ids->type, out == "b.ply" ? nonbloppy::ScalarType::Float64 : nonbloppy::ScalarType::Int64);
+        for (size_t i = 0; i < back.size(); ++i) {
+            ASSERT_EQ(int64_t(ids->asDouble(i)), firstId + int64_t(nearestOf[i])) << out << " vertex " << i;
+        }
+    }
 }
 
 TEST_F(CliFormatsTest, APlyMeshGivenAsParticlesIsSaidToBeOne)

@@ -38,11 +38,11 @@ NONBLOPPY_API std::vector<std::string> resolveAttributeNames(const ParticleSet& 
 /// with the MPS weight w of Kernel.h over r_e = @a effectiveRadius, the same weights as the
 /// relaxation's weighted mean t_i. Integer attributes (ids, flags, material indices), whose
 /// means would name nothing, take instead the value of the nearest particle within r_e (of
-/// equally near ones, the first in @a particles), and are flagged MeshAttribute::integer
-/// (writeMesh() stores them as ints). The type is the file's (readParticles()); CSV and JSON
-/// declare none, and a column of whole numbers there reads as Int64: write 300.0, not 300,
-/// for a quantity to be averaged. A vertex with no particle within r_e gets 0. Values
-/// are converted to float (integers beyond ±2^24 are rounded); every component is
+/// equally near ones, the first in @a particles), exactly: they are flagged
+/// MeshAttribute::integer and held in MeshAttribute::integers (means as floats in
+/// MeshAttribute::values). The type is the file's (readParticles()); CSV and JSON declare
+/// none, and a column of whole numbers there reads as Int64: write 300.0, not 300, for a
+/// quantity to be averaged. A vertex with no particle within r_e gets 0. Every component is
 /// interpolated independently. An attribute already on the mesh under the same name is
 /// replaced (also on a mesh without vertices).
 /// Cost: a ParticleIndex of the particles with cells of r_e (O(N), not interruptible), then
@@ -56,7 +56,9 @@ NONBLOPPY_API std::vector<std::string> resolveAttributeNames(const ParticleSet& 
 ///                     (not for an empty mesh or no names), wasInterrupted() before each
 ///                     block of 256 vertices
 /// @throw ParameterError for r_e ≤ 0 or not finite, an unknown name, an attribute whose
-///        size differs from the particle count, or particles ParticleIndex::build() refuses
+///        size differs from the particle count, a UInt64 attribute holding a value past
+///        2^63 − 1 ("attribute 'h' holds 18446744073709551615, above 9223372036854775807,
+///        the largest integer a mesh attribute holds"), or particles ParticleIndex::build() refuses
 ///        (r_e below kMinCellSize, a non-finite position, coordinates too far from the
 ///        origin); CancelledError("interrupted during interpolate attributes") when
 ///        @a interrupter says so.

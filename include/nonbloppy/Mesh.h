@@ -7,27 +7,34 @@
 
 #include <openvdb/openvdb.h>
 
+#include <cstddef>
+#include <cstdint>
 #include <string>
 #include <vector>
 
 namespace nonbloppy {
 
-/// The largest magnitude up to which every integer is exact as a MeshAttribute value
-/// (float32): 2^24. Ids beyond it may round to a neighbour's.
-constexpr float kMaxExactAttributeInteger = 16777216.0f;
-
 /// A per-vertex attribute carried by a mesh (e.g. "velocity" interpolated from the
-/// particles): values[i * components + c] is component c of vertex i.
+/// particles). A quantity (velocity, temperature) is held as floats; one that counts or
+/// names things (ids, flags, material indices: an integer particle attribute, which
+/// interpolateAttributes() carries as the nearest particle's value) as exact 64-bit
+/// integers, so an id past 2^24, where floats skip integers, stays the particle's.
+/// Either way, element i * components + c is component c of vertex i.
 struct MeshAttribute
 {
-    std::string name;            ///< as the particles' attribute, e.g. "velocity"
-    int components = 1;          ///< 1 for scalars, 3 for vectors, ...
-    std::vector<float> values;   ///< points.size() × components values, vertex-major
-    /// The values count or name things (ids, flags: an integer particle attribute, which
-    /// interpolateAttributes() carries as the nearest particle's value). writeMesh() then
-    /// stores them as 32-bit integers if every one is a whole number within
-    /// ±kMaxExactAttributeInteger (beyond, they may have been rounded: floats then).
+    std::string name;                ///< as the particles' attribute, e.g. "velocity"
+    int components = 1;              ///< 1 for scalars, 3 for vectors, ...
+    /// Which of the two arrays holds the values; the other stays empty. writeMesh() stores
+    /// integers as 32-bit ints where every one fits, else as doubles.
     bool integer = false;
+    std::vector<float> values;       ///< points.size() × components floats, unless integer
+    std::vector<int64_t> integers;   ///< points.size() × components integers, if integer
+
+    /// Number of values held, whichever array holds them.
+    size_t size() const { return integer ? integers.size() : values.size(); }
+    /// Element @a i (vertex i / components, component i % components) as a double, exact
+    /// for floats and for integers within ±2^53.
+    double asDouble(size_t i) const { return integer ? double(integers[i]) : double(values[i]); }
 };
 
 /// A polygon mesh of triangles and quads sharing one vertex array, in world units.

@@ -38,9 +38,10 @@ struct MeshWriteSettings
 /// Per-vertex attributes (mesh.attributes, see interpolateAttributes()) are written as PLY
 /// float vertex properties ("density"; a 3-vector "velocity" as velocity_x, velocity_y,
 /// velocity_z) and as VTK POINT_DATA (VECTORS for 3 components, SCALARS for 1, 2 or 4, a
-/// FIELD array otherwise); as int instead of float where MeshAttribute::integer is set and
-/// every value is a whole number within ±kMaxExactAttributeInteger (2^24; ids). OBJ has no
-/// place for them: they are left out. Names are written as writeParticles() writes them
+/// FIELD array otherwise). Integer attributes (MeshAttribute::integer: ids) are written
+/// exactly, as PLY int, else uint, where every value fits, else double (exact within
+/// ±2^53, as PLY has no 64-bit type), and as VTK int, else vtktypeint64. OBJ has no place
+/// for attributes: they are left out. Names are written as writeParticles() writes them
 /// (whitespace, control and non-ASCII bytes, ',', '"', '<', '>' and '&' become '_') and
 /// kept distinct from one another and from the format's own columns (PLY x, y, z and,
 /// with normals, nx, ny, nz; the VTK normals array "normals"): such a name gets _2, _3,
@@ -53,7 +54,8 @@ struct MeshWriteSettings
 ///        vertices or polygon corners ("too many vertices for 32-bit indices (PATH)").
 /// @throw ParameterError if a polygon references a vertex that does not exist,
 ///        mesh.normals is non-empty but not one per vertex, or an attribute has fewer than
-///        one component or not V·components values.
+///        one component, not V·components values, or values in the array its
+///        MeshAttribute::integer flag does not name.
 NONBLOPPY_API void writeMesh(const SurfaceMesh& mesh, const std::string& path,
                const MeshWriteSettings& settings = MeshWriteSettings());
 

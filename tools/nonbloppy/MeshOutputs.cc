@@ -14,7 +14,6 @@
 
 #include <atomic>
 #include <cctype>
-#include <cmath>
 #include <iostream>
 #include <vector>
 
@@ -39,7 +38,6 @@ std::vector<std::string> splitNames(const std::string& list)
 
 std::atomic<bool> gObjWarningPrinted{false};
 std::atomic<bool> gRenameWarningPrinted{false};
-std::atomic<bool> gRoundingWarningPrinted{false};
 
 } // namespace
 
@@ -70,27 +68,6 @@ void requireAttributes(const nonbloppy::ParticleSet& particles, const MeshOutput
     if (!o.attributes.empty()) nonbloppy::resolveAttributeNames(particles, splitNames(o.attributes));
 }
 
-/// Once per run: an integer attribute past ±2^24 (large ids) reaches the mesh rounded, as
-/// its values are float32 there.
-void warnIfIntegersRound(const nonbloppy::ParticleSet& particles, const std::vector<std::string>& names)
-{
-    if (gRoundingWarningPrinted) return;  // the scan is for the first frame that needs it
-    for (const std::string& name : nonbloppy::resolveAttributeNames(particles, names)) {
-        const nonbloppy::ParticleAttribute& a = *particles.findAttribute(name);
-        if (!nonbloppy::isIntegerType(a.type)) continue;
-        for (size_t n = 0; n < a.size(); ++n) {
-            for (int c = 0; c < a.components; ++c) {
-                if (std::abs(a.asDouble(n, c)) <= nonbloppy::kMaxExactAttributeInteger) continue;
-                if (!gRoundingWarningPrinted.exchange(true)) {
-                    std::cerr << "nonbloppy: warning: attribute '" << name << "' holds integers beyond 2^24 = "
-                                 "16777216, which the mesh's float32 values round" << std::endl;
-                }
-                return;
-            }
-        }
-    }
-}
-
 void addSurfaceAttributes(nonbloppy::SurfaceResult& result, const nonbloppy::ParticleSet& particles,
                           const MeshOutputOptions& o, const std::string& meshPath,
                           openvdb::util::NullInterrupter* interrupter)
@@ -100,7 +77,6 @@ void addSurfaceAttributes(nonbloppy::SurfaceResult& result, const nonbloppy::Par
     nonbloppy::interpolateAttributes(result.mesh, particles, names,
                                      result.parameters.effectiveRadius, interrupter);
     const std::string ext = lowerExtension(meshPath);
-    if (ext != ".obj") warnIfIntegersRound(particles, names);  // OBJ keeps none: warned below
     if (ext == ".obj" && !result.mesh.attributes.empty() && !gObjWarningPrinted.exchange(true)) {
         std::cerr << "nonbloppy: warning: OBJ cannot store vertex attributes; write .ply or .vtk "
                      "to keep --attributes" << std::endl;
