@@ -30,6 +30,7 @@
 #include <cstring>
 #include <limits>
 #include <ostream>
+#include <type_traits>
 #include <vector>
 
 namespace nonbloppy {
@@ -119,28 +120,20 @@ struct PolygonView
     }
 };
 
-/// Stores @a value's bytes at @a at in the given byte order; returns the next position.
+/// Stores @a value's bytes (4 or 8) at @a at in the given byte order; returns the next
+/// position.
 template<bool BigEndian, typename T>
-inline char* put4(char* at, T value)
+inline char* putBytes(char* at, T value)
 {
-    static_assert(sizeof(T) == 4, "4-byte values only");
-    uint32_t bits;
-    std::memcpy(&bits, &value, 4);
-    if ((__BYTE_ORDER__ == __ORDER_BIG_ENDIAN__) != BigEndian) bits = __builtin_bswap32(bits);
-    std::memcpy(at, &bits, 4);
-    return at + 4;
-}
-
-/// Stores @a value's 8 bytes at @a at in the given byte order; returns the next position.
-template<bool BigEndian, typename T>
-inline char* put8(char* at, T value)
-{
-    static_assert(sizeof(T) == 8, "8-byte values only");
-    uint64_t bits;
-    std::memcpy(&bits, &value, 8);
-    if ((__BYTE_ORDER__ == __ORDER_BIG_ENDIAN__) != BigEndian) bits = __builtin_bswap64(bits);
-    std::memcpy(at, &bits, 8);
-    return at + 8;
+    static_assert(sizeof(T) == 4 || sizeof(T) == 8, "4- or 8-byte values only");
+    std::conditional_t<sizeof(T) == 4, uint32_t, uint64_t> bits;
+    std::memcpy(&bits, &value, sizeof(T));
+    if ((__BYTE_ORDER__ == __ORDER_BIG_ENDIAN__) != BigEndian) {
+        if constexpr (sizeof(T) == 4) bits = __builtin_bswap32(bits);
+        else bits = __builtin_bswap64(bits);
+    }
+    std::memcpy(at, &bits, sizeof(T));
+    return at + sizeof(T);
 }
 
 /// The type @a attribute's values are stored as: Float32 for floats; for integers the
@@ -162,11 +155,11 @@ template<bool BigEndian>
 inline char* putValue(char* at, const MeshAttribute& attribute, size_t i, ScalarType type)
 {
     switch (type) {
-    case ScalarType::Float32: return put4<BigEndian>(at, attribute.values[i]);
-    case ScalarType::Int32: return put4<BigEndian>(at, int32_t(attribute.integers[i]));
-    case ScalarType::UInt32: return put4<BigEndian>(at, uint32_t(attribute.integers[i]));
-    case ScalarType::Int64: return put8<BigEndian>(at, attribute.integers[i]);
-    default: return put8<BigEndian>(at, double(attribute.integers[i]));
+    case ScalarType::Float32: return putBytes<BigEndian>(at, attribute.values[i]);
+    case ScalarType::Int32: return putBytes<BigEndian>(at, int32_t(attribute.integers[i]));
+    case ScalarType::UInt32: return putBytes<BigEndian>(at, uint32_t(attribute.integers[i]));
+    case ScalarType::Int64: return putBytes<BigEndian>(at, attribute.integers[i]);
+    default: return putBytes<BigEndian>(at, double(attribute.integers[i]));
     }
 }
 
@@ -220,9 +213,9 @@ writePolygonRecords(ChunkWriter& out, const PolygonView& polygons)
         if constexpr (sizeof(CountT) == 1) {
             *at++ = char(n);
         } else {
-            at = put4<BigEndian>(at, CountT(n));
+            at = putBytes<BigEndian>(at, CountT(n));
         }
-        for (int i = 0; i < n; ++i) at = put4<BigEndian>(at, int32_t(corners[i]));
+        for (int i = 0; i < n; ++i) at = putBytes<BigEndian>(at, int32_t(corners[i]));
         return at;
     };
     const size_t triangleBytes = sizeof(CountT) + 3 * 4, quadBytes = sizeof(CountT) + 4 * 4;
@@ -372,9 +365,9 @@ writePly(const SurfaceMesh& mesh, const PolygonView& polygons, const std::string
     out.text("element face " + std::to_string(polygons.polygonCount()) + "\n");
     out.text("property list uchar int vertex_indices\nend_header\n");
     writeRecords(out, mesh.points.size(), vertexBytes, [&](size_t i, char* at) {
-        for (int axis = 0; axis < 3; ++axis) at = put4<false>(at, float(mesh.points[i][axis]));
+        for (int axis = 0; axis < 3; ++axis) at = putBytes<false>(at, float(mesh.points[i][axis]));
         if (withNormals) {
-            for (int axis = 0; axis < 3; ++axis) at = put4<false>(at, float(mesh.normals[i][axis]));
+            for (int axis = 0; axis < 3; ++axis) at = putBytes<false>(at, float(mesh.normals[i][axis]));
         }
         for (size_t a = 0; a < mesh.attributes.size(); ++a) {
             const MeshAttribute& attribute = mesh.attributes[a];
@@ -396,7 +389,7 @@ writeVtk(const SurfaceMesh& mesh, const PolygonView& polygons, const std::string
     out.text("# vtk DataFile Version 3.0\nnonbloppy surface mesh\nBINARY\nDATASET POLYDATA\n");
     out.text("POINTS " + std::to_string(mesh.points.size()) + " float\n");
     auto putVec3 = [](char* at, const openvdb::Vec3s& v) {
-        for (int axis = 0; axis < 3; ++axis) at = put4<true>(at, float(v[axis]));
+        for (int axis = 0; axis < 3; ++axis) at = putBytes<true>(at, float(v[axis]));
     };
     writeRecords(out, mesh.points.size(), 12, [&](size_t i, char* at) { putVec3(at, mesh.points[i]); });
     out.text("\nPOLYGONS " + std::to_string(polygons.polygonCount()) + " " +
