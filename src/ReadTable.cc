@@ -93,6 +93,16 @@ parseDoubleField(std::string_view text, double& value)
     return result.ec == std::errc() && result.ptr == text.data() + text.size() && !text.empty();
 }
 
+/// Appends the 8 native bytes of @a value to @a bytes.
+template<typename T>
+void
+appendBytes(std::vector<unsigned char>& bytes, T value)
+{
+    static_assert(sizeof(T) == 8, "int64 or float64");
+    const unsigned char* raw = reinterpret_cast<const unsigned char*>(&value);
+    bytes.insert(bytes.end(), raw, raw + 8);
+}
+
 /// Rows read before the arrays are reserved from the bytes per row seen so far.
 constexpr size_t kEstimateAfterRows = 1024;
 
@@ -181,8 +191,9 @@ parseTable(StreamReader& in, const std::string& path)
         componentCounts.push_back(int(group.columns.size()));
     }
 
-    // Values go straight into the attribute arrays as float64; an attribute whose values
-    // are all integers is turned into int64 in place at the end.
+    // Values go straight into the attribute arrays: as int64 while every value of the
+    // attribute is a whole number that fits (parsed as such, so an id past 2^53 stays
+    // exact), then as float64 from the first that is not, the int64s before it converted.
     ParticleSet particles;
     particles.attributes.resize(names.size());
     std::vector<bool> integral(names.size(), true);
@@ -196,23 +207,31 @@ parseTable(StreamReader& in, const std::string& path)
         }
         openvdb::Vec3f p;
         for (size_t i = 0; i < fields.size(); ++i) {
-            double value;
             const std::string_view field = trimmed(fields[i]);
+            const int attribute = columns[i].attribute;
+            int64_t whole;
+            if (attribute >= 0 && integral[size_t(attribute)] && io_internal::parseWhole(field, whole)) {
+                appendBytes(particles.attributes[size_t(attribute)].bytes, whole);
+                continue;
+            }
+            double value;
             if (!parseDoubleField(field, value)) {
                 fail(path, "bad number '" + printable(field) + "' on line " + std::to_string(lineNumber));
             }
-            if (columns[i].attribute < 0) {
+            if (attribute < 0) {
                 p[columns[i].component] = static_cast<float>(value);
-            } else {
-                const size_t a = size_t(columns[i].attribute);
-                std::vector<unsigned char>& bytes = particles.attributes[a].bytes;
-                const unsigned char* raw = reinterpret_cast<const unsigned char*>(&value);
-                bytes.insert(bytes.end(), raw, raw + 8);
-                if (integral[a] && (field.find_first_of(".eE") != std::string_view::npos
-                                    || !(std::abs(value) < 9.0e15))) {
-                    integral[a] = false;
+                continue;
+            }
+            std::vector<unsigned char>& bytes = particles.attributes[size_t(attribute)].bytes;
+            if (integral[size_t(attribute)]) {
+                integral[size_t(attribute)] = false;
+                for (size_t at = 0; at < bytes.size(); at += 8) {
+                    std::memcpy(&whole, bytes.data() + at, 8);
+                    const double converted = double(whole);
+                    std::memcpy(bytes.data() + at, &converted, 8);
                 }
             }
+            appendBytes(bytes, value);
         }
         particles.positions.push_back(p);
         if (timeToEstimate(particles.positions.size(), particles.positions.capacity())) {
@@ -228,13 +247,6 @@ parseTable(StreamReader& in, const std::string& path)
         attribute.name = names[a];
         attribute.components = componentCounts[a];
         attribute.type = integral[a] ? ScalarType::Int64 : ScalarType::Float64;
-        if (!integral[a]) continue;
-        for (size_t k = 0; k < attribute.bytes.size() / 8; ++k) {
-            double value;
-            std::memcpy(&value, attribute.bytes.data() + 8 * k, 8);
-            const int64_t v = static_cast<int64_t>(value);
-            std::memcpy(attribute.bytes.data() + 8 * k, &v, 8);
-        }
     }
     return particles;
 }

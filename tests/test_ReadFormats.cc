@@ -23,6 +23,7 @@
 #include <fstream>
 #include <functional>
 #include <iterator>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -443,6 +444,32 @@ TEST_F(ReadFormatsTest, CsvWithVectorAndScalarColumns)
     EXPECT_EQ(attribute(particles, "id").asDouble(1), 8.0);
     EXPECT_EQ(attribute(particles, "density").type, ScalarType::Float64);
     EXPECT_EQ(attribute(particles, "density").asDouble(0), 1000.5);
+}
+
+TEST_F(ReadFormatsTest, CsvIntegersAreExactPast2To53)
+{
+    // Whole numbers were parsed as doubles and a column was int64 only below 9e15: the id
+    // 9007199254740993 (2^53 + 1) came back as ...992, a neighbour's. Now parsed as int64;
+    // a column turns float64 at its first value that is not a whole number (or past int64).
+    const std::string file = write("ids.csv",
+        "x,y,z,id,mixed,beyond\n"
+        "0,0,0,9007199254740993,9007199254740993,9223372036854775807\n"
+        "1,0,0,-9223372036854775808,2.5,9223372036854775808\n");
+    const ParticleSet particles = readParticles(file);
+    ASSERT_EQ(particles.size(), 2u);
+    const ParticleAttribute& id = attribute(particles, "id");
+    ASSERT_EQ(id.type, ScalarType::Int64);
+    int64_t values[2];
+    std::memcpy(values, id.bytes.data(), sizeof(values));
+    EXPECT_EQ(values[0], 9007199254740993);
+    EXPECT_EQ(values[1], std::numeric_limits<int64_t>::min());
+    const ParticleAttribute& mixed = attribute(particles, "mixed");
+    EXPECT_EQ(mixed.type, ScalarType::Float64);
+    EXPECT_EQ(mixed.asDouble(0), 9007199254740992.0);  // the nearest double
+    EXPECT_EQ(mixed.asDouble(1), 2.5);
+    const ParticleAttribute& beyond = attribute(particles, "beyond");
+    EXPECT_EQ(beyond.type, ScalarType::Float64);
+    EXPECT_EQ(beyond.asDouble(1), 9223372036854775808.0);
 }
 
 TEST_F(ReadFormatsTest, CsvWithAByteOrderMarkAsExcelWritesIt)

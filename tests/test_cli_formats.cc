@@ -287,6 +287,36 @@ TEST_F(CliFormatsTest, IntegerAttributesReachTheMeshAsTheNearestParticlesValue)
             ASSERT_EQ(int64_t(ids->asDouble(i)), firstId + int64_t(nearestOf[i])) << out << " vertex " << i;
         }
     }
+
+    // Past 2^53 a double rounds them: PLY (no 64-bit integers) says so, VTK keeps them.
+    const int64_t pastDouble = (int64_t(1) << 53) + 1;
+    for (size_t j = 0; j < big.size(); ++j) {
+        const int64_t value = pastDouble + int64_t(j);
+        std::memcpy(big.attributes[0].bytes.data() + 8 * j, &value, 8);
+    }
+    nonbloppy::writeParticles(big, path("past.vtu"));
+    const std::string warning = "nonbloppy: warning: attribute 'id' holds integers past 2^53, which " + path("p.ply") +
+                                " stores as doubles, rounded (PLY has no 64-bit integers); write .vtk to keep them exact\n";
+    const RunResult rounded = run("mesh -q " + quote(path("past.vtu")) + " -o " + quote(path("p.ply")) +
+                                  " --radius 0.3 --attributes id");
+    EXPECT_EQ(rounded.exitCode, 0);
+    EXPECT_EQ(rounded.err, warning);
+    const RunResult converted = run("convert -q " + quote(path("past.vtu")) + " " + quote(path("p.ply")));
+    EXPECT_EQ(converted.exitCode, 0);
+    EXPECT_EQ(converted.err, warning);
+    const RunResult exact = run("mesh -q " + quote(path("past.vtu")) + " -o " + quote(path("p.vtk")) +
+                                " --radius 0.3 --attributes id");
+    EXPECT_EQ(exact.exitCode, 0);
+    EXPECT_EQ(exact.err, "");
+    const ParticleSet back = nonbloppy::readParticles(path("p.vtk"));
+    const ParticleAttribute* ids = back.findAttribute("id");
+    ASSERT_NE(ids, nullptr);
+    ASSERT_EQ(ids->type, nonbloppy::ScalarType::Int64);
+    for (size_t i = 0; i < back.size(); ++i) {
+        int64_t value;
+        std::memcpy(&value, ids->bytes.data() + 8 * i, 8);
+        ASSERT_EQ(value, pastDouble + int64_t(nearestOf[i])) << "vertex " << i;
+    }
 }
 
 TEST_F(CliFormatsTest, APlyMeshGivenAsParticlesIsSaidToBeOne)

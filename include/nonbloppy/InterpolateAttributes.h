@@ -40,9 +40,9 @@ NONBLOPPY_API std::vector<std::string> resolveAttributeNames(const ParticleSet& 
 /// means would name nothing, take instead the value of the nearest particle within r_e (of
 /// equally near ones, the first in @a particles), exactly: they are flagged
 /// MeshAttribute::integer and held in MeshAttribute::integers (means as floats in
-/// MeshAttribute::values). The type is the file's (readParticles()); CSV and JSON declare
-/// none, and a column of whole numbers there reads as Int64: write 300.0, not 300, for a
-/// quantity to be averaged. A vertex with no particle within r_e gets 0. Every component is
+/// MeshAttribute::values). The type is the file's (readParticles()); CSV declares none, and
+/// a column of whole numbers there reads as Int64: write 300.0, not 300, for a quantity to
+/// be averaged. A vertex with no particle within r_e gets 0. Every component is
 /// interpolated independently. An attribute already on the mesh under the same name is
 /// replaced (also on a mesh without vertices).
 /// Cost: a ParticleIndex of the particles with cells of r_e (O(N), not interruptible), then

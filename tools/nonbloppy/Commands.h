@@ -59,6 +59,19 @@ std::string versionLine();
 void warnRenamedAttributes(const std::vector<std::string>& original, const std::vector<std::string>& written,
                            const std::string& path);
 
+/// The largest magnitude up to which a double holds every integer: PLY has no 64-bit
+/// integer type, so the writers store such attributes as doubles, exact to here only.
+constexpr int64_t kExactInDouble = int64_t(1) << 53;
+
+/// Whether @a value is within ±kExactInDouble.
+inline bool exactInDouble(int64_t value) { return value >= -kExactInDouble && value <= kExactInDouble; }
+
+/// Warn on stderr that attribute @a name holds integers past 2^53, which @a path, a PLY
+/// file, stores rounded: "nonbloppy: warning: attribute 'id' holds integers past 2^53, which
+/// out.ply stores as doubles, rounded (PLY has no 64-bit integers); write .vtk to keep them
+/// exact". Defined in main.cc.
+void warnRoundedInPly(const std::string& name, const std::string& path);
+
 /// @throw UsageError("<@a name> needs a file name, got ''") if @a path is empty, say a shell
 ///        variable left unset: "cannot open : No such file or directory" named nothing, and
 ///        an empty --vdb wrote no grid without a word.

@@ -12,6 +12,7 @@
 #include <nonbloppy/WriteMesh.h>
 #include <nonbloppy/WriteParticles.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cctype>
 #include <iostream>
@@ -38,6 +39,7 @@ std::vector<std::string> splitNames(const std::string& list)
 
 std::atomic<bool> gObjWarningPrinted{false};
 std::atomic<bool> gRenameWarningPrinted{false};
+std::atomic<bool> gRoundingWarningPrinted{false};
 
 } // namespace
 
@@ -80,6 +82,14 @@ void addSurfaceAttributes(nonbloppy::SurfaceResult& result, const nonbloppy::Par
     if (ext == ".obj" && !result.mesh.attributes.empty() && !gObjWarningPrinted.exchange(true)) {
         std::cerr << "nonbloppy: warning: OBJ cannot store vertex attributes; write .ply or .vtk "
                      "to keep --attributes" << std::endl;
+    }
+    if (ext == ".ply" && !gRoundingWarningPrinted) {
+        for (const nonbloppy::MeshAttribute& a : result.mesh.attributes) {
+            if (a.integer && !std::all_of(a.integers.begin(), a.integers.end(), exactInDouble)
+                && !gRoundingWarningPrinted.exchange(true)) {
+                warnRoundedInPly(a.name, meshPath);
+            }
+        }
     }
     // Once per run: the frames of a sequence carry the same attributes.
     if (ext != ".obj" && !result.mesh.attributes.empty() && !gRenameWarningPrinted.exchange(true)) {

@@ -45,18 +45,34 @@ std::string versionLine()
            + openvdb::getLibraryVersionString() + ")";
 }
 
+namespace {
+
+/// @a name as shown in a warning: control bytes would act on the terminal.
+std::string shownName(std::string name)
+{
+    for (char& c : name) {
+        if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) c = '?';
+    }
+    return name;
+}
+
+} // namespace
+
 void warnRenamedAttributes(const std::vector<std::string>& original, const std::vector<std::string>& written,
                            const std::string& path)
 {
     for (size_t i = 0; i < original.size() && i < written.size(); ++i) {
         if (written[i].empty() || written[i] == original[i]) continue;
-        std::string shown = original[i];  // control bytes would act on the terminal
-        for (char& c : shown) {
-            if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) c = '?';
-        }
-        std::cerr << "nonbloppy: warning: attribute '" << shown << "' is written to " << path << " as '"
-                  << written[i] << "'" << std::endl;
+        std::cerr << "nonbloppy: warning: attribute '" << shownName(original[i]) << "' is written to " << path
+                  << " as '" << written[i] << "'" << std::endl;
     }
+}
+
+void warnRoundedInPly(const std::string& name, const std::string& path)
+{
+    std::cerr << "nonbloppy: warning: attribute '" << shownName(name) << "' holds integers past 2^53, which " << path
+              << " stores as doubles, rounded (PLY has no 64-bit integers); write .vtk to keep them exact"
+              << std::endl;
 }
 
 } // namespace nonbloppy_tool
