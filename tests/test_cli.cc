@@ -455,6 +455,18 @@ TEST_F(CliTest, InspectUnknownExtension)
                            "or .json\n");
 }
 
+TEST_F(CliTest, InspectRefusesAFifoInsteadOfWaitingForIt)
+{
+    // inspect opens its file more than once: a FIFO's writer left after the first read and
+    // the second open() waited for another one for ever. No writer is needed to refuse it.
+    const std::string fifo = in("fifo.vtk");
+    ASSERT_EQ(::mkfifo(fifo.c_str(), 0644), 0);
+    const RunResult r = run("inspect " + quote(fifo));
+    EXPECT_EQ(r.exitCode, 1);
+    EXPECT_EQ(r.err, "nonbloppy: cannot inspect " + fifo + ": not a regular file (inspect reads it more than once; "
+                     "save it to a file first)\n");
+}
+
 TEST_F(CliTest, InspectBrokenMeshIsNotCalledAParticleFile)
 {
     // Its vertices alone would read as three particles.

@@ -542,6 +542,13 @@ int runInspect(const std::string& path, bool json)
     if (S_ISDIR(info.st_mode)) {
         throw nonbloppy::FileError("cannot open " + path + ": " + std::strerror(EISDIR));
     }
+    // The format is told from the file before it is read, and a mesh's attributes are read
+    // again: a FIFO (or a shell's <(...)) would be drained by the first read and block the
+    // next open for ever.
+    if (!S_ISREG(info.st_mode)) {
+        throw nonbloppy::FileError("cannot inspect " + path + ": not a regular file (inspect reads it more than "
+                                   "once; save it to a file first)");
+    }
 
     const std::string ext = lowerExtension(path);
     if (ext == ".vdb") return inspectVdb(path, json);
