@@ -14,7 +14,9 @@ namespace nonbloppy {
 
 /// Set mesh.normals[i] to the normalized sum of the area-weighted normals of the polygons
 /// around vertex i (a quad's normal is half the cross product of its diagonals).
-/// A vertex no polygon uses, or whose normals cancel, gets (0,0,0).
+/// A vertex no polygon uses, or whose normals cancel, gets (0,0,0); so does one whose
+/// polygons all have zero area, as a droplet's do when c = 1 collapses it to its particle
+/// (radius (1 − c)^t r), which covers no pixel when rendered.
 /// Cost: O(P + V), in parallel over ranges of 32,768 vertex numbers, each summing the
 /// polygons that touch it; deterministic (each vertex sums its polygons in polygon order, so
 /// the bits do not depend on the ranges or the thread count). When polygon order and vertex
