@@ -12,6 +12,7 @@
 #include <tbb/parallel_reduce.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -40,14 +41,17 @@ addEdge(std::vector<EdgeUse>& edges, uint32_t from, uint32_t to)
     edges.push_back({(uint64_t(low) << 32) | high, from < to});
 }
 
-/// Adds the area and the signed volume of the tetrahedron (origin, p0, p1, p2).
-void
+/// Adds the area and the signed volume of the tetrahedron (origin, p0, p1, p2); returns
+/// the triangle's area.
+double
 addTriangle(const SurfaceMesh& mesh, uint32_t i0, uint32_t i1, uint32_t i2, AreaAndVolume& m)
 {
     const openvdb::Vec3d p0(mesh.points[i0]), p1(mesh.points[i1]), p2(mesh.points[i2]);
-    m.area += 0.5 * (p1 - p0).cross(p2 - p0).length();
+    const double area = 0.5 * (p1 - p0).cross(p2 - p0).length();
+    m.area += area;
     // Divergence theorem: the volume is the sum over faces of p0 · (p1 × p2) / 6.
     m.volume += p0.dot(p1.cross(p2)) / 6.0;
+    return area;
 }
 
 [[noreturn]] void
@@ -97,8 +101,11 @@ polygon_indices_internal::requireValidIndices(const SurfaceMesh& mesh)
     if (!badIndex.empty()) throw ParameterError(badIndex);
 }
 
+namespace {
+
+/// measureAreaAndVolume(), also counting the polygons of zero area in @a zeroArea.
 AreaAndVolume
-measureAreaAndVolume(const SurfaceMesh& mesh)
+sumAreaAndVolume(const SurfaceMesh& mesh, size_t& zeroArea)
 {
     AreaAndVolume m;
     const size_t vertexCount = mesh.points.size();
@@ -107,18 +114,27 @@ measureAreaAndVolume(const SurfaceMesh& mesh)
         for (int i = 0; i < 3; ++i) {
             if (t[i] >= vertexCount) throwBadIndex(mesh, polygon, t[i]);
         }
-        addTriangle(mesh, t[0], t[1], t[2], m);
+        zeroArea += addTriangle(mesh, t[0], t[1], t[2], m) == 0.0;
         ++polygon;
     }
     for (const openvdb::Vec4I& q : mesh.quads) {
         for (int i = 0; i < 4; ++i) {
             if (q[i] >= vertexCount) throwBadIndex(mesh, polygon, q[i]);
         }
-        addTriangle(mesh, q[0], q[1], q[2], m);
-        addTriangle(mesh, q[0], q[2], q[3], m);
+        const double first = addTriangle(mesh, q[0], q[1], q[2], m);
+        zeroArea += first + addTriangle(mesh, q[0], q[2], q[3], m) == 0.0;
         ++polygon;
     }
     return m;
+}
+
+} // namespace
+
+AreaAndVolume
+measureAreaAndVolume(const SurfaceMesh& mesh)
+{
+    size_t zeroArea = 0;
+    return sumAreaAndVolume(mesh, zeroArea);
 }
 
 MeshMeasures
@@ -128,9 +144,10 @@ measureMesh(const SurfaceMesh& mesh)
     m.vertices = mesh.points.size();
     m.polygons = mesh.polygonCount();
     // Checks every index first (the same error for the same mesh), so the loop below may trust them.
-    const AreaAndVolume sums = measureAreaAndVolume(mesh);
+    const AreaAndVolume sums = sumAreaAndVolume(mesh, m.zeroAreaPolygons);
     m.area = sums.area;
     m.volume = sums.volume;
+    for (const openvdb::Vec3s& p : mesh.points) m.nonFiniteVertices += !std::isfinite(p[0] + p[1] + p[2]);
 
     std::vector<bool> used(mesh.points.size(), false);
     std::vector<EdgeUse> edges;

@@ -7,6 +7,8 @@
 
 #include <gtest/gtest.h>
 
+#include <limits>
+
 #include <algorithm>
 
 namespace {
@@ -60,6 +62,8 @@ TEST(MeasureMesh, UnitCubeOfQuadsIsClosedManifoldWithAreaSixAndVolumeOne)
     EXPECT_EQ(m.vertices, 8u);
     EXPECT_EQ(m.polygons, 6u);
     EXPECT_EQ(m.unusedVertices, 0u);
+    EXPECT_EQ(m.nonFiniteVertices, 0u);
+    EXPECT_EQ(m.zeroAreaPolygons, 0u);
     EXPECT_EQ(m.boundaryEdges, 0u);
     EXPECT_EQ(m.nonManifoldEdges, 0u);
     EXPECT_EQ(m.inconsistentEdges, 0u);
@@ -165,6 +169,26 @@ TEST(MeasureMesh, TwoCubesSharingAnEdgeAreClosedButNotManifold)
     EXPECT_FALSE(m.manifold);
     EXPECT_DOUBLE_EQ(m.volume, 2.0);
     EXPECT_DOUBLE_EQ(m.area, 12.0);
+}
+
+TEST(MeasureMesh, CountsZeroAreaPolygonsAndNonFiniteVertices)
+{
+    // Edges alone called a triangle with a corner repeated, or a droplet that -c 1 shrank to
+    // a point, closed and manifold: the count says what they are.
+    SurfaceMesh mesh = cube();
+    mesh.points.push_back(mesh.points[0]);  // 8: on top of corner 0
+    mesh.triangles = {{0, 0, 1},           // a corner repeated
+                      {0, 8, 0}};          // and a point, twice
+    mesh.quads.push_back({0, 8, 0, 8});     // a quad of one point
+    MeshMeasures m = measureMesh(mesh);
+    EXPECT_EQ(m.zeroAreaPolygons, 3u);
+    EXPECT_EQ(m.nonFiniteVertices, 0u);
+    EXPECT_DOUBLE_EQ(m.area, 6.0);
+    mesh.points[8] = openvdb::Vec3s(0.0f, std::numeric_limits<float>::quiet_NaN(), 0.0f);
+    mesh.points.push_back(openvdb::Vec3s(std::numeric_limits<float>::infinity(), 0.0f, 0.0f));
+    m = measureMesh(mesh);
+    EXPECT_EQ(m.nonFiniteVertices, 2u);
+    EXPECT_EQ(m.zeroAreaPolygons, 1u) << "a NaN area is not zero";
 }
 
 TEST(MeasureMesh, EmptyMeshIsNeitherClosedNorManifold)

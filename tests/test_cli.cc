@@ -164,6 +164,21 @@ TEST_F(CliTest, InspectSaysWhyAnOpenOrEmptyMeshIsNotManifold)
         << r.out;
 }
 
+TEST_F(CliTest, InspectCountsZeroAreaFacesAndNonFiniteVertices)
+{
+    // A triangle with a corner repeated is closed and manifold by its edges; a NaN vertex
+    // gave area "nan" with no word why.
+    writeText(out("degenerate.obj"), "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 nan\nf 1 1 2\n");
+    RunResult r = run("inspect " + quote(out("degenerate.obj")));
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_NE(r.out.find("  vertices         4, 2 unused, 1 not finite\n"
+                         "  faces            1 (1 triangles, 0 quads, 1 of zero area)\n"), std::string::npos) << r.out;
+    r = run("inspect --json " + quote(out("degenerate.obj")));
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_EQ(jsonNumber(r.out, "non_finite_vertices"), 1.0) << r.out;
+    EXPECT_EQ(jsonNumber(r.out, "zero_area_faces"), 1.0) << r.out;
+}
+
 TEST_F(CliTest, InspectListsAMeshsAttributesOnlyWhenTheyCanBeRead)
 {
     // A mesh's vertex attributes are read as particles, which refuse a NaN vertex that the

@@ -18,6 +18,9 @@ struct MeshMeasures
     size_t vertices = 0;          ///< mesh.points.size()
     size_t polygons = 0;          ///< triangles + quads
     size_t unusedVertices = 0;    ///< vertices no polygon references
+    size_t nonFiniteVertices = 0; ///< vertices with a NaN or infinite coordinate
+    size_t zeroAreaPolygons = 0;  ///< polygons of zero area: collapsed (c = 1 shrinks a
+                                  ///< droplet to a point) or with a corner repeated
     size_t boundaryEdges = 0;     ///< edges with one adjacent polygon
     size_t nonManifoldEdges = 0;  ///< edges with three or more adjacent polygons
     size_t inconsistentEdges = 0; ///< edges of two polygons that both use it in the same

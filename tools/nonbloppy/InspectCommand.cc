@@ -291,6 +291,8 @@ int inspectMesh(const std::string& path, const nonbloppy::SurfaceMesh& mesh, boo
         w.integer("non_manifold_edges", static_cast<long long>(m.nonManifoldEdges));
         w.integer("inconsistent_edges", static_cast<long long>(m.inconsistentEdges));
         w.integer("unused_vertices", static_cast<long long>(m.unusedVertices));
+        w.integer("non_finite_vertices", static_cast<long long>(m.nonFiniteVertices));
+        w.integer("zero_area_faces", static_cast<long long>(m.zeroAreaPolygons));
         w.number("area", m.area);
         w.number("volume", m.volume);
         w.boundingBox(bbox);
@@ -305,9 +307,13 @@ int inspectMesh(const std::string& path, const nonbloppy::SurfaceMesh& mesh, boo
     printRow("vertices", std::to_string(m.vertices)
                              + (mesh.normals.empty() ? "" : " (with normals)")
                              + (m.unusedVertices ? ", " + std::to_string(m.unusedVertices) + " unused"
-                                                 : ""));
+                                                 : "")
+                             + (m.nonFiniteVertices ? ", " + std::to_string(m.nonFiniteVertices) + " not finite"
+                                                    : ""));
     printRow("faces", std::to_string(m.polygons) + " (" + std::to_string(mesh.triangles.size())
-                          + " triangles, " + std::to_string(mesh.quads.size()) + " quads)");
+                          + " triangles, " + std::to_string(mesh.quads.size()) + " quads"
+                          + (m.zeroAreaPolygons ? ", " + std::to_string(m.zeroAreaPolygons) + " of zero area" : "")
+                          + ")");
     // Manifold here includes closed (MeshMeasures), so an open or empty mesh says why not.
     if (m.polygons == 0) {
         printRow("closed", "no (no faces)");
