@@ -163,6 +163,27 @@ TEST_F(CliSequenceTest, NoFrameWritesAnotherFramesInputOrTheLog)
                      "cannot write " + dotted + ": --log names an output of frame 11");
 }
 
+TEST_F(CliSequenceTest, NoOutputIsNamedSoTheInputPatternWouldReadItAsAFrame)
+{
+    // 'f_{}.vtk' -o 'f_####.vtk' wrote frame 7's mesh as f_0007.vtk beside the particles
+    // f_007.vtk: every later run of the pattern stopped at "both frame 7". Refused before
+    // anything is written, the same from another spelling of the directory.
+    fs::copy_file(kCube, in("f_007.vtk"));
+    const std::string before = readText(in("f_007.vtk"));
+    expectUsageError("mesh " + quote(in("f_{}.vtk")) + " -o " + quote(in("f_####.vtk")),
+                     "cannot write " + in("f_0007.vtk") + ": " + in("f_{}.vtk") + " would read it as frame 7");
+    const std::string dotted = dir() + "/in/./f_%05d.vtk";
+    expectUsageError("mesh " + quote(in("f_{}.vtk")) + " -o " + quote(dotted),
+                     "cannot write " + dir() + "/in/./f_00007.vtk: " + in("f_{}.vtk") + " would read it as frame 7");
+    EXPECT_EQ(listDir(dir() + "/in"), (std::vector<std::string>{"f_007.vtk"}));
+    EXPECT_EQ(readText(in("f_007.vtk")), before);
+    // A name the pattern does not read, or another directory, is fine.
+    for (const std::string output : {in("f_####_mesh.vtk"), out("f_####.vtk")}) {
+        const RunResult r = run("mesh -q " + quote(in("f_{}.vtk")) + " -o " + quote(output));
+        EXPECT_EQ(r.exitCode, 0) << output << ": " << r.err;
+    }
+}
+
 TEST_F(CliSequenceTest, SequenceOptionsNeedASequence)
 {
     const RunResult r = run("mesh " + quote(kFree) + " -o " + quote(out("m.obj")) + " --frames 1-3");

@@ -769,12 +769,15 @@ std::string fileIdentity(const std::string& path)
 /// sequence (@a sequence: every frame on disk, requested or not; 'x{}.vtk' -o 'x1{}.vtk':
 /// frame 1's mesh x11.vtk would replace frame 11's particles, then be read as them), and a
 /// --log that names an input (overwritten with JSON) or an output (whose rename would
-/// replace the log). Each frame's own input is
+/// replace the log), and an output the input pattern would read as a frame ('f_{}.vtk' -o
+/// 'f_####.vtk': frame 7's mesh f_0007.vtk beside the particles f_007.vtk made every later
+/// run stop at "f_0007.vtk and f_007.vtk are both frame 7"). Each frame's own input is
 /// checked again by validatePaths(). Cost: one stat() (and, for files not yet there, one
 /// weakly_canonical()) per path, O(F log F) for F frames.
-void requireOutputsApart(const std::vector<Frame>& sequence, const std::vector<BatchJob>& jobs,
-                         const std::string& logPath)
+void requireOutputsApart(const FramePattern& input, const std::vector<Frame>& sequence,
+                         const std::vector<BatchJob>& jobs, const std::string& logPath)
 {
+    const std::string inputDirectory = fileIdentity(input.directory().empty() ? "." : input.directory());
     std::map<std::string, int> inputs;
     for (const Frame& frame : sequence) {
         inputs.emplace(fileIdentity(frame.input), frame.number);
@@ -790,9 +793,16 @@ void requireOutputsApart(const std::vector<Frame>& sequence, const std::vector<B
     for (const BatchJob& job : jobs) {
         for (const std::string& output : job.outputs) {
             const std::string identity = fileIdentity(output);
-            if (const auto input = inputs.find(identity); input != inputs.end()) {
+            if (const auto found = inputs.find(identity); found != inputs.end()) {
                 throw UsageError("cannot write " + output + ": it is the input of frame " +
-                                 std::to_string(input->second));
+                                 std::to_string(found->second));
+            }
+            const fs::path outputPath(output);
+            const std::string outputDirectory = outputPath.parent_path().empty() ? "." : outputPath.parent_path().string();
+            if (const auto digits = input.matchFileName(outputPath.filename().string());
+                digits && fileIdentity(outputDirectory) == inputDirectory) {
+                throw UsageError("cannot write " + output + ": " + input.text() + " would read it as frame " +
+                                 std::to_string(std::stoi(*digits)));
             }
             if (identity == log) {
                 throw UsageError("cannot write " + logPath + ": --log names an output of frame " +
@@ -863,7 +873,7 @@ int runSequence(const MeshOptions& o)
     }
     // Output extensions and directories, before any work.
     validatePaths(optionsForFrame(o, plan.frames.front()));
-    requireOutputsApart(plan.onDisk, jobs, o.logPath);
+    requireOutputsApart(input, plan.onDisk, jobs, o.logPath);
 
     std::unique_ptr<tbb::global_control> threadLimit;
     if (o.threadsOpt->count() > 0) {
