@@ -967,7 +967,7 @@ public:
     void feed(const char* text, size_t n)
     {
         mChecks.grow(n);
-        if (mChecks.stopped() || mDone == mValues) return;
+        if (mChecks.stopped()) return;
         size_t i = 0;
         while (i < n && mDone < mValues && !mChecks.stopped()) {
             if (isBlank(text[i])) {
@@ -990,14 +990,23 @@ public:
                 mToken.clear();
             }
         }
+        // Past the declared count only blanks may follow: a value more means the count (or
+        // the array) is wrong, and was dropped without a word.
+        if (mDone == mValues && mToken.empty()) {
+            mExtra = mExtra || std::any_of(text + i, text + n, [](char c) { return !isBlank(c); });
+        }
     }
 
-    /// The text has ended: fail if it was too short or held a bad value.
+    /// The text has ended: fail if it was too short or too long, or held a bad value.
     void finish()
     {
-        if (!mToken.empty() && mDone < mValues && !mChecks.stopped()) parse(mToken);
+        if (!mToken.empty() && !mChecks.stopped()) {
+            if (mDone < mValues) parse(mToken);
+            else mExtra = true;
+        }
         mChecks.finish();
         if (mDone < mValues) fail(mPath, "truncated ascii data in " + mWhat);
+        if (mExtra) fail(mPath, "more than the " + std::to_string(mValues) + " declared values in " + mWhat);
     }
 
 private:
@@ -1028,6 +1037,7 @@ private:
     std::string mWhat;
     TextChecks mChecks;
     uint64_t mDone = 0;
+    bool mExtra = false;  ///< a value after the last declared one
     std::string mToken;  ///< a value split between two pieces of text
 };
 

@@ -474,6 +474,14 @@ TEST_F(ReadVtuStreamingTest, TruncatedAndCorruptFilesGiveTheExistingMessages)
     fewer.erase(text, fewer.find('\n', text + 3000) - text);
     const std::string fewerFile = write("fewer.vtu", fewer);
     EXPECT_EQ(errorOfBoth(fewerFile), "truncated ascii data in 'density' (" + fewerFile + ")");
+    // One value more than declared was dropped without a word; trailing blanks are fine.
+    std::string more = ascii;
+    more.insert(text, "7 ");
+    const std::string moreFile = write("more.vtu", more);
+    EXPECT_EQ(errorOfBoth(moreFile), "more than the 1000 declared values in 'density' (" + moreFile + ")");
+    std::string blanks = ascii;
+    blanks.insert(ascii.find("</DataArray>", text), " \n\t ");
+    EXPECT_NO_THROW(nonbloppy::readParticles(write("blanks.vtu", blanks)));
     ascii.replace(ascii.find(' ', text + 500) + 1, 1, "x");
     const std::string badValueFile = write("badvalue.vtu", ascii);
     EXPECT_EQ(errorOfBoth(badValueFile).rfind("bad value '", 0), 0u) << errorOfBoth(badValueFile);
