@@ -13,6 +13,7 @@
 #include <cmath>
 #include <limits>
 #include <sstream>
+#include <tuple>
 
 namespace nonbloppy {
 
@@ -127,8 +128,11 @@ ParticleIndex ParticleIndex::build(std::vector<openvdb::Vec3f> positions, double
     impl.grid->tree().evalLeafBoundingBox(impl.leafBounds);  // stays empty without particles
 
     // Give every particle a sorted slot: leaves in tree order, then voxels in offset order,
-    // then (sorted here, so the result never depends on the partitioner's threading)
-    // ascending original index. Afterwards the grid's index lists hold slots, not originals.
+    // then (sorted here) by position, x, then y, then z, and ascending original index among
+    // equal positions. So the slots, and every sum the stages make over them, depend neither
+    // on the partitioner's threading nor on the particles' order in the file: a frame
+    // written in another order (a .vdb round trip, a simulator that re-sorts its particles)
+    // meshes to the same bytes. Afterwards the grid's index lists hold slots, not originals.
     openvdb::tree::LeafManager<IndexTree> leaves(impl.grid->tree());
     std::vector<size_t> leafStart(leaves.leafCount() + 1, 0);
     for (size_t n = 0; n < leaves.leafCount(); ++n) {
@@ -143,7 +147,13 @@ ParticleIndex ParticleIndex::build(std::vector<openvdb::Vec3f> positions, double
                 uint32_t begin = 0;
                 for (openvdb::Index offset = 0; offset < IndexLeaf::SIZE; ++offset) {
                     const uint32_t end = uint32_t(leaf.getValue(offset));
-                    std::sort(indices.begin() + begin, indices.begin() + end);
+                    std::sort(indices.begin() + begin, indices.begin() + end,
+                              [&](openvdb::PointIndex32 a, openvdb::PointIndex32 b) {
+                                  const openvdb::Vec3f& p = positions[uint32_t(a)];
+                                  const openvdb::Vec3f& q = positions[uint32_t(b)];
+                                  return std::make_tuple(p[0], p[1], p[2], uint32_t(a))
+                                       < std::make_tuple(q[0], q[1], q[2], uint32_t(b));
+                              });
                     begin = end;
                 }
                 for (size_t i = 0; i < indices.size(); ++i) {

@@ -9,6 +9,8 @@
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
 
+#include <algorithm>
+#include <random>
 #include <string>
 #include <thread>
 #include <vector>
@@ -95,6 +97,33 @@ TEST(BuildSurface, IdenticalWithOneAndTwoThreads)
     EXPECT_EQ(serial.mesh.quads, parallel.mesh.quads);
     EXPECT_EQ(serial.mesh.triangles, parallel.mesh.triangles);
     EXPECT_EQ(serial.density->activeVoxelCount(), parallel.density->activeVoxelCount());
+}
+
+TEST(BuildSurface, TheSameBytesWhateverTheParticlesOrder)
+{
+    // Particles of one cell were summed in file order: the same frame written in another
+    // order (a simulator that re-sorts its particles, a conversion) estimated s = 0.0467139,
+    // 0.0467137 or 0.0467175 and meshed to other bytes. The index now orders each cell's
+    // particles by position. Checked with the spacing estimated, and given (the volume
+    // correction and the smoothing then run too).
+    const ParticleSet particles = readParticles(dataPath("dam_break_frame_23_24389_particles.vtk"));
+    std::vector<openvdb::Vec3f> shuffled = particles.positions;
+    std::shuffle(shuffled.begin(), shuffled.end(), std::mt19937(11));
+    std::vector<openvdb::Vec3f> reversed(particles.positions.rbegin(), particles.positions.rend());
+    for (const double spacing : {0.0, 0.0467}) {
+        SurfaceParameters params;
+        if (spacing > 0.0) params.spacing = spacing;
+        const SurfaceResult inOrder = buildSurface(particles.positions, params);
+        ASSERT_GT(inOrder.mesh.points.size(), 10000u);
+        for (const std::vector<openvdb::Vec3f>* other : {&shuffled, &reversed}) {
+            const SurfaceResult result = buildSurface(*other, params);
+            EXPECT_EQ(result.parameters.spacing, inOrder.parameters.spacing) << spacing;
+            EXPECT_TRUE(result.mesh.points == inOrder.mesh.points) << spacing;
+            EXPECT_TRUE(result.mesh.normals == inOrder.mesh.normals) << spacing;
+            EXPECT_EQ(result.mesh.triangles, inOrder.mesh.triangles) << spacing;
+            EXPECT_EQ(result.mesh.quads, inOrder.mesh.quads) << spacing;
+        }
+    }
 }
 
 TEST(BuildSurface, ConcurrentCallsOnDifferentFramesGiveTheirOwnResults)

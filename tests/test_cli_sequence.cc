@@ -666,7 +666,7 @@ TEST_F(CliSequenceTest, TheLoggedLengthsAndStepCapGivenBackMeshTheSameBytes)
     EXPECT_FALSE(derived == readText(out("uncapped_0001.ply")));
     // The summary says which cap a run used.
     const std::string single = "mesh " + quote(in("fluid_0001.vtk")) + " -c 1 -t 4 -o " + quote(out("one.ply"));
-    EXPECT_NE(run(single).out.find("  max step             0.023357       (s/2)\n"), std::string::npos);
+    EXPECT_NE(run(single).out.find("  max step             0.0233607      (s/2)\n"), std::string::npos);
     EXPECT_NE(run(single + lengths).out.find("  max step             none           (no spacing to derive it from)\n"),
               std::string::npos);
     EXPECT_NE(run(single + " --max-step 0.01").out.find("  max step             0.01           (given)\n"),

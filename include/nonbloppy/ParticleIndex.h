@@ -62,7 +62,8 @@ public:
     ParticleIndex& operator=(ParticleIndex&&) noexcept;
 
     /// Bucket @a positions (world units, taken over and reordered) into cells of
-    /// @a cellSize world units. Cost: O(N) time (parallel radix partitioning by OpenVDB).
+    /// @a cellSize world units. Cost: O(N) time (parallel radix partitioning by OpenVDB),
+    /// plus a sort of each cell's few particles by position.
     /// @param positions    world units; taken over (reordered into the index's own array)
     /// @param cellSize     cell edge, world units, ≥ kMinCellSize
     /// @param interrupter  optional; asked every 4096 particles of the checks and once per
@@ -84,7 +85,9 @@ public:
     size_t size() const;
     /// Position of the particle at sorted slot @a k (PointArray concept, for OpenVDB tools).
     void getPos(size_t k, openvdb::Vec3R& xyz) const { xyz = sortedPositions()[k]; }
-    /// Positions in cell order (world units).
+    /// Positions in cell order (world units): cells in tree order, and within a cell by
+    /// position (x, then y, then z; equal positions by original index), so the order, and
+    /// every sum the stages make in it, does not depend on the order the particles came in.
     const std::vector<openvdb::Vec3f>& sortedPositions() const;
     /// originalIndex()[k] is the index, in the caller's particle list, of sorted slot k.
     const std::vector<uint32_t>& originalIndex() const;
