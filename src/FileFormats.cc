@@ -410,6 +410,20 @@ integerValue(const unsigned char* p, ScalarType type, int64_t& value)
     }
 }
 
+void
+requireInt64Values(const ParticleAttribute& attribute, const char* holder)
+{
+    if (attribute.type != ScalarType::UInt64) return;
+    for (size_t at = 0; at + 8 <= attribute.bytes.size(); at += 8) {
+        uint64_t value;
+        std::memcpy(&value, attribute.bytes.data() + at, 8);
+        if (value > uint64_t(std::numeric_limits<int64_t>::max())) {
+            throw ParameterError("attribute '" + attribute.name + "' holds " + std::to_string(value) +
+                                 ", above 9223372036854775807, the largest integer " + holder);
+        }
+    }
+}
+
 ScalarType
 plyIntegerType(int64_t lowest, int64_t highest)
 {

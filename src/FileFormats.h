@@ -183,6 +183,11 @@ const char* plyTypeName(ScalarType type);
 /// The legacy VTK data type name of @a type ("float", "unsigned_int", "vtktypeint64", ...).
 const char* vtkTypeName(ScalarType type);
 
+/// @throw ParameterError("attribute 'h' holds 18446744073709551615, above
+///        9223372036854775807, the largest integer @a holder") if @a attribute is UInt64
+///        and holds a value no int64 can (@a holder: "a .vdb stores", "a mesh attribute holds").
+void requireInt64Values(const ParticleAttribute& attribute, const char* holder);
+
 /// The native value of @a type at @a p as double.
 double valueAsDouble(const unsigned char* p, ScalarType type);
 

@@ -15,8 +15,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstring>
-#include <limits>
 #include <sstream>
 
 namespace nonbloppy {
@@ -126,34 +124,31 @@ struct InterpolateOp
 
 } // namespace
 
-void
-interpolateAttributes(SurfaceMesh& mesh, const ParticleSet& particles,
-                      const std::vector<std::string>& names, double effectiveRadius,
-                      openvdb::util::NullInterrupter* interrupter)
+std::vector<const ParticleAttribute*>
+checkAttributes(const ParticleSet& particles, const std::vector<std::string>& names)
 {
-    parameter_checks_internal::requirePositive(effectiveRadius, "--radius");
-    const std::vector<std::string> resolved = resolveAttributeNames(particles, names);
-    // Every check before start(), so that a start() is always followed by its end().
     std::vector<const ParticleAttribute*> attributes;
-    for (const std::string& name : resolved) {
+    for (const std::string& name : resolveAttributeNames(particles, names)) {
         const ParticleAttribute& attribute = *particles.findAttribute(name);
         if (attribute.size() != particles.size()) {
             throw ParameterError("attribute '" + attribute.name + "' has " +
                                  std::to_string(attribute.size()) + " values for " +
                                  std::to_string(particles.size()) + " particles");
         }
-        if (attribute.type == ScalarType::UInt64) {
-            for (size_t at = 0; at < attribute.bytes.size(); at += 8) {
-                uint64_t value;
-                std::memcpy(&value, attribute.bytes.data() + at, 8);
-                if (value > uint64_t(std::numeric_limits<int64_t>::max())) {
-                    throw ParameterError("attribute '" + attribute.name + "' holds " + std::to_string(value) +
-                                         ", above 9223372036854775807, the largest integer a mesh attribute holds");
-                }
-            }
-        }
+        io_internal::requireInt64Values(attribute, "a mesh attribute holds");
         attributes.push_back(&attribute);
     }
+    return attributes;
+}
+
+void
+interpolateAttributes(SurfaceMesh& mesh, const ParticleSet& particles,
+                      const std::vector<std::string>& names, double effectiveRadius,
+                      openvdb::util::NullInterrupter* interrupter)
+{
+    parameter_checks_internal::requirePositive(effectiveRadius, "--radius");
+    // Every check before start(), so that a start() is always followed by its end().
+    const std::vector<const ParticleAttribute*> attributes = checkAttributes(particles, names);
 
     std::vector<MeshAttribute> out(attributes.size());
     for (size_t a = 0; a < attributes.size(); ++a) {

@@ -147,7 +147,9 @@ measureMesh(const SurfaceMesh& mesh)
     const AreaAndVolume sums = sumAreaAndVolume(mesh, m.zeroAreaPolygons);
     m.area = sums.area;
     m.volume = sums.volume;
-    for (const openvdb::Vec3s& p : mesh.points) m.nonFiniteVertices += !std::isfinite(p[0] + p[1] + p[2]);
+    for (const openvdb::Vec3s& p : mesh.points) {
+        m.nonFiniteVertices += !(std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2]));
+    }
 
     std::vector<bool> used(mesh.points.size(), false);
     std::vector<EdgeUse> edges;

@@ -131,7 +131,7 @@ ParticleIndex ParticleIndex::build(std::vector<openvdb::Vec3f> positions, double
     // then (sorted here) by position, x, then y, then z, and ascending original index among
     // equal positions. So the slots, and every sum the stages make over them, depend neither
     // on the partitioner's threading nor on the particles' order in the file: a frame
-    // written in another order (a .vdb round trip, a simulator that re-sorts its particles)
+    // written in another order (a conversion, a simulator that re-sorts its particles)
     // meshes to the same bytes. Afterwards the grid's index lists hold slots, not originals.
     openvdb::tree::LeafManager<IndexTree> leaves(impl.grid->tree());
     std::vector<size_t> leafStart(leaves.leafCount() + 1, 0);

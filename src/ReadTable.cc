@@ -14,8 +14,9 @@
 /// is Int64, else Float64.
 ///
 /// Both are read through a StreamReader (a bounded buffer) straight into the final arrays:
-/// table rows line by line, attribute values stored as float64 and turned into int64 in
-/// place at the end if all were integers; JSON through nlohmann's SAX parser, with no DOM.
+/// table rows line by line, an attribute's values stored as int64 while every one is a
+/// whole number that fits, then as float64 (those before converted) from the first that is
+/// not; JSON through nlohmann's SAX parser, with no DOM.
 /// Text has no counts to check; once the first rows show the bytes per particle, the
 /// arrays are reserved for the bytes left in the file plus a quarter (re-estimated if that
 /// falls short), so they are not copied as they grow.

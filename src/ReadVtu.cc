@@ -1000,10 +1000,7 @@ public:
     /// The text has ended: fail if it was too short or too long, or held a bad value.
     void finish()
     {
-        if (!mToken.empty() && !mChecks.stopped()) {
-            if (mDone < mValues) parse(mToken);
-            else mExtra = true;
-        }
+        if (!mToken.empty() && mDone < mValues && !mChecks.stopped()) parse(mToken);
         mChecks.finish();
         if (mDone < mValues) fail(mPath, "truncated ascii data in " + mWhat);
         if (mExtra) fail(mPath, "more than the " + std::to_string(mValues) + " declared values in " + mWhat);

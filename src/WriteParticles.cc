@@ -382,15 +382,10 @@ addScalarAttribute(PointDataGrid& grid, const PointIndexGrid& index, const Parti
     for (size_t n = 0; n < values.size(); ++n) {
         if (a.type == ScalarType::Int64 || a.type == ScalarType::UInt64) {
             // 64-bit integers are copied from their own bits: through a double, those above
-            // 2^53 lost their low bits. A uint64 above 2^63 - 1 has no int64 (the widest
-            // integer a .vdb attribute holds).
+            // 2^53 lost their low bits (a uint64 past int64 was refused before).
             const unsigned char* p = a.bytes.data() + (n * size_t(a.components) + size_t(c)) * 8;
             uint64_t bits;
             std::memcpy(&bits, p, 8);
-            if (a.type == ScalarType::UInt64 && bits > uint64_t(std::numeric_limits<int64_t>::max())) {
-                throw ParameterError("attribute '" + a.name + "' holds " + std::to_string(bits) +
-                                     ", above 9223372036854775807, the largest integer a .vdb stores");
-            }
             values[n] = static_cast<ScalarT>(static_cast<int64_t>(bits));
         } else {
             values[n] = static_cast<ScalarT>(a.asDouble(n, c));
@@ -464,6 +459,7 @@ pointDataGridOfFinitePositions(const ParticleSet& particles, double voxelSize)
             }
             continue;
         }
+        io_internal::requireInt64Values(a, "a .vdb stores");  // the widest integer a .vdb attribute holds
         const std::vector<std::string> columns = vdbColumns(names[i], a.components);
         for (int c = 0; c < a.components; ++c) {
             const std::string& name = columns[size_t(c)];

@@ -186,6 +186,7 @@ TEST(MeasureMesh, CountsZeroAreaPolygonsAndNonFiniteVertices)
     EXPECT_DOUBLE_EQ(m.area, 6.0);
     mesh.points[8] = openvdb::Vec3s(0.0f, std::numeric_limits<float>::quiet_NaN(), 0.0f);
     mesh.points.push_back(openvdb::Vec3s(std::numeric_limits<float>::infinity(), 0.0f, 0.0f));
+    mesh.points.push_back(openvdb::Vec3s(3e38f, 3e38f, 0.0f));  // finite, though their sum is not
     m = measureMesh(mesh);
     EXPECT_EQ(m.nonFiniteVertices, 2u);
     EXPECT_EQ(m.zeroAreaPolygons, 1u) << "a NaN area is not zero";

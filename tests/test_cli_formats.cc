@@ -317,6 +317,20 @@ TEST_F(CliFormatsTest, IntegerAttributesReachTheMeshAsTheNearestParticlesValue)
         std::memcpy(&value, ids->bytes.data() + 8 * i, 8);
         ASSERT_EQ(value, pastDouble + int64_t(nearestOf[i])) << "vertex " << i;
     }
+
+    // A uint64 past int64 has no place in a mesh attribute: refused once the frame is read,
+    // before it is meshed (-v lists the stages that ran), naming the file.
+    big.attributes[0].type = nonbloppy::ScalarType::UInt64;
+    const uint64_t tooLarge = std::numeric_limits<uint64_t>::max();
+    std::memcpy(big.attributes[0].bytes.data() + 8 * 5, &tooLarge, 8);
+    nonbloppy::writeParticles(big, path("hash.vtu"));
+    const RunResult refused = run("mesh -v " + quote(path("hash.vtu")) + " -o " + quote(path("h.vtk")) +
+                                  " --radius 0.3 --attributes id");
+    EXPECT_EQ(refused.exitCode, 1);
+    EXPECT_EQ(lines(refused.err).back(), "nonbloppy: " + path("hash.vtu") + ": attribute 'id' holds 18446744073709551615, "
+                                         "above 9223372036854775807, the largest integer a mesh attribute holds");
+    EXPECT_EQ(refused.err.find("rasterize density"), std::string::npos) << refused.err;
+    EXPECT_FALSE(fs::exists(path("h.vtk")));
 }
 
 TEST_F(CliFormatsTest, APlyMeshGivenAsParticlesIsSaidToBeOne)

@@ -32,6 +32,16 @@ namespace nonbloppy {
 NONBLOPPY_API std::vector<std::string> resolveAttributeNames(const ParticleSet& particles,
                                                const std::vector<std::string>& requested);
 
+/// The attributes of @a particles named in @a names (as resolveAttributeNames() takes them),
+/// checked as interpolateAttributes() checks them before any work, so a caller can refuse a
+/// frame before meshing it. Cost: O(N) for a UInt64 attribute (its values are scanned), O(1)
+/// otherwise.
+/// @throw ParameterError as resolveAttributeNames(); "attribute 'c' has 1 values for 1000
+///        particles"; "attribute 'h' holds 18446744073709551615, above 9223372036854775807,
+///        the largest integer a mesh attribute holds" (a UInt64 past int64).
+NONBLOPPY_API std::vector<const ParticleAttribute*> checkAttributes(const ParticleSet& particles,
+                                                                  const std::vector<std::string>& names);
+
 /// Append to mesh.attributes, for each attribute of @a particles named in @a names, its
 /// values at every vertex v_i of @a mesh (as positioned now, i.e. after relaxation):
 ///   f(v_i) = Σ_j w(|v_i − r_j|) f_j / Σ_j w(|v_i − r_j|),
@@ -55,10 +65,8 @@ NONBLOPPY_API std::vector<std::string> resolveAttributeNames(const ParticleSet& 
 /// @param interrupter  optional; start("interpolate attributes") … end() around the work
 ///                     (not for an empty mesh or no names), wasInterrupted() before each
 ///                     block of 256 vertices
-/// @throw ParameterError for r_e ≤ 0 or not finite, an unknown name, an attribute whose
-///        size differs from the particle count, a UInt64 attribute holding a value past
-///        2^63 − 1 ("attribute 'h' holds 18446744073709551615, above 9223372036854775807,
-///        the largest integer a mesh attribute holds"), or particles ParticleIndex::build() refuses
+/// @throw ParameterError for r_e ≤ 0 or not finite, what checkAttributes() refuses, or
+///        particles ParticleIndex::build() refuses
 ///        (r_e below kMinCellSize, a non-finite position, coordinates too far from the
 ///        origin); CancelledError("interrupted during interpolate attributes") when
 ///        @a interrupter says so.

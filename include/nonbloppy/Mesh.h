@@ -25,7 +25,7 @@ struct MeshAttribute
     std::string name;                ///< as the particles' attribute, e.g. "velocity"
     int components = 1;              ///< 1 for scalars, 3 for vectors, ...
     /// Which of the two arrays holds the values; the other stays empty. writeMesh() stores
-    /// integers as 32-bit ints where every one fits, else as doubles.
+    /// integers in the narrowest type of the format that holds every one (see there).
     bool integer = false;
     std::vector<float> values;       ///< points.size() × components floats, unless integer
     std::vector<int64_t> integers;   ///< points.size() × components integers, if integer

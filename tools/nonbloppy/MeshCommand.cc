@@ -773,7 +773,7 @@ std::string fileIdentity(const std::string& path)
 /// 'f_####.vtk': frame 7's mesh f_0007.vtk beside the particles f_007.vtk made every later
 /// run stop at "f_0007.vtk and f_007.vtk are both frame 7"). Each frame's own input is
 /// checked again by validatePaths(). Cost: one stat() (and, for files not yet there, one
-/// weakly_canonical()) per path, O(F log F) for F frames.
+/// weakly_canonical()) per path and per output directory, O(F log F) for F frames.
 void requireOutputsApart(const FramePattern& input, const std::vector<Frame>& sequence,
                          const std::vector<BatchJob>& jobs, const std::string& logPath)
 {

@@ -67,7 +67,7 @@ void checkAttributeList(const MeshOutputOptions& o)
 
 void requireAttributes(const nonbloppy::ParticleSet& particles, const MeshOutputOptions& o)
 {
-    if (!o.attributes.empty()) nonbloppy::resolveAttributeNames(particles, splitNames(o.attributes));
+    if (!o.attributes.empty()) nonbloppy::checkAttributes(particles, splitNames(o.attributes));
 }
 
 void addSurfaceAttributes(nonbloppy::SurfaceResult& result, const nonbloppy::ParticleSet& particles,

@@ -39,8 +39,9 @@ void addMeshOutputOptions(CLI::App* cmd, MeshOutputOptions& options, CLI::Option
 void checkAttributeList(const MeshOutputOptions& options);
 
 /// @throw nonbloppy::ParameterError("unknown attribute 'x'; the particles have: ...") if
-///        --attributes names an attribute @a particles lack: checked once the frame is read,
-///        before it is meshed.
+///        --attributes names an attribute @a particles lack, or one interpolateAttributes()
+///        refuses (nonbloppy::checkAttributes()): checked once the frame is read, before it
+///        is meshed.
 void requireAttributes(const nonbloppy::ParticleSet& particles, const MeshOutputOptions& options);
 
 /// With --attributes, interpolate the named attributes of @a particles to the final
