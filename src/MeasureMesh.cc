@@ -114,7 +114,7 @@ sumAreaAndVolume(const SurfaceMesh& mesh, size_t& zeroArea)
         for (int i = 0; i < 3; ++i) {
             if (t[i] >= vertexCount) throwBadIndex(mesh, polygon, t[i]);
         }
-        zeroArea += addTriangle(mesh, t[0], t[1], t[2], m) == 0.0;
+        zeroArea += (addTriangle(mesh, t[0], t[1], t[2], m) == 0.0);
         ++polygon;
     }
     for (const openvdb::Vec4I& q : mesh.quads) {
@@ -122,7 +122,8 @@ sumAreaAndVolume(const SurfaceMesh& mesh, size_t& zeroArea)
             if (q[i] >= vertexCount) throwBadIndex(mesh, polygon, q[i]);
         }
         const double first = addTriangle(mesh, q[0], q[1], q[2], m);
-        zeroArea += first + addTriangle(mesh, q[0], q[2], q[3], m) == 0.0;
+        const double second = addTriangle(mesh, q[0], q[2], q[3], m);
+        zeroArea += (first + second) == 0.0;
         ++polygon;
     }
     return m;

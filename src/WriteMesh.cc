@@ -24,7 +24,6 @@
 #include <tbb/task_group.h>
 
 #include <algorithm>
-#include <cmath>
 #include <charconv>
 #include <cstdint>
 #include <cstring>

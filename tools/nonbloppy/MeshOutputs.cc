@@ -83,12 +83,11 @@ void addSurfaceAttributes(nonbloppy::SurfaceResult& result, const nonbloppy::Par
         std::cerr << "nonbloppy: warning: OBJ cannot store vertex attributes; write .ply or .vtk "
                      "to keep --attributes" << std::endl;
     }
-    if (ext == ".ply" && !gRoundingWarningPrinted) {
+    if (ext == ".ply" && !gRoundingWarningPrinted) {  // once per run: the scan is for the first frame that needs it
         for (const nonbloppy::MeshAttribute& a : result.mesh.attributes) {
-            if (a.integer && !std::all_of(a.integers.begin(), a.integers.end(), exactInDouble)
-                && !gRoundingWarningPrinted.exchange(true)) {
-                warnRoundedInPly(a.name, meshPath);
-            }
+            if (!a.integer || std::all_of(a.integers.begin(), a.integers.end(), exactInDouble)) continue;
+            if (!gRoundingWarningPrinted.exchange(true)) warnRoundedInPly(a.name, meshPath);
+            break;
         }
     }
     // Once per run: the frames of a sequence carry the same attributes.
