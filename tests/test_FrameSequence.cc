@@ -219,12 +219,29 @@ TEST_F(FindFramesTest, TwoNamesForOneFrameIsAnErrorWhenThatFrameIsPlanned)
     EXPECT_EQ(two.frames[0].input, mDir + "/f_2.vtk");
 }
 
-TEST_F(FindFramesTest, PlaceholderInDirectoryIsAnError)
+TEST_F(FindFramesTest, PlaceholdersInDirectoriesArePartOfTheirNames)
 {
-    const FramePattern pattern = parseFramePattern(mDir + "/take_{}/fluid.vtk", "IN");
-    EXPECT_EQ(errorOf([&] { nonbloppy_tool::findFrames(pattern); }),
-              "IN: the frame placeholder must be in the file name, not in a directory ('" + mDir
-                  + "/take_{}/fluid.vtk')");
+    // A shot directory "take#2" or "50%done" made every path in it a pattern: a single
+    // file there could not be meshed, nor a sequence of frames in it.
+    fs::create_directories(mDir + "/take#2");
+    std::ofstream(mDir + "/take#2/f_7.vtk") << "x";
+    const FramePattern inTake = parseFramePattern(mDir + "/take#2/f_{}.vtk", "IN");
+    EXPECT_EQ(inTake.kind(), FramePattern::Kind::Braces);
+    const std::vector<Frame> frames = nonbloppy_tool::findFrames(inTake);
+    ASSERT_EQ(frames.size(), 1u);
+    EXPECT_EQ(frames[0].input, mDir + "/take#2/f_7.vtk");
+    EXPECT_EQ(inTake.path(8), mDir + "/take#2/f_8.vtk");
+    EXPECT_FALSE(parseFramePattern("take#2/single.ply", "--output").hasPlaceholder());
+    EXPECT_FALSE(parseFramePattern("50%d/{}x/m.obj", "--output").hasPlaceholder());
+    EXPECT_EQ(parseFramePattern("a_{}/b_##/m_%03d.obj", "--output").width(), 3);
+
+    // Only a directory spelling one: no sequence of directories is taken (the command
+    // refuses it when no such file exists).
+    EXPECT_TRUE(nonbloppy_tool::placeholderInDirectory("take_{}/fluid.vtk"));
+    EXPECT_TRUE(nonbloppy_tool::placeholderInDirectory("/a/f_%04d/b/fluid.vtk"));
+    EXPECT_FALSE(nonbloppy_tool::placeholderInDirectory("take_2/fluid_{}.vtk"));
+    EXPECT_FALSE(nonbloppy_tool::placeholderInDirectory("fluid_#.vtk"));
+
     const FramePattern missing = parseFramePattern(mDir + "/nowhere/f_{}.vtk", "IN");
     EXPECT_EQ(errorOf([&] { nonbloppy_tool::findFrames(missing); }),
               "cannot read directory " + mDir + "/nowhere: No such file or directory");

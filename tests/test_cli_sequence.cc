@@ -108,6 +108,35 @@ TEST_F(CliSequenceTest, HashAndPrintfPatterns)
                                                                  "m_009.ply", "m_010.ply"}));
 }
 
+TEST_F(CliSequenceTest, DirectoriesMaySpellPlaceholders)
+{
+    // '#', '{}' and '%d' in a directory are its name: a file in "shot#1" was refused as a
+    // pattern, and a sequence there as holding two placeholders.
+    const std::string shot = dir() + "/shot#1 50%d";
+    fs::create_directories(shot);
+    fs::copy_file(kFree, shot + "/fluid_0003.vtk");
+    fs::copy_file(kFree, shot + "/fluid_0004.vtk");
+    RunResult r = run("mesh " + quote(shot + "/fluid_0003.vtk") + " -o " + quote(shot + "/single.ply")
+                      + " --vdb " + quote(shot + "/single.vdb") + " -q");
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    r = run("mesh " + quote(shot + "/fluid_{}.vtk") + " -o " + quote(shot + "/m_#.obj") + " -q");
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_EQ(listDir(shot), (std::vector<std::string>{"fluid_0003.vtk", "fluid_0004.vtk", "m_3.obj", "m_4.obj",
+                                                       "single.ply", "single.vdb"}));
+
+    // Only a directory spelling one names no file, and frames are files: refused as before.
+    r = run("mesh " + quote(dir() + "/take_{}/fluid.vtk") + " -o " + quote(out("m.obj")));
+    EXPECT_EQ(r.exitCode, 2);
+    EXPECT_EQ(r.err, "nonbloppy: IN: the frame placeholder must be in the file name, not in a directory ('" + dir()
+                         + "/take_{}/fluid.vtk')\n");
+    makeFrames({kFree});
+    r = run("mesh " + quote(in("fluid_{}.vtk")) + " -o " + quote(out("m_{}/mesh.obj")));
+    EXPECT_EQ(r.exitCode, 2);
+    EXPECT_EQ(r.err, "nonbloppy: --output: the frame placeholder must be in the file name, not in a directory ('"
+                         + out("m_{}/mesh.obj") + "')\n");
+    EXPECT_TRUE(listDir(dir() + "/out").empty());
+}
+
 TEST_F(CliSequenceTest, OutputWithoutPlaceholderIsAnError)
 {
     makeFrames({kFree});

@@ -64,11 +64,11 @@ struct Placeholder
     int width = 0;
 };
 
-/// Every placeholder in @a text, left to right.
-std::vector<Placeholder> findPlaceholders(const std::string& text)
+/// Every placeholder in @a text from index @a begin on, left to right.
+std::vector<Placeholder> findPlaceholders(const std::string& text, size_t begin)
 {
     std::vector<Placeholder> found;
-    for (size_t i = 0; i < text.size();) {
+    for (size_t i = begin; i < text.size();) {
         if (text.compare(i, 2, "{}") == 0) {
             found.push_back({i, i + 2, FramePattern::Kind::Braces, 0});
             i += 2;
@@ -102,13 +102,28 @@ std::vector<Placeholder> findPlaceholders(const std::string& text)
     return found;
 }
 
+/// Where the file name of @a path begins (after its last '/').
+size_t fileNameStart(const std::string& path)
+{
+    const size_t slash = path.rfind('/');
+    return slash == std::string::npos ? 0 : slash + 1;
+}
+
 } // namespace
+
+bool placeholderInDirectory(const std::string& path)
+{
+    const size_t nameStart = fileNameStart(path);
+    const std::vector<Placeholder> found = findPlaceholders(path.substr(0, nameStart), 0);
+    return !found.empty();
+}
 
 FramePattern parseFramePattern(const std::string& text, const std::string& what)
 {
     FramePattern pattern;
     pattern.mText = text;
-    const std::vector<Placeholder> found = findPlaceholders(text);
+    // Only the file name: a directory is taken as it is spelled ("shot#2/fluid_{}.vtk").
+    const std::vector<Placeholder> found = findPlaceholders(text, fileNameStart(text));
     if (found.size() > 1) {
         throw UsageError(what + ": more than one frame placeholder in '" + text
                                         + "'");
@@ -248,10 +263,6 @@ std::string formatFrameList(std::vector<int> frames)
 std::vector<Frame> findFrames(const FramePattern& input)
 {
     const std::string dir = input.directory();
-    if (!input.placeholderInFileName()) {
-        throw UsageError("IN: the frame placeholder must be in the file name, "
-                                        "not in a directory ('" + input.text() + "')");
-    }
     std::error_code ec;
     fs::directory_iterator it(dir.empty() ? fs::path(".") : fs::path(dir), ec);
     if (ec) {

@@ -60,9 +60,6 @@ public:
     /// `####` and `%04d` accept exactly the digits path() would write for the number.
     std::optional<std::string> matchFileName(const std::string& fileName) const;
 
-    /// False if the placeholder is in a directory name ("sim_{}/fluid.vtk").
-    bool placeholderInFileName() const { return mSuffix.find('/') == std::string::npos; }
-
     /// The directory part of the pattern ("" for the current directory).
     std::string directory() const;
 
@@ -73,10 +70,15 @@ private:
     int mWidth = 0;
 };
 
-/// Find the placeholder in @a text. @a what names the option in errors ("IN", "--output"):
-/// "--output: more than one frame placeholder in 'a_{}_{}.obj'".
+/// Find the placeholder in the file name of @a text; placeholders in its directories are
+/// part of their names ("shot#2/fluid_{}.vtk" is a sequence in the directory "shot#2").
+/// @a what names the option in errors ("IN", "--output"): "--output: more than one frame placeholder in 'a_{}_{}.obj'".
 /// @throw nonbloppy::ParameterError
 FramePattern parseFramePattern(const std::string& text, const std::string& what);
+
+/// Whether a directory of @a path spells a placeholder ("take_{}/fluid.vtk"): a sequence
+/// whose frames are directories, which nonbloppy does not take, when no such file exists.
+bool placeholderInDirectory(const std::string& path);
 
 /// Parse a frame list: "1-240", "1-240:2" (every second frame), "12,15,90-99", "7".
 /// Returns the frames in increasing order, without duplicates. Spaces around items are
@@ -88,11 +90,9 @@ std::vector<int> parseFrameList(const std::string& text, const std::string& what
 /// parseFrameList() reads them (consecutive frames from two, stepped ones from three).
 std::string formatFrameList(std::vector<int> frames);
 
-/// Every frame of @a input on disk, in increasing order (the placeholder must be in the file
-/// name, not in a directory).
+/// Every frame of @a input on disk, in increasing order.
 /// Two files that give the same number are both kept (Frame::otherInput).
-/// @throw nonbloppy::FileError if the directory cannot be read,
-///        nonbloppy::ParameterError if the placeholder is in a directory name.
+/// @throw nonbloppy::FileError if the directory cannot be read.
 std::vector<Frame> findFrames(const FramePattern& input);
 
 /// The frames a run works on.

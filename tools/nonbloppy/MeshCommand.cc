@@ -706,13 +706,21 @@ void warnAboutFrame(const MeshOptions& f, const nonbloppy::SurfaceResult& result
 // ---------------------------------------------------------------------------------------
 // Frame sequences
 
+/// The refusal of a placeholder that only a directory of @a path spells.
+std::string placeholderInDirectoryError(const std::string& option, const std::string& path)
+{
+    return option + ": the frame placeholder must be in the file name, not in a directory ('" + path + "')";
+}
+
 /// True if IN names a sequence: it has a frame placeholder and is not itself a file
 /// (so a single file whose name happens to contain '#' still meshes as before).
 bool isSequenceInput(const std::string& input)
 {
     struct stat info;
     if (::stat(input.c_str(), &info) == 0) return false;
-    return parseFramePattern(input, "IN").hasPlaceholder();
+    if (parseFramePattern(input, "IN").hasPlaceholder()) return true;
+    if (placeholderInDirectory(input)) throw UsageError(placeholderInDirectoryError("IN", input));
+    return false;
 }
 
 /// @a o with the paths of @a frame filled in. Every option that names a file per frame
@@ -731,6 +739,7 @@ MeshOptions optionsForFrame(const MeshOptions& o, const Frame& frame)
 void requirePlaceholder(const std::string& path, const std::string& option, const MeshOptions& o)
 {
     if (!parseFramePattern(path, option).hasPlaceholder()) {
+        if (placeholderInDirectory(path)) throw UsageError(placeholderInDirectoryError(option, path));
         throw UsageError(option + ": no frame placeholder ({}, #### or %04d) in '"
                                         + path + "', but IN is the sequence '" + o.input + "'");
     }
