@@ -154,9 +154,9 @@ namespace {
 double spacingGuess(const std::vector<openvdb::Vec3f>& positions, CancelPoll& poll)
 {
     if (positions.size() < 2) {
-        throw ParameterError("cannot estimate the particle spacing from " +
-                             std::to_string(positions.size()) +
-                             " particle(s); give --spacing or --radius, --threshold and --voxel-size");
+        throw ParameterError(std::string("cannot estimate the particle spacing from ")
+                             + (positions.empty() ? "no particles" : "1 particle")
+                             + "; give --spacing or --radius, --threshold and --voxel-size");
     }
     // One parallel pass (the serial loop it replaced read the 512x benchmark input's 150 MB
     // of positions on one thread).

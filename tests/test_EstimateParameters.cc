@@ -131,9 +131,12 @@ TEST(EstimateParameters, SpacingNeedsTwoDistinctParticles)
         estimateSpacing({openvdb::Vec3f(1.0f)});
         FAIL() << "one particle accepted";
     } catch (const ParameterError& e) {
-        EXPECT_STREQ(e.what(), "cannot estimate the particle spacing from 1 particle(s); give --spacing or "
+        EXPECT_STREQ(e.what(), "cannot estimate the particle spacing from 1 particle; give --spacing or "
                                "--radius, --threshold and --voxel-size");
     }
+    EXPECT_EQ(nonbloppy_test::messageOf<ParameterError>([] { estimateSpacing({}); }),
+              "cannot estimate the particle spacing from no particles; give --spacing or --radius, --threshold and "
+              "--voxel-size");
     EXPECT_THROW(estimateSpacing(std::vector<openvdb::Vec3f>(5, openvdb::Vec3f(1.0f))), ParameterError);
 }
 

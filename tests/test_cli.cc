@@ -103,6 +103,11 @@ TEST_F(CliTest, WarnsWhenRelaxationIsTooStrongForTheCalibration)
     EXPECT_EQ(strong.err, "nonbloppy: warning: --blend 0.5 --iterations 4 relax too strongly for --threshold "
                           "to be calibrated: flat faces end inside the particles; lower --blend or "
                           "--iterations, or give --spacing to correct the volume\n");
+    // With --spacing given the volume is corrected already: not advised again.
+    const RunResult spaced = meshCube("spaced", "-q --blend 0.5 --iterations 4 --spacing 0.05");
+    ASSERT_EQ(spaced.exitCode, 0) << spaced.err;
+    EXPECT_EQ(spaced.err, "nonbloppy: warning: --blend 0.5 --iterations 4 relax too strongly for --threshold "
+                          "to be calibrated: flat faces end inside the particles; lower --blend or --iterations\n");
     // A threshold of the user's own is not calibrated: nothing to warn about.
     const RunResult given = meshCube("given", "-q --blend 0.5 --iterations 4 --threshold 3");
     ASSERT_EQ(given.exitCode, 0) << given.err;
@@ -172,7 +177,7 @@ TEST_F(CliTest, InspectCountsZeroAreaFacesAndNonFiniteVertices)
     RunResult r = run("inspect " + quote(out("degenerate.obj")));
     ASSERT_EQ(r.exitCode, 0) << r.err;
     EXPECT_NE(r.out.find("  vertices         4, 2 unused, 1 not finite\n"
-                         "  faces            1 (1 triangles, 0 quads, 1 of zero area)\n"), std::string::npos) << r.out;
+                         "  faces            1 (1 triangle, 0 quads, 1 of zero area)\n"), std::string::npos) << r.out;
     r = run("inspect --json " + quote(out("degenerate.obj")));
     ASSERT_EQ(r.exitCode, 0) << r.err;
     EXPECT_EQ(jsonNumber(r.out, "non_finite_vertices"), 1.0) << r.out;

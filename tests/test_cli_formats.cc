@@ -232,6 +232,31 @@ TEST_F(CliFormatsTest, MeshAttributesReachPlyAndVtk)
     }
 }
 
+TEST_F(CliFormatsTest, AttributeNamesKeepTheirInnerSpaces)
+{
+    // --attributes dropped every space: 'my attr' was looked up as 'myattr' and refused.
+    const ParticleSet cube = nonbloppy::readParticles(kData + "/cube_2366_particles.vtk");
+    std::string csv = "x,y,z,my attr,other\n";
+    for (size_t i = 0; i < cube.size(); ++i) {
+        csv += std::to_string(cube.positions[i].x()) + "," + std::to_string(cube.positions[i].y()) + ","
+               + std::to_string(cube.positions[i].z()) + ",2.5," + std::to_string(i) + "\n";
+    }
+    writeText(path("spaced.csv"), csv);
+    const RunResult r = run("mesh -q " + quote(path("spaced.csv")) + " -o " + quote(path("m.ply"))
+                            + " --attributes ' my attr , other'");
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    const ParticleSet vertices = nonbloppy::readParticles(path("m.ply"));
+    const ParticleAttribute* mine = vertices.findAttribute("my_attr");  // a PLY name is one word
+    ASSERT_NE(mine, nullptr);
+    EXPECT_EQ(mine->asDouble(0), 2.5);
+    EXPECT_NE(vertices.findAttribute("other"), nullptr);
+    const RunResult joined = run("mesh -q " + quote(path("spaced.csv")) + " -o " + quote(path("u.ply"))
+                                 + " --attributes myattr");
+    EXPECT_EQ(joined.exitCode, 1);
+    EXPECT_EQ(joined.err, "nonbloppy: " + path("spaced.csv") + ": unknown attribute 'myattr'; the particles have: "
+                          "my attr, other\n");
+}
+
 TEST_F(CliFormatsTest, IntegerAttributesReachTheMeshAsTheNearestParticlesValue)
 {
     // The int64 "index" of each vertex is that of the nearest particle, not a mean of several.

@@ -368,7 +368,7 @@ TEST_F(CliSequenceTest, ParametersThatDoNotSuitAFrameFailThatFrame)
     makeFrames({kFree, kFree});
     writeText(in("fluid_0002.vtk"), "# vtk DataFile Version 3.0\none\nASCII\nDATASET POLYDATA\n"
                                    "POINTS 1 float\n0 0 0\n");
-    const std::string message = "cannot estimate the particle spacing from 1 particle(s); give --spacing or "
+    const std::string message = "cannot estimate the particle spacing from 1 particle; give --spacing or "
                                 "--radius, --threshold and --voxel-size";
     const RunResult r = meshSequence(dir() + "/out", "-q");
     EXPECT_EQ(r.exitCode, 1);

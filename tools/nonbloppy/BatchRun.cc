@@ -136,7 +136,7 @@ public:
                 "\"input\": " + jsonString(job.frame.input) + ", \"output\": "
                 + jsonString(job.outputs.front()) + ", \"error\": " + jsonString(message) + "}");
         // Named like --keep-going's lines: in a sequence, the message alone may not say which
-        // frame (e.g. "cannot estimate the particle spacing from 1 particle(s)").
+        // frame (e.g. "cannot estimate the particle spacing from 1 particle").
         if (mFirstError.empty()) mFirstError = "frame " + std::to_string(job.frame.number) + ": " + message;
         if (mSettings.keepGoing) {
             // Reported now, on one line; the run goes on and fails at the end.
@@ -232,9 +232,9 @@ public:
             if (!notRun.empty()) notRunPart += ", " + std::to_string(notRun.size()) + " not run";
             char line[256];
             std::snprintf(line, sizeof(line),
-                          "%zu frames: %zu done, %zu failed, %zu skipped, %zu missing%s in %.2f s "
+                          "%s: %zu done, %zu failed, %zu skipped, %zu missing%s in %.2f s "
                           "(%s particles/s)",
-                          requested, doneFrames.size(),
+                          counted(requested, "frame").c_str(), doneFrames.size(),
                           failedFrames.size(), skippedFrames.size(), mSettings.missing.size(),
                           notRunPart.c_str(), total, formatCount(uint64_t(rate)).c_str());
             std::cout << line << std::endl;

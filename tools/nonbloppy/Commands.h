@@ -59,6 +59,12 @@ std::string versionLine();
 void warnRenamedAttributes(const std::vector<std::string>& original, const std::vector<std::string>& written,
                            const std::string& path);
 
+/// "1 frame", "0 frames", "2 frames": @a count and @a noun, made plural unless it is one.
+inline std::string counted(size_t count, const std::string& noun)
+{
+    return std::to_string(count) + " " + noun + (count == 1 ? "" : "s");
+}
+
 /// The largest magnitude up to which a double holds every integer: PLY has no 64-bit
 /// integer type, so the writers store such attributes as doubles, exact to here only.
 constexpr int64_t kExactInDouble = int64_t(1) << 53;

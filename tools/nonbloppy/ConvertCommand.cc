@@ -87,8 +87,8 @@ int runConvert(const ConvertOptions& o)
     cleanup.keep(remover);
     if (!o.quiet) {
         // As written: .xyz keeps none of them (the warning above names those dropped).
-        std::cout << "converted " << particles.size() << " particles with "
-                  << (positionsOnly ? 0 : particles.attributes.size()) << " attributes: " << o.input << " -> "
+        std::cout << "converted " << counted(particles.size(), "particle") << " with "
+                  << counted(positionsOnly ? 0 : particles.attributes.size(), "attribute") << ": " << o.input << " -> "
                   << o.output << std::endl;
     }
     return 0;
@@ -103,7 +103,7 @@ Command setupConvertCommand(CLI::App& parent)
         "convert", "Convert a particle file to another format, keeping its attributes");
     cmd->footer("Reads .vtk, .vtu, .vtp, .ply, .xyz, .bgeo, .vdb (points), .csv, .txt, .json;\n"
                 "writes .ply, .vtk, .vtu, .xyz (positions only), .csv, .vdb (PointDataGrid).\n"
-                ".xyz is raw binary: little-endian float32 x y z triples (text goes in .csv or .txt).");
+                ".xyz is raw binary: little-endian float32 x y z triples (write text tables as .csv).");
     cmd->add_option("IN", options->input, "Particle file to read")->required()->group(kGroupInputOutput);
     cmd->add_option("OUT", options->output, "Particle file to write")->required()->group(kGroupInputOutput);
     cmd->add_flag("--no-direct-io", options->noDirectIo,

@@ -310,8 +310,8 @@ int inspectMesh(const std::string& path, const nonbloppy::SurfaceMesh& mesh, boo
                                                  : "")
                              + (m.nonFiniteVertices ? ", " + std::to_string(m.nonFiniteVertices) + " not finite"
                                                     : ""));
-    printRow("faces", std::to_string(m.polygons) + " (" + std::to_string(mesh.triangles.size())
-                          + " triangles, " + std::to_string(mesh.quads.size()) + " quads"
+    printRow("faces", std::to_string(m.polygons) + " (" + counted(mesh.triangles.size(), "triangle") + ", "
+                          + counted(mesh.quads.size(), "quad")
                           + (m.zeroAreaPolygons ? ", " + std::to_string(m.zeroAreaPolygons) + " of zero area" : "")
                           + ")");
     // Manifold here includes closed (MeshMeasures), so an open or empty mesh says why not.

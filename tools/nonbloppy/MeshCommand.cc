@@ -633,8 +633,8 @@ void warnIfFacesEndInside(const MeshOptions& o, const nonbloppy::ResolvedParamet
     if (p.thresholdReachesSurface || once.facesEndInside.exchange(true)) return;
     std::cerr << "nonbloppy: warning: --blend " << formatNumber(o.blend) << " --iterations " << o.iterations
               << " relax too strongly for --threshold to be calibrated: flat faces end inside the "
-                 "particles; lower --blend or --iterations, or give --spacing to correct the volume"
-              << std::endl;
+                 "particles; lower --blend or --iterations"
+              << (p.spacingGiven ? "" : ", or give --spacing to correct the volume") << std::endl;
 }
 
 /// Once per run: positions are floats, whose step grows with the distance from the origin;

@@ -25,14 +25,14 @@ namespace {
 std::vector<std::string> splitNames(const std::string& list)
 {
     std::vector<std::string> names;
-    std::string current;
-    for (const char c : list + ",") {
-        if (c == ',') {
-            if (!current.empty()) names.push_back(current);
-            current.clear();
-        } else if (!std::isspace(static_cast<unsigned char>(c))) {
-            current += c;
-        }
+    size_t begin = 0;
+    while (begin <= list.size()) {
+        const size_t comma = std::min(list.find(',', begin), list.size());
+        size_t first = begin, last = comma;  // spaces around a name go, those inside stay
+        while (first < last && std::isspace(static_cast<unsigned char>(list[first]))) ++first;
+        while (last > first && std::isspace(static_cast<unsigned char>(list[last - 1]))) --last;
+        if (last > first) names.push_back(list.substr(first, last - first));
+        begin = comma + 1;
     }
     return names;
 }
