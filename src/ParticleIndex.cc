@@ -75,6 +75,7 @@ size_t ParticleIndex::size() const { return mImpl->sortedPositions.size(); }
 const std::vector<openvdb::Vec3f>& ParticleIndex::sortedPositions() const { return mImpl->sortedPositions; }
 const std::vector<uint32_t>& ParticleIndex::originalIndex() const { return mImpl->originalIndex; }
 double ParticleIndex::cellSize() const { return mImpl->cellSize; }
+openvdb::BBoxd ParticleIndex::bounds() const { return mImpl->bounds; }
 openvdb::GridBase::ConstPtr ParticleIndex::indexGrid() const { return mImpl->grid; }
 
 ParticleIndex ParticleIndex::build(std::vector<openvdb::Vec3f> positions, double cellSize,
@@ -110,6 +111,7 @@ ParticleIndex ParticleIndex::build(std::vector<openvdb::Vec3f> positions, double
     ParticleIndex index;
     Impl& impl = *index.mImpl;
     impl.cellSize = cellSize;
+    if (!positions.empty()) impl.bounds = openvdb::BBoxd(openvdb::Vec3d(scan.min), openvdb::Vec3d(scan.max));
     const openvdb::math::Transform::Ptr transform = openvdb::math::Transform::createLinearTransform(cellSize);
     // OpenVDB's partitioner takes no interrupter, and stopping its TBB context would leave
     // its own serial steps working on partial counts: it runs to the end. Its serial steps

@@ -29,6 +29,7 @@ struct ParticleIndex::Impl
     /// queries are clipped to it (a query box far wider than the particles, e.g. a voxel
     /// hundreds of times r_e, would otherwise walk billions of empty cells).
     openvdb::CoordBBox leafBounds;
+    openvdb::BBoxd bounds;  ///< the particles' world-space box (empty without particles)
 };
 
 namespace cancellation_internal { class CancelPoll; }

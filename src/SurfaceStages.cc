@@ -62,6 +62,7 @@ void resolveAndIndex(const SurfaceParameters& params, const ResolvedParameters* 
         checkCancelled(interrupter, "estimate parameters");
     }
     if (!indexFirst) indexParticles(result.parameters.effectiveRadius);
+    result.particleBounds = index.bounds();
 }
 
 namespace {

@@ -23,6 +23,10 @@ TEST(BuildSurface, NormalsPointOutOfABallOfParticles)
 {
     const auto ball = latticeParticles(0.1, 1.1, [](const openvdb::Vec3d& x) { return x.length() < 1.0; }, 0.1);
     const SurfaceResult result = buildSurface(ball);
+    openvdb::BBoxd box;  // the particles' own box
+    for (const openvdb::Vec3f& p : ball) box.expand(openvdb::Vec3d(p));
+    EXPECT_EQ(result.particleBounds, box);
+    ASSERT_FALSE(box.empty());
     const SurfaceMesh& mesh = result.mesh;
     ASSERT_EQ(mesh.normals.size(), mesh.points.size());
     ASSERT_GT(mesh.points.size(), 1000u);
@@ -48,6 +52,7 @@ TEST(BuildSurface, CallerArraysModelTheParticleListConcept)
     params.iterations = 1;
     const SurfaceResult result = buildSurface(PositionArrayView<double>(xyz.data(), 1), params);
     EXPECT_EQ(result.particleCount, 1u);
+    EXPECT_EQ(result.particleBounds, openvdb::BBoxd(openvdb::Vec3d(0.0), openvdb::Vec3d(0.0)));
     EXPECT_FALSE(result.parameters.spacingGiven);
     EXPECT_EQ(result.parameters.spacing, 0.0);  // not needed: every length was given
     ASSERT_GT(result.mesh.points.size(), 200u);  // a sphere of radius 0.5 at h = 0.05, relaxed to 0.25

@@ -706,15 +706,28 @@ TEST_F(CliFormatsTest, ParticlesFarFromTheOriginAreWarnedOfTheirFloatStep)
     const RunResult r = run("mesh " + quote(far) + " -q -o " + quote(mesh) + " --spacing 0.05");
     EXPECT_EQ(r.exitCode, 0) << r.err;
     float farthest = 0.0f;
-    for (const openvdb::Vec3s& p : nonbloppy::readMesh(mesh).points) {
+    for (const openvdb::Vec3f& p : particles.positions) {
         for (int k = 0; k < 3; ++k) farthest = std::max(farthest, std::abs(p[k]));
     }
     ASSERT_GT(farthest, 1.0e5f);
     std::ostringstream shown;  // as the tool prints numbers: %g, 6 significant digits
     shown << double(farthest);
-    EXPECT_EQ(r.err, "nonbloppy: warning: the surface reaches " + shown.str() +
+    EXPECT_EQ(r.err, "nonbloppy: warning: the particles reach " + shown.str() +
                          " from the origin, where float positions step by 0.0078125, more than 1/16 of the "
-                         "spacing 0.05: the surface is quantized; move the particles nearer the origin\n");
+                         "spacing 0.05: the surface is quantized there; move the particles nearer the origin\n");
+
+    // A droplet of 27 particles 4e6 out, where floats step by 0.25, became one point and left
+    // no vertex: the warning looked at the mesh, so the loss went unsaid.
+    nonbloppy::ParticleSet scene = nonbloppy::readParticles(kData + "/cube_2366_particles.vtk");
+    for (int i = 0; i < 27; ++i) {
+        scene.positions.emplace_back(4.0e6f + 0.05f * float(i % 3), 0.05f * float(i / 3 % 3), 0.05f * float(i / 9));
+    }
+    nonbloppy::writeParticles(scene, path("droplet.ply"));
+    const RunResult lost = run("mesh " + quote(path("droplet.ply")) + " -q -o " + quote(mesh) + " --spacing 0.05");
+    EXPECT_EQ(lost.exitCode, 0) << lost.err;
+    EXPECT_EQ(lost.err, "nonbloppy: warning: the particles reach 4e+06 from the origin, where float positions step "
+                        "by 0.25, more than 1/16 of the spacing 0.05: the surface is quantized there, and droplets "
+                        "may vanish; move the particles nearer the origin\n");
     // At the origin, no warning.
     EXPECT_EQ(run("mesh " + quote(kData + "/cube_2366_particles.vtk") + " -q -o " + quote(mesh) + " --spacing 0.05").err,
               "");

@@ -39,6 +39,10 @@ struct SurfaceResult
     openvdb::FloatGrid::Ptr density;
     ResolvedParameters parameters;      ///< every value used, and which were given
     size_t particleCount = 0;           ///< number of input particles
+    /// The smallest box holding every input particle, world units. Positions are floats,
+    /// whose step grows with the distance from the origin: where it nears the spacing,
+    /// the surface is quantized, and droplets collapse to points and are lost.
+    openvdb::BBoxd particleBounds;
     StageTimings timings;               ///< seconds per stage
 };
 

@@ -93,6 +93,9 @@ public:
     const std::vector<uint32_t>& originalIndex() const;
     /// Cell edge length in world units.
     double cellSize() const;
+    /// The smallest box holding every particle, world units; empty (min > max) without
+    /// particles. Found by build()'s check of the positions, at no extra cost.
+    openvdb::BBoxd bounds() const;
     /// The tools::PointIndexGrid (as GridBase, so this header stays light; cast it with
     /// openvdb::gridPtrCast<openvdb::tools::PointIndexGrid>). Its indices refer to sorted slots.
     openvdb::GridBase::ConstPtr indexGrid() const;

@@ -24,7 +24,6 @@
 #include <openvdb/util/NullInterrupter.h>
 #include <tbb/blocked_range.h>
 #include <tbb/global_control.h>
-#include <tbb/parallel_reduce.h>
 
 #include <algorithm>
 #include <atomic>
@@ -639,29 +638,25 @@ void warnIfFacesEndInside(const MeshOptions& o, const nonbloppy::ResolvedParamet
 
 /// Once per run: positions are floats, whose step grows with the distance from the origin;
 /// a scene placed far out (georeferenced, say) meshes to a surface quantized to that step,
-/// and nothing else tells why it looks rough. Warned when the step at the mesh's farthest
-/// coordinate exceeds 1/16 of the spacing (from 8192 units out for s = 0.01).
+/// and nothing else tells why it looks rough; where the step nears the spacing, droplets
+/// collapse to points and vanish from the mesh. Warned when the step at the particles'
+/// farthest coordinate exceeds 1/16 of the spacing (from 8192 units out for s = 0.01). The
+/// particles, not the mesh: a part of the fluid that is lost leaves no vertex to tell.
 void warnIfCoarseFloats(const nonbloppy::SurfaceResult& result, OnceWarnings& once)
 {
-    if (once.coarseFloats.load()) return;  // said once: later frames need no scan
-    const std::vector<openvdb::Vec3s>& points = result.mesh.points;
-    const float farthest = tbb::parallel_reduce(tbb::blocked_range<size_t>(0, points.size()), 0.0f,
-        [&](const tbb::blocked_range<size_t>& range, float found) {
-            for (size_t i = range.begin(); i < range.end(); ++i) {
-                for (int k = 0; k < 3; ++k) {
-                    if (std::isfinite(points[i][k])) found = std::max(found, std::abs(points[i][k]));
-                }
-            }
-            return found;
-        },
-        [](float a, float b) { return std::max(a, b); });
-    const double step = double(std::nextafter(farthest, std::numeric_limits<float>::infinity())) - double(farthest);
+    const openvdb::BBoxd& bounds = result.particleBounds;
+    if (bounds.empty() || once.coarseFloats.load()) return;
+    double farthest = 0.0;
+    for (int k = 0; k < 3; ++k) farthest = std::max({farthest, std::abs(bounds.min()[k]), std::abs(bounds.max()[k])});
+    const float atFarthest = float(farthest);  // exact: the bounds are float positions
+    const double step = double(std::nextafter(atFarthest, std::numeric_limits<float>::infinity())) - farthest;
     const double spacing = result.parameters.spacing;
     if (!(spacing > 0.0) || !(step > spacing / 16.0) || once.coarseFloats.exchange(true)) return;
-    std::cerr << "nonbloppy: warning: the surface reaches " << formatNumber(double(farthest))
+    std::cerr << "nonbloppy: warning: the particles reach " << formatNumber(farthest)
               << " from the origin, where float positions step by " << formatNumber(step)
               << ", more than 1/16 of the spacing " << formatNumber(spacing)
-              << ": the surface is quantized; move the particles nearer the origin" << std::endl;
+              << ": the surface is quantized there" << (step >= spacing / 2.0 ? ", and droplets may vanish" : "")
+              << "; move the particles nearer the origin" << std::endl;
 }
 
 /// An empty mesh from particles is written (a frame of spray may have none), but said: an
