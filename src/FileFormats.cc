@@ -424,6 +424,21 @@ requireInt64Values(const ParticleAttribute& attribute, const char* holder)
     }
 }
 
+bool
+holdsIntegersPastDouble(const ParticleAttribute& attribute)
+{
+    const bool isSigned = attribute.type == ScalarType::Int64;
+    if (!isSigned && attribute.type != ScalarType::UInt64) return false;
+    for (size_t at = 0; at + 8 <= attribute.bytes.size(); at += 8) {
+        uint64_t bits;
+        std::memcpy(&bits, attribute.bytes.data() + at, 8);
+        const bool exact = isSigned ? int64_t(bits) >= -kExactInDouble && int64_t(bits) <= kExactInDouble
+                                    : bits <= uint64_t(kExactInDouble);
+        if (!exact) return true;
+    }
+    return false;
+}
+
 ScalarType
 plyIntegerType(int64_t lowest, int64_t highest)
 {

@@ -188,6 +188,13 @@ const char* vtkTypeName(ScalarType type);
 ///        and holds a value no int64 can (@a holder: "a .vdb stores", "a mesh attribute holds").
 void requireInt64Values(const ParticleAttribute& attribute, const char* holder);
 
+/// The largest magnitude up to which a double holds every integer (2^53).
+constexpr int64_t kExactInDouble = int64_t(1) << 53;
+
+/// Whether 64-bit integer attribute @a attribute (Int64 or UInt64; false for other types)
+/// holds a value past ±kExactInDouble, which a double rounds.
+bool holdsIntegersPastDouble(const ParticleAttribute& attribute);
+
 /// The native value of @a type at @a p as double.
 double valueAsDouble(const unsigned char* p, ScalarType type);
 

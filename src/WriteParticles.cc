@@ -518,6 +518,20 @@ writtenAttributeNames(const ParticleSet& particles, const std::string& path)
     return namesForExtension(particles, ext);
 }
 
+std::vector<std::string>
+roundedAttributes(const ParticleSet& particles, const std::string& path)
+{
+    const std::string ext = requireParticleOutput(path);
+    std::vector<std::string> rounded;
+    for (const ParticleAttribute& a : particles.attributes) {
+        // PLY has no 64-bit integer (plyTypeOf64() falls back to double); a .vdb's 3-vectors
+        // of them are vec3d (OpenVDB's integer vectors are 32-bit); its scalars are int64.
+        const bool asDoubles = ext == ".ply" || (ext == ".vdb" && a.components == 3);
+        if (asDoubles && io_internal::holdsIntegersPastDouble(a)) rounded.push_back(a.name);
+    }
+    return rounded;
+}
+
 bool
 isParticleOutputFile(const std::string& path)
 {

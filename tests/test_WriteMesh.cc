@@ -376,6 +376,12 @@ TEST_F(WriteMeshTest, IntegerAttributesAreWrittenExactlyInTheNarrowestTypeThatHo
         EXPECT_EQ(back.findAttribute("huge")->type, ply ? ScalarType::Float64 : ScalarType::Int64) << file;
         EXPECT_EQ(back.findAttribute("count")->type, ScalarType::Float32) << file;
     }
+    // Every value above fits a double exactly; one past 2^53 is rounded by PLY only.
+    EXPECT_TRUE(nonbloppy::roundedAttributes(mesh, path("m.ply")).empty());
+    addIntegers("past", 1, [](size_t k) { return k == 1 ? -(int64_t(1) << 53) - 1 : int64_t(k); });
+    EXPECT_EQ(nonbloppy::roundedAttributes(mesh, path("m.ply")), std::vector<std::string>{"past"});
+    EXPECT_TRUE(nonbloppy::roundedAttributes(mesh, path("m.vtk")).empty());
+    EXPECT_TRUE(nonbloppy::roundedAttributes(mesh, path("m.obj")).empty());
 }
 
 TEST_F(WriteMeshTest, RefusesAnAttributeWhoseValuesAreInTheArrayItsFlagDoesNotName)

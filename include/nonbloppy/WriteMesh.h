@@ -67,6 +67,13 @@ NONBLOPPY_API void writeMesh(const SurfaceMesh& mesh, const std::string& path,
 /// @throw FileError for an unknown extension, as writeMesh().
 NONBLOPPY_API std::vector<std::string> writtenAttributeNames(const SurfaceMesh& mesh, const std::string& path);
 
+/// The names of @a mesh's integer attributes that writeMesh() stores rounded in @a path's
+/// format: in PLY, which has no 64-bit integer, those with a value past ±2^53 (written as
+/// doubles). Empty for `.vtk` (vtktypeint64 keeps them) and `.obj` (no attributes).
+/// Cost: one pass over the integer attributes' values, until one is past 2^53.
+/// @throw FileError for an unknown extension, as writeMesh().
+NONBLOPPY_API std::vector<std::string> roundedAttributes(const SurfaceMesh& mesh, const std::string& path);
+
 /// True if @a path has an extension writeMesh() understands.
 NONBLOPPY_API bool isMeshFile(const std::string& path);
 

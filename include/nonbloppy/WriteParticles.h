@@ -62,6 +62,15 @@ NONBLOPPY_API void writeParticles(const ParticleSet& particles, const std::strin
 NONBLOPPY_API std::vector<std::string> writtenAttributeNames(const ParticleSet& particles,
                                                              const std::string& path);
 
+/// The names of @a particles' attributes whose values writeParticles() stores rounded in
+/// @a path's format: 64-bit integers (Int64, UInt64) past ±2^53 that the format holds as
+/// doubles only, a PLY property (PLY has no 64-bit integer) or a `.vdb` 3-vector (OpenVDB's
+/// integer vectors are 32-bit; its scalars are int64, exact). Empty for `.vtk`, `.vtu` and
+/// `.csv`, which keep every value, and `.xyz`, which keeps none.
+/// Cost: one pass over the values of the 64-bit integer attributes, until one is past 2^53.
+/// @throw FileError for an unknown extension, as writeParticles().
+NONBLOPPY_API std::vector<std::string> roundedAttributes(const ParticleSet& particles, const std::string& path);
+
 /// True if @a path has an extension writeParticles() understands.
 NONBLOPPY_API bool isParticleOutputFile(const std::string& path);
 

@@ -65,18 +65,11 @@ inline std::string counted(size_t count, const std::string& noun)
     return std::to_string(count) + " " + noun + (count == 1 ? "" : "s");
 }
 
-/// The largest magnitude up to which a double holds every integer: PLY has no 64-bit
-/// integer type, so the writers store such attributes as doubles, exact to here only.
-constexpr int64_t kExactInDouble = int64_t(1) << 53;
-
-/// Whether @a value is within ±kExactInDouble.
-inline bool exactInDouble(int64_t value) { return value >= -kExactInDouble && value <= kExactInDouble; }
-
-/// Warn on stderr that attribute @a name holds integers past 2^53, which @a path, a PLY
-/// file, stores rounded: "nonbloppy: warning: attribute 'id' holds integers past 2^53, which
-/// out.ply stores as doubles, rounded (PLY has no 64-bit integers); write .vtk to keep them
-/// exact". Defined in main.cc.
-void warnRoundedInPly(const std::string& name, const std::string& path);
+/// Warn on stderr that attribute @a name holds integers past 2^53, which @a path stores
+/// as doubles, rounded (nonbloppy::roundedAttributes() tells which): "nonbloppy: warning:
+/// attribute 'id' holds integers past 2^53, which out.ply stores as doubles, rounded (PLY has
+/// no 64-bit integers); write .vtk to keep them exact". Defined in main.cc.
+void warnRounded(const std::string& name, const std::string& path);
 
 /// @throw UsageError("<@a name> needs a file name, got ''") if @a path is empty, say a shell
 ///        variable left unset: "cannot open : No such file or directory" named nothing, and

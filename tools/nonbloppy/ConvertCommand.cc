@@ -62,20 +62,7 @@ int runConvert(const ConvertOptions& o)
         for (const auto& a : particles.attributes) original.push_back(a.name);
         warnRenamedAttributes(original, nonbloppy::writtenAttributeNames(particles, o.output), o.output);
     }
-    if (lowerExtension(o.output) == ".ply") {
-        for (const nonbloppy::ParticleAttribute& a : particles.attributes) {
-            const bool isSigned = a.type == nonbloppy::ScalarType::Int64;
-            if (!isSigned && a.type != nonbloppy::ScalarType::UInt64) continue;
-            for (size_t at = 0; at < a.bytes.size(); at += 8) {
-                uint64_t bits;
-                std::memcpy(&bits, a.bytes.data() + at, 8);
-                if (isSigned ? !exactInDouble(int64_t(bits)) : bits > uint64_t(kExactInDouble)) {
-                    warnRoundedInPly(a.name, o.output);
-                    break;
-                }
-            }
-        }
-    }
+    for (const std::string& name : nonbloppy::roundedAttributes(particles, o.output)) warnRounded(name, o.output);
     nonbloppy::ParticleWriteSettings settings;
     settings.directIo = !o.noDirectIo;
     BackgroundRemover remover;

@@ -544,7 +544,7 @@ FrameOutcome writeFrame(const MeshOptions& o, MeshedFrame& frame, ProgressInterr
         openvdb::MetaMap fileMetadata;
         fileMetadata.insertMeta("creator", openvdb::StringMetadata(versionLine()));
         openvdb::GridCPtrVec grids{result.density};
-        appendVdbGrids(grids, result, frame.particles, o.outputs, &interrupter);
+        appendVdbGrids(grids, result, frame.particles, o.outputs, o.vdbPath, &interrupter);
         cleanup.willWrite(o.vdbPath);
         nonbloppy::writeVdb(grids, o.vdbPath, fileMetadata);
         cleanup.written();

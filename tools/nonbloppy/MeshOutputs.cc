@@ -40,6 +40,7 @@ std::vector<std::string> splitNames(const std::string& list)
 std::atomic<bool> gObjWarningPrinted{false};
 std::atomic<bool> gRenameWarningPrinted{false};
 std::atomic<bool> gRoundingWarningPrinted{false};
+std::atomic<bool> gVdbRoundingWarningPrinted{false};
 
 } // namespace
 
@@ -47,7 +48,8 @@ void addMeshOutputOptions(CLI::App* cmd, MeshOutputOptions& o, CLI::Option* vdbO
 {
     o.attributesOpt = cmd->add_option("--attributes", o.attributes,
         "Particle attributes to carry to the mesh vertices, e.g. velocity,id, or all: kernel-weighted "
-        "means, integers the nearest particle's value (PLY properties, VTK point data; OBJ cannot store them)")
+        "means as float32, integers the nearest particle's value, exact (PLY properties, VTK point data; OBJ "
+        "cannot store them)")
         ->group(kGroupInputOutput);
     cmd->add_flag("--vdb-surface", o.vdbSurface,
         "Also store the final surface as a level set grid 'surface' in the --vdb file")
@@ -83,12 +85,9 @@ void addSurfaceAttributes(nonbloppy::SurfaceResult& result, const nonbloppy::Par
         std::cerr << "nonbloppy: warning: OBJ cannot store vertex attributes; write .ply or .vtk "
                      "to keep --attributes" << std::endl;
     }
-    if (ext == ".ply" && !gRoundingWarningPrinted) {  // once per run: the scan is for the first frame that needs it
-        for (const nonbloppy::MeshAttribute& a : result.mesh.attributes) {
-            if (!a.integer || std::all_of(a.integers.begin(), a.integers.end(), exactInDouble)) continue;
-            if (!gRoundingWarningPrinted.exchange(true)) warnRoundedInPly(a.name, meshPath);
-            break;
-        }
+    if (!gRoundingWarningPrinted) {  // once per run: the scan is for the first frame that needs it
+        const std::vector<std::string> rounded = nonbloppy::roundedAttributes(result.mesh, meshPath);
+        if (!rounded.empty() && !gRoundingWarningPrinted.exchange(true)) warnRounded(rounded[0], meshPath);
     }
     // Once per run: the frames of a sequence carry the same attributes.
     if (ext != ".obj" && !result.mesh.attributes.empty() && !gRenameWarningPrinted.exchange(true)) {
@@ -99,13 +98,19 @@ void addSurfaceAttributes(nonbloppy::SurfaceResult& result, const nonbloppy::Par
 }
 
 void appendVdbGrids(openvdb::GridCPtrVec& grids, const nonbloppy::SurfaceResult& result,
-                    const nonbloppy::ParticleSet& particles, const MeshOutputOptions& o,
+                    const nonbloppy::ParticleSet& particles, const MeshOutputOptions& o, const std::string& vdbPath,
                     openvdb::util::NullInterrupter* interrupter)
 {
     if (o.vdbSurface) {
         grids.push_back(nonbloppy::meshToLevelSet(result.mesh, result.parameters.voxelSize, 3.0f, interrupter));
     }
-    if (o.vdbPoints) grids.push_back(nonbloppy::makePointDataGrid(particles));
+    if (o.vdbPoints) {
+        grids.push_back(nonbloppy::makePointDataGrid(particles));
+        if (!gVdbRoundingWarningPrinted) {
+            const std::vector<std::string> rounded = nonbloppy::roundedAttributes(particles, vdbPath);
+            if (!rounded.empty() && !gVdbRoundingWarningPrinted.exchange(true)) warnRounded(rounded[0], vdbPath);
+        }
+    }
 }
 
 } // namespace nonbloppy_tool

@@ -52,11 +52,12 @@ void addSurfaceAttributes(nonbloppy::SurfaceResult& result, const nonbloppy::Par
                           openvdb::util::NullInterrupter* interrupter);
 
 /// Append to @a grids what --vdb-surface ("surface" level set at the density's voxel
-/// size) and --vdb-points ("points" PointDataGrid) ask for. The level set, seconds on large
+/// size) and --vdb-points ("points" PointDataGrid, warned once per run if @a vdbPath
+/// stores an attribute rounded) ask for. The level set, seconds on large
 /// frames, asks @a interrupter as it goes (nonbloppy::CancelledError on a stop).
 void appendVdbGrids(openvdb::GridCPtrVec& grids, const nonbloppy::SurfaceResult& result,
                     const nonbloppy::ParticleSet& particles, const MeshOutputOptions& options,
-                    openvdb::util::NullInterrupter* interrupter);
+                    const std::string& vdbPath, openvdb::util::NullInterrupter* interrupter);
 
 } // namespace nonbloppy_tool
 

@@ -68,11 +68,12 @@ void warnRenamedAttributes(const std::vector<std::string>& original, const std::
     }
 }
 
-void warnRoundedInPly(const std::string& name, const std::string& path)
+void warnRounded(const std::string& name, const std::string& path)
 {
+    const char* why = lowerExtension(path) == ".vdb" ? "OpenVDB has no 64-bit integer vectors"
+                                                     : "PLY has no 64-bit integers";
     std::cerr << "nonbloppy: warning: attribute '" << shownName(name) << "' holds integers past 2^53, which " << path
-              << " stores as doubles, rounded (PLY has no 64-bit integers); write .vtk to keep them exact"
-              << std::endl;
+              << " stores as doubles, rounded (" << why << "); write .vtk to keep them exact" << std::endl;
 }
 
 } // namespace nonbloppy_tool
