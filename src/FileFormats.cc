@@ -155,15 +155,27 @@ lowerCase(std::string_view text)
 
 } // namespace
 
+namespace {
+
+/// The component number @a digits spells: 0 to 99 without a leading zero; -1 otherwise.
+int componentNumber(std::string_view digits)
+{
+    if (digits.empty() || digits.size() > 2 || (digits.size() == 2 && digits[0] == '0')) return -1;
+    for (char c : digits) {
+        if (c < '0' || c > '9') return -1;
+    }
+    return digits.size() == 1 ? digits[0] - '0' : (digits[0] - '0') * 10 + (digits[1] - '0');
+}
+
+} // namespace
+
 int
 tableComponentOf(const std::string& name, std::string& base)
 {
-    static const char* suffixes[3][4] = {{":0", "_x", "[0]", ".x"},
-                                         {":1", "_y", "[1]", ".y"},
-                                         {":2", "_z", "[2]", ".z"}};
+    static const char* letters[3][2] = {{"_x", ".x"}, {"_y", ".y"}, {"_z", ".z"}};
     const std::string low = lowerCase(name);
     for (int c = 0; c < 3; ++c) {
-        for (const char* suffix : suffixes[c]) {
+        for (const char* suffix : letters[c]) {
             const size_t n = std::strlen(suffix);
             if (low.size() > n && low.compare(low.size() - n, n, suffix) == 0) {
                 base = name.substr(0, name.size() - n);
@@ -171,7 +183,29 @@ tableComponentOf(const std::string& name, std::string& base)
             }
         }
     }
-    return -1;
+    // name:c, name_c or name[c]
+    const bool bracket = !name.empty() && name.back() == ']';
+    const size_t open = bracket ? name.rfind('[') : name.find_last_of(":_");
+    if (open == std::string::npos || open == 0) return -1;
+    if (!bracket && name[open] != ':' && name[open] != '_') return -1;
+    const size_t end = bracket ? name.size() - 1 : name.size();
+    const int component = componentNumber(std::string_view(name).substr(open + 1, end - open - 1));
+    if (component < 0) return -1;
+    base = name.substr(0, open);
+    return component;
+}
+
+int
+suffixComponentOf(const std::string& name, std::string& base)
+{
+    const size_t underscore = name.rfind('_');
+    if (underscore == std::string::npos || underscore == 0 || underscore + 1 == name.size()) return -1;
+    const std::string_view suffix = std::string_view(name).substr(underscore + 1);
+    const int component = suffix.size() == 1 && suffix[0] >= 'x' && suffix[0] <= 'z' ? suffix[0] - 'x'
+                                                                                    : componentNumber(suffix);
+    if (component < 0) return -1;
+    base = name.substr(0, underscore);
+    return component;
 }
 
 int
@@ -183,7 +217,7 @@ tablePositionAxis(const std::string& name)
     const int component = tableComponentOf(name, base);
     const std::string lowBase = lowerCase(base);
     const bool positionBase = lowBase == "points" || lowBase == "position" || lowBase == "pos" || lowBase == "p";
-    return component >= 0 && positionBase ? component : -1;
+    return component >= 0 && component < 3 && positionBase ? component : -1;
 }
 
 std::vector<ColumnGroup>

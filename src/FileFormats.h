@@ -79,9 +79,15 @@ std::string requireMeshExtension(const std::string& path);
 std::string printable(std::string_view text, size_t maxLength = 40);
 
 /// If the table (CSV/TXT) column @a name is "<base><suffix>" with suffix one of the
-/// component spellings (:0 _x [0] .x, :1 _y [1] .y, :2 _z [2] .z, any case), the component
-/// (0..2), with @a base set; else -1.
+/// component spellings (_x .x, _y .y, _z .z, any case, for 0 to 2, or :c _c [c] for any c
+/// up to 99, as ParaView and writeParticles() spell components past the third), the
+/// component, with @a base set; else -1.
 int tableComponentOf(const std::string& name, std::string& base);
+
+/// The component a property or attribute name spells as nonbloppy's writers write the
+/// components of vectors in PLY and .vdb: "<base>_x/_y/_z" (0 to 2) or "<base>_<c>" (c up
+/// to 99, no leading zero), with @a base set; -1 otherwise.
+int suffixComponentOf(const std::string& name, std::string& base);
 
 /// The axis (0..2) a table column named @a name holds: x, y or z, or a component of
 /// Points, position, pos or p (any case, e.g. "Points:0", "P_y"); -1 for an attribute

@@ -321,26 +321,6 @@ struct PlyColumn
     }
 };
 
-/// The component a PLY property name spells as nonbloppy's writer writes vectors:
-/// "<base>_x/_y/_z" (3 components) or "<base>_<c>" (any other count); -1 otherwise.
-int plyComponentOf(const std::string& name, std::string& base)
-{
-    const size_t underscore = name.rfind('_');
-    if (underscore == std::string::npos || underscore == 0 || underscore + 1 == name.size()) return -1;
-    const std::string suffix = name.substr(underscore + 1);
-    int component = -1;
-    if (suffix.size() == 1 && suffix[0] >= 'x' && suffix[0] <= 'z') {
-        component = suffix[0] - 'x';
-    } else if (suffix.size() <= 2 && std::all_of(suffix.begin(), suffix.end(), [](char c) { return c >= '0' && c <= '9'; })
-               && (suffix.size() == 1 || suffix[0] != '0')) {
-        component = std::stoi(suffix);
-    } else {
-        return -1;
-    }
-    base = name.substr(0, underscore);
-    return component;
-}
-
 /// The vertex element of a PLY file, read straight into a ParticleSet: x, y, z as
 /// positions, every other scalar property an attribute, those spelling the components of
 /// a vector (<name>_x,_y,_z or <name>_0,_1,..., as writeParticles() writes them, of one
@@ -384,7 +364,7 @@ private:
             column.axis = axisOf(property.name);
             if (column.axis < 0) {
                 AttributeColumn attributeColumn{p, property.name, std::string(), -1, int(property.type)};
-                attributeColumn.component = plyComponentOf(property.name, attributeColumn.base);
+                attributeColumn.component = suffixComponentOf(property.name, attributeColumn.base);
                 attributeColumns.push_back(std::move(attributeColumn));
             } else if (property.type != ScalarType::Float32 &&
                        property.type != ScalarType::Float64) {

@@ -77,12 +77,50 @@ copyAttribute(const PointDataGrid& grid, size_t arrayIndex, size_t count, Partic
             if constexpr (ComponentsT == 1) {
                 stored[0] = static_cast<StoredT>(value);
             } else {
+                if constexpr (std::is_same_v<ValueT, openvdb::Mat3s> || std::is_same_v<ValueT, openvdb::Mat3d>
+                          || std::is_same_v<ValueT, openvdb::Mat4s> || std::is_same_v<ValueT, openvdb::Mat4d>) {
+                for (int c = 0; c < ComponentsT; ++c) stored[c] = static_cast<StoredT>(value.asPointer()[c]);  // row-major
+            } else {
                 for (int c = 0; c < ComponentsT; ++c) stored[c] = static_cast<StoredT>(value[c]);
+            }
             }
             std::memcpy(dst, stored, sizeof(stored));
             dst += sizeof(stored);
         }
     }
+}
+
+/// @a attributes with runs of scalars "<base>_0", "<base>_1", ... (or _x, _y, _z) of one type
+/// joined into one attribute of that many components (groupColumns()): writeParticles()
+/// splits so what OpenVDB has no attribute type for (4 floats, say, or 5 integers).
+std::vector<ParticleAttribute> joinComponents(std::vector<ParticleAttribute> attributes)
+{
+    std::vector<AttributeColumn> columns;
+    for (size_t i = 0; i < attributes.size(); ++i) {
+        AttributeColumn column{i, attributes[i].name, std::string(), -1, int(attributes[i].type)};
+        if (attributes[i].components == 1) column.component = suffixComponentOf(column.name, column.base);
+        columns.push_back(std::move(column));
+    }
+    std::vector<ParticleAttribute> joined;
+    for (const ColumnGroup& group : groupColumns(columns)) {
+        if (group.columns.size() == 1) {
+            joined.push_back(std::move(attributes[group.columns[0]]));
+            continue;
+        }
+        const ParticleAttribute& first = attributes[group.columns[0]];
+        ParticleAttribute vector;
+        vector.name = group.name;
+        vector.type = first.type;
+        vector.components = int(group.columns.size());
+        const size_t width = scalarSize(first.type), count = first.bytes.size() / width, n = group.columns.size();
+        vector.bytes.resize(count * n * width);
+        for (size_t c = 0; c < n; ++c) {
+            const unsigned char* source = attributes[group.columns[c]].bytes.data();
+            for (size_t i = 0; i < count; ++i) std::memcpy(&vector.bytes[(i * n + c) * width], source + i * width, width);
+        }
+        joined.push_back(std::move(vector));
+    }
+    return joined;
 }
 
 ParticleSet
@@ -156,9 +194,16 @@ convertGrid(const PointDataGrid& grid, const std::string& path)
         else if (valueType == "vec3s") { attribute.type = ScalarType::Float32; copyAttribute<openvdb::Vec3f, float, 3>(grid, arrayIndex, c, attribute); }
         else if (valueType == "vec3d") { attribute.type = ScalarType::Float64; copyAttribute<openvdb::Vec3d, double, 3>(grid, arrayIndex, c, attribute); }
         else if (valueType == "vec3i") { attribute.type = ScalarType::Int32; copyAttribute<openvdb::Vec3i, int32_t, 3>(grid, arrayIndex, c, attribute); }
-        else continue;  // matrices, quaternions: nothing the pipeline can use
+        else if (valueType == "quats") { attribute.type = ScalarType::Float32; copyAttribute<openvdb::math::Quats, float, 4>(grid, arrayIndex, c, attribute); }
+        else if (valueType == "quatd") { attribute.type = ScalarType::Float64; copyAttribute<openvdb::math::Quatd, double, 4>(grid, arrayIndex, c, attribute); }
+        else if (valueType == "mat3s") { attribute.type = ScalarType::Float32; copyAttribute<openvdb::Mat3s, float, 9>(grid, arrayIndex, c, attribute); }
+        else if (valueType == "mat3d") { attribute.type = ScalarType::Float64; copyAttribute<openvdb::Mat3d, double, 9>(grid, arrayIndex, c, attribute); }
+        else if (valueType == "mat4s") { attribute.type = ScalarType::Float32; copyAttribute<openvdb::Mat4s, float, 16>(grid, arrayIndex, c, attribute); }
+        else if (valueType == "mat4d") { attribute.type = ScalarType::Float64; copyAttribute<openvdb::Mat4d, double, 16>(grid, arrayIndex, c, attribute); }
+        else continue;  // a type registered after OpenVDB 10's own (which are all above)
         particles.attributes.push_back(std::move(attribute));
     }
+    particles.attributes = joinComponents(std::move(particles.attributes));
     return particles;
 }
 

@@ -9,6 +9,7 @@
 
 #include <nonbloppy/Error.h>
 #include <nonbloppy/ReadParticles.h>
+#include <nonbloppy/WriteParticles.h>
 
 #include <openvdb/openvdb.h>
 
@@ -597,6 +598,71 @@ TEST_F(ReadFormatsTest, VdbPointDataGridWithAttributes)
         const size_t i = size_t(t.asDouble(n) * 2.0);
         ASSERT_LT(i, positions.size());
         for (int a = 0; a < 3; ++a) EXPECT_NEAR(particles.positions[n][a], positions[i][a], 1e-5);
+    }
+}
+
+TEST_F(ReadFormatsTest, VdbQuaternionsMatricesAndSplitVectorsAreAttributesOfTheirComponents)
+{
+    // Quaternions and matrices were skipped without a word, and the 4 scalars c_0..c_3
+    // that writeParticles() makes of a 4-component attribute came back as 4 attributes.
+    openvdb::initialize();
+    const std::vector<openvdb::Vec3R> positions{{0.0, 0.0, 0.0}, {1.0, 2.0, 3.0}};
+    const std::string file = path("extras.vdb");
+    nonbloppy_test::writeOpenVdbPoints(file, positions, 0.5, nonbloppy_test::PointExtras::QuatMatricesAndSplitVector);
+    const ParticleSet particles = readParticles(file);
+    ASSERT_EQ(particles.size(), 2u);
+    std::vector<std::string> names;
+    for (const ParticleAttribute& a : particles.attributes) names.push_back(a.name + "/" + std::to_string(a.components));
+    EXPECT_EQ(names, (std::vector<std::string>{"temperature/1", "orient/4", "xform/16", "stress/9", "c/4"}));
+    for (size_t n = 0; n < particles.size(); ++n) {
+        for (int c = 0; c < 4; ++c) EXPECT_EQ(attribute(particles, "orient").asDouble(n, c), double(c + 1));
+        for (int c = 0; c < 16; ++c) EXPECT_EQ(attribute(particles, "xform").asDouble(n, c), double(c));
+        for (int c = 0; c < 9; ++c) EXPECT_EQ(attribute(particles, "stress").asDouble(n, c), double(c) + 0.5);
+        for (int c = 0; c < 4; ++c) EXPECT_EQ(attribute(particles, "c").asDouble(n, c), double(10 + c));
+    }
+    EXPECT_EQ(attribute(particles, "stress").type, ScalarType::Float64);
+    EXPECT_EQ(attribute(particles, "xform").type, ScalarType::Float32);
+}
+
+TEST_F(ReadFormatsTest, ComponentsPastTheThirdRoundTripThroughEveryFormat)
+{
+    // A 4-component attribute went to CSV as q:0..q:3 and came back as a 3-vector plus a
+    // scalar "q:3"; to .vdb as q_0..q_3 and came back as four scalars (bug hunt).
+    ParticleSet particles;
+    particles.positions = {openvdb::Vec3f(0.0f), openvdb::Vec3f(1.0f, 2.0f, 3.0f)};
+    for (const int components : {4, 9, 16}) {
+        ParticleAttribute a;
+        a.name = "q" + std::to_string(components);
+        a.type = components == 9 ? ScalarType::Int32 : ScalarType::Float32;
+        a.components = components;
+        for (int k = 0; k < 2 * components; ++k) {
+            const unsigned char* bytes;
+            const float asFloat = float(k) + 0.25f;
+            const int32_t asInt = k - 7;
+            bytes = a.type == ScalarType::Int32 ? reinterpret_cast<const unsigned char*>(&asInt)
+                                                : reinterpret_cast<const unsigned char*>(&asFloat);
+            a.bytes.insert(a.bytes.end(), bytes, bytes + 4);
+        }
+        particles.attributes.push_back(a);
+    }
+    for (const std::string ext : {".csv", ".vdb", ".ply", ".vtk", ".vtu"}) {
+        const std::string file = path("round" + ext);
+        nonbloppy::writeParticles(particles, file);
+        const ParticleSet back = readParticles(file);
+        ASSERT_EQ(back.size(), 2u) << ext;
+        ASSERT_EQ(back.attributes.size(), 3u) << ext;
+        // Points of a .vdb come back in voxel order: the origin first here either way.
+        for (size_t i = 0; i < 3; ++i) {
+            const ParticleAttribute& written = particles.attributes[i];
+            const ParticleAttribute& read = back.attributes[i];
+            EXPECT_EQ(read.name, written.name) << ext;
+            ASSERT_EQ(read.components, written.components) << ext << " " << written.name;
+            for (size_t n = 0; n < 2; ++n) {
+                for (int c = 0; c < written.components; ++c) {
+                    ASSERT_EQ(read.asDouble(n, c), written.asDouble(n, c)) << ext << " " << written.name;
+                }
+            }
+        }
     }
 }
 

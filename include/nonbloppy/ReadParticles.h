@@ -24,12 +24,15 @@
 ///           (raw or base64) arrays, zlib-compressed or not, UInt32/UInt64 headers, either
 ///           byte order, Float32/Float64 points; every PointData array in its type.
 /// - `.vdb`  the first openvdb::points::PointDataGrid: world positions from `P` plus every
-///           numeric and vector attribute (group and string attributes are skipped); a .vdb
-///           without one (e.g. a density cache) is an error.
+///           numeric, vector, quaternion (4 components) and matrix attribute (9 or 16,
+///           row by row); group and string attributes are skipped. Consecutive scalars
+///           `name_0, name_1, ...` (or `_x, _y, _z`) of one type form one attribute `name`,
+///           as writeParticles() splits what OpenVDB has no type for. A .vdb without a
+///           PointDataGrid (e.g. a density cache) is an error.
 /// - `.csv`, `.txt`  a header row naming the columns (x, y, z or ParaView's Points:0..2,
-///           plus any others; two or three consecutive `name:0..2`, `name_x/_y/_z`,
-///           `name[0..2]` or `name.x/.y/.z` form a vector `name` unless a column is itself
-///           called `name`; a lone `name_x` keeps its name),
+///           plus any others; consecutive `name:0, name:1, ...` (up to 100), `name_0, ...`,
+///           `name[0], ...`, `name_x/_y/_z` or `name.x/.y/.z` form a vector `name` unless a
+///           column is itself called `name`; a lone `name_x` keeps its name),
 ///           separated by ',', ';', tabs or spaces; attributes are int64 if every value is
 ///           an integer, else float64.
 /// - `.json` `[[x, y, z], ...]` (positions only).

@@ -33,6 +33,19 @@ void writeOpenVdbPoints(const std::string& file, const std::vector<openvdb::Vec3
         openvdb::points::appendGroup(grid->tree(), "tagged");
         openvdb::points::setGroup(grid->tree(), "tagged", true);
     }
+    if (extras == PointExtras::QuatMatricesAndSplitVector) {
+        openvdb::points::appendAttribute<openvdb::math::Quats>(grid->tree(), "orient",
+                                                                openvdb::math::Quats(1.0f, 2.0f, 3.0f, 4.0f));
+        openvdb::Mat4s xform;
+        for (int k = 0; k < 16; ++k) xform.asPointer()[k] = float(k);
+        openvdb::points::appendAttribute<openvdb::Mat4s>(grid->tree(), "xform", xform);
+        openvdb::Mat3d stress;
+        for (int k = 0; k < 9; ++k) stress.asPointer()[k] = double(k) + 0.5;
+        openvdb::points::appendAttribute<openvdb::Mat3d>(grid->tree(), "stress", stress);
+        for (int c = 0; c < 4; ++c) {
+            openvdb::points::appendAttribute<float>(grid->tree(), "c_" + std::to_string(c), float(10 + c));
+        }
+    }
     openvdb::io::File out(file);
     if (compression) out.setCompression(*compression);
     out.write({grid});

@@ -22,6 +22,11 @@ enum class PointExtras
     /// A uniform int "id" (7), a non-uniform float pair "pair" (stride 2: 0 and the point's
     /// index in its leaf) and a group "tagged" that holds every point.
     IdPairAndGroup,
+    /// Uniform values of the types nonbloppy reads as several components: a quats
+    /// "orient" (1, 2, 3, 4), a mat4s "xform" (0 to 15 row by row), a mat3d "stress" (0.5
+    /// to 8.5), and float scalars "c_0" to "c_3" (10 to 13) as writeParticles() splits a
+    /// 4-component attribute.
+    QuatMatricesAndSplitVector,
 };
 
 /// Writes @a file with one PointDataGrid "points" of @a positions (linear transform of
