@@ -358,7 +358,10 @@ private:
         std::vector<AttributeColumn> attributeColumns;
         for (size_t p = 0; p < element.properties.size(); ++p) {
             const PlyProperty& property = element.properties[p];
-            if (property.isList) continue;
+            if (property.isList) {
+                mData.skipped.push_back("list property '" + property.name + "'");
+                continue;
+            }
             PlyColumn& column = columns[p];
             column.width = scalarSize(property.type);
             column.axis = axisOf(property.name);

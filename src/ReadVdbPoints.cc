@@ -179,7 +179,14 @@ convertGrid(const PointDataGrid& grid, const std::string& path)
     for (const auto& [arrayIndex, name] : arrays) {
         if (arrayIndex == positionIndex) continue;
         const openvdb::points::AttributeArray& array = firstLeaf->constAttributeArray(arrayIndex);
-        if (openvdb::points::isGroup(array) || openvdb::points::isString(array)) continue;
+        if (openvdb::points::isGroup(array)) {
+            // Groups share bit arrays named "__group0", ...; the descriptor names each group.
+            continue;
+        }
+        if (openvdb::points::isString(array)) {
+            particles.skipped.push_back("string attribute '" + name + "'");
+            continue;
+        }
         const std::string valueType = descriptor.valueType(arrayIndex);
         ParticleAttribute attribute;
         attribute.name = name;
@@ -204,6 +211,7 @@ convertGrid(const PointDataGrid& grid, const std::string& path)
         particles.attributes.push_back(std::move(attribute));
     }
     particles.attributes = joinComponents(std::move(particles.attributes));
+    for (const auto& group : descriptor.groupMap()) particles.skipped.push_back("group '" + group.first + "'");
     return particles;
 }
 

@@ -624,6 +624,28 @@ TEST_F(ReadFormatsTest, VdbQuaternionsMatricesAndSplitVectorsAreAttributesOfThei
     EXPECT_EQ(attribute(particles, "xform").type, ScalarType::Float32);
 }
 
+TEST_F(ReadFormatsTest, WhatNoAttributeCanTakeIsListedAsSkipped)
+{
+    // A .vdb's groups and a PLY vertex's list properties were left out without a word.
+    openvdb::initialize();
+    const std::vector<openvdb::Vec3R> positions{{0.0, 0.0, 0.0}, {1.0, 2.0, 3.0}};
+    const std::string vdb = path("grouped.vdb");
+    nonbloppy_test::writeOpenVdbPoints(vdb, positions, 0.5, nonbloppy_test::PointExtras::IdPairAndGroup);
+    const ParticleSet grouped = readParticles(vdb);
+    EXPECT_EQ(grouped.skipped, std::vector<std::string>{"group 'tagged'"});
+    EXPECT_NE(grouped.findAttribute("id"), nullptr);
+    EXPECT_EQ(grouped.findAttribute("__group0"), nullptr);
+
+    const std::string ply = write("listed.ply", "ply\nformat ascii 1.0\nelement vertex 1\n"
+                                                "property float x\nproperty float y\nproperty float z\n"
+                                                "property list uchar int ids\nproperty float w\nend_header\n"
+                                                "1 2 3 2 7 8 0.5\n");
+    const ParticleSet listed = readParticles(ply);
+    EXPECT_EQ(listed.skipped, std::vector<std::string>{"list property 'ids'"});
+    EXPECT_EQ(attribute(listed, "w").asDouble(0), 0.5);
+    EXPECT_TRUE(readParticles(dataPath("cube_8_particles.vtk")).skipped.empty());
+}
+
 TEST_F(ReadFormatsTest, ComponentsPastTheThirdRoundTripThroughEveryFormat)
 {
     // A 4-component attribute went to CSV as q:0..q:3 and came back as a 3-vector plus a

@@ -20,6 +20,7 @@
 #include "../src/AtomicFile.h"
 #include "CliTestUtil.h"
 #include "TestUtil.h"
+#include "support/OpenVdbPoints.h"
 
 #include <algorithm>
 #include <cmath>
@@ -714,6 +715,33 @@ TEST_F(CliFormatsTest, AVdbCannotHoldANonFinitePositionAndSaysSo)
     nonbloppy::writeParticles(particles, path("inf.ply"));
     EXPECT_EQ(nonbloppy_test::messageOf<nonbloppy::ParameterError>([&] { nonbloppy::readParticles(path("inf.ply")); }),
               "non-finite position of particle 2 (" + path("inf.ply") + ")");
+}
+
+TEST_F(CliFormatsTest, WhatIsNotReadIsSaid)
+{
+    // A .vdb's group converted to nothing, and inspect did not show it.
+    const std::vector<openvdb::Vec3R> positions{{0.0, 0.0, 0.0}, {1.0, 2.0, 3.0}};
+    const std::string vdb = path("grouped.vdb");
+    nonbloppy_test::writeOpenVdbPoints(vdb, positions, 0.5, nonbloppy_test::PointExtras::IdPairAndGroup);
+    const RunResult converted = run("convert -q " + quote(vdb) + " " + quote(path("g.csv")));
+    EXPECT_EQ(converted.exitCode, 0);
+    EXPECT_EQ(converted.err, "nonbloppy: warning: not read from " + vdb + ", so not converted: group 'tagged'\n");
+    // inspect of particles lists it (a .vdb is inspected as grids, its group among them).
+    writeText(path("listed.ply"), "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\n"
+                                  "property float z\nproperty list uchar int ids\nend_header\n1 2 3 2 7 8\n");
+    const RunResult inspected = run("inspect " + quote(path("listed.ply")));
+    EXPECT_NE(inspected.out.find("\n  not read         list property 'ids'\n"), std::string::npos) << inspected.out;
+    const nlohmann::json report = nlohmann::json::parse(run("inspect --json " + quote(path("listed.ply"))).out);
+    EXPECT_EQ(report.at("not_read"), nlohmann::json::array({"list property 'ids'"}));
+    EXPECT_EQ(nlohmann::json::parse(run("inspect --json " + quote(path("g.csv"))).out).at("not_read"),
+              nlohmann::json::array());
+    // mesh says so where it uses the attributes, once.
+    const RunResult meshed = run("mesh -q " + quote(vdb) + " -o " + quote(path("m.ply")) + " --radius 2 --voxel-size 0.5 "
+                                 "--threshold 0.5 --attributes id");
+    EXPECT_EQ(meshed.exitCode, 0) << meshed.err;
+    EXPECT_EQ(meshed.err, "nonbloppy: warning: not read from " + vdb + ": group 'tagged'\n");
+    EXPECT_EQ(run("mesh -q " + quote(vdb) + " -o " + quote(path("m.ply")) + " --radius 2 --voxel-size 0.5 "
+                  "--threshold 0.5").err, "");
 }
 
 TEST_F(CliFormatsTest, ParticlesFarFromTheOriginAreWarnedOfTheirFloatStep)

@@ -93,6 +93,10 @@ struct NONBLOPPY_API ParticleSet
 
     std::vector<openvdb::Vec3f> positions;      ///< world units
     std::vector<ParticleAttribute> attributes;  ///< each holds positions.size() values
+    /// Per-particle data the file holds that no attribute could take, each said as
+    /// "group 'splash'", "string attribute 'name'" (.vdb) or "list property 'ids'" (PLY),
+    /// so that a caller can tell its user what a conversion leaves behind.
+    std::vector<std::string> skipped;
 
     /// Number of particles.
     size_t size() const { return positions.size(); }

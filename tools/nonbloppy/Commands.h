@@ -12,6 +12,8 @@
 
 #include "UsageError.h"
 
+#include <nonbloppy/Particles.h>
+
 #include <CLI/CLI.hpp>
 
 #include <cctype>
@@ -58,6 +60,14 @@ std::string versionLine();
 /// out.ply as 'a_b_2'". Defined in main.cc.
 void warnRenamedAttributes(const std::vector<std::string>& original, const std::vector<std::string>& written,
                            const std::string& path);
+
+/// @a particles.skipped as one list: "group 'splash', string attribute 'name'".
+inline std::string joinedSkipped(const nonbloppy::ParticleSet& particles)
+{
+    std::string list;
+    for (const std::string& item : particles.skipped) list += (list.empty() ? "" : ", ") + item;
+    return list;
+}
 
 /// "1 frame", "0 frames", "2 frames": @a count and @a noun, made plural unless it is one.
 inline std::string counted(size_t count, const std::string& noun)

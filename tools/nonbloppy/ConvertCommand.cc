@@ -50,6 +50,10 @@ int runConvert(const ConvertOptions& o)
     SignalHandlerScope signals;
     const nonbloppy::ParticleSet particles = nonbloppy::readParticles(o.input);
     throwIfInterrupted();
+    if (!particles.skipped.empty()) {
+        std::cerr << "nonbloppy: warning: not read from " << o.input << ", so not converted: " << joinedSkipped(particles)
+                  << std::endl;
+    }
     const bool positionsOnly = lowerExtension(o.output) == ".xyz";
     if (positionsOnly && !particles.attributes.empty()) {
         std::string names;

@@ -202,6 +202,9 @@ int inspectParticles(const std::string& path, const nonbloppy::ParticleSet& part
         if (spacing) w.number("spacing", *spacing);
         else w.raw("spacing", "null");
         writeAttributes(w, particles.attributes);
+        w.beginArray("not_read");
+        for (const std::string& skipped : particles.skipped) w.string(nullptr, skipped);
+        w.endArray();
         w.endObject();
         std::cout << w.str();
         return 0;
@@ -219,6 +222,7 @@ int inspectParticles(const std::string& path, const nonbloppy::ParticleSet& part
                                                            "or the median neighbour distance where no particle is surrounded)"
                                 : "- (" + spacingNote + ")");
     printAttributes(particles.attributes);
+    if (!particles.skipped.empty()) printRow("not read", joinedSkipped(particles));
     std::cout.flush();
     return 0;
 }

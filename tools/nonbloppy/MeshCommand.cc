@@ -477,6 +477,12 @@ MeshedFrame meshFrameSurface(const MeshOptions& o, ProgressInterrupter& interrup
     if (frame.particles.size() == 0) {
         throw nonbloppy::FileError("no particles in " + o.input);
     }
+    // Once per run, and only where the particles' attributes are used.
+    static std::atomic<bool> skippedSaid{false};
+    if (o.outputs.needParticles() && !frame.particles.skipped.empty() && !skippedSaid.exchange(true)) {
+        std::cerr << "nonbloppy: warning: not read from " << o.input << ": " << joinedSkipped(frame.particles)
+                  << std::endl;
+    }
     // Before meshing: a misspelt name used to cost the whole frame's work first.
     try {
         requireAttributes(frame.particles, o.outputs);
