@@ -7,14 +7,13 @@
 #include <nonbloppy/MeshToLevelSet.h>
 #include <nonbloppy/ParticleIndex.h>
 
+#include "MachineMemory.h"
 #include "OpenVdbScale.h"
 #include "ParameterChecks.h"
 
 #pragma GCC visibility push(default)  // OpenVDB templates: see src/VisibilityPrelude.h
 #include <openvdb/tools/MeshToVolume.h>
 #pragma GCC visibility pop
-
-#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
@@ -28,13 +27,6 @@ namespace {
 /// polygon-index grid and scratch): 19–30 bytes measured on the dam-break surface at h/2 and
 /// h/4 with half widths 3 and 10, rounded up.
 constexpr double kPeakBytesPerBandVoxel = 32.0;
-
-/// The machine's physical memory in bytes, or 0 if unknown.
-double physicalMemoryBytes()
-{
-    const long pages = sysconf(_SC_PHYS_PAGES), pageSize = sysconf(_SC_PAGE_SIZE);
-    return pages > 0 && pageSize > 0 ? double(pages) * double(pageSize) : 0.0;
-}
 
 /// @throw ParameterError naming the first vertex that is not finite, or the largest
 ///        coordinate if it is too far from the origin for 32-bit voxel coordinates.
@@ -62,7 +54,7 @@ void requireVerticesInRange(const SurfaceMesh& mesh, double voxelSize, float hal
 void requireBandFitsInMemory(double area, double voxelSize, float halfWidth)
 {
     const double bandVoxels = area / (voxelSize * voxelSize) * 2.0 * double(halfWidth);
-    const double needed = bandVoxels * kPeakBytesPerBandVoxel, available = physicalMemoryBytes();
+    const double needed = bandVoxels * kPeakBytesPerBandVoxel, available = machine_memory_internal::usableMemoryBytes();
     if (available > 0.0 && needed > available) {
         std::ostringstream msg;
         msg.precision(2);

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "Cancellation.h"
 #include "InstructionSet.h"
+#include "MachineMemory.h"
 #include "OpenVdbScale.h"
 #include "ParameterChecks.h"
 #include "ParticleIndexImpl.h"
@@ -41,10 +42,32 @@ using particle_index_internal::IndexTree;
 /// its 512 voxels, so a task of many leaves would otherwise run for milliseconds.
 constexpr size_t kLeavesPerPoll = 8;
 
+/// Bytes one density leaf takes on the heap: the node (masks, origin, buffer handle), its
+/// separately allocated 512 values, and malloc's header for each.
+constexpr double kBytesPerDensityLeaf = double(sizeof(FloatLeaf)) + double(FloatLeaf::SIZE * sizeof(float)) + 32.0;
+
+/// @throw ParameterError("... would take about 7.3 GB, more than the 4.1 GB this process
+///        can use: ...") if @a bytes (@a what: "the density grid (N leaves of 8^3 voxels)")
+///        exceed the memory this process can use (machine_memory_internal). A voxel size
+///        far below the spacing made the process allocate until the kernel ended it.
+void requireMemoryFor(double bytes, const std::string& what, double voxelSize, double effectiveRadius)
+{
+    const double usable = machine_memory_internal::usableMemoryBytes();
+    if (!(usable > 0.0) || !(bytes > usable)) return;
+    std::ostringstream msg;
+    msg.precision(3);
+    msg << what << " of these particles at --voxel-size " << voxelSize << " and --radius " << effectiveRadius
+        << " would take about " << bytes / 1e9 << " GB, more than the " << usable / 1e9
+        << " GB this process can use: give a larger --voxel-size or a smaller --radius";
+    throw ParameterError(msg.str());
+}
+
 /// Origins of the density leaves that may hold a voxel within r_e of a particle: for each
 /// leaf of the particle index, the density leaves overlapping its active cells' bounding box
 /// grown by r_e. Sorted, so the leaf order (and thus everything after) is deterministic.
 /// On a stop (@a poll) the list is incomplete; the caller checks.
+/// @throw ParameterError (requireMemoryFor()) if the list, or the leaves it names, cannot
+///        fit in memory.
 std::vector<openvdb::Coord> candidateLeafOrigins(const ParticleIndex& particles,
                                                  const openvdb::math::Transform& transform,
                                                  double effectiveRadius, CancelPoll& poll)
@@ -52,10 +75,11 @@ std::vector<openvdb::Coord> candidateLeafOrigins(const ParticleIndex& particles,
     const IndexTree& indexTree = particles.impl().grid->tree();
     const double cellSize = particles.cellSize();
     openvdb::tree::LeafManager<const IndexTree> leaves(indexTree);
-    tbb::enumerable_thread_specific<std::vector<openvdb::Coord>> perThread;
+    // Per index leaf, the box of the density leaf origins it reaches; counted before they
+    // are listed, so that a list larger than memory is refused, not allocated.
+    std::vector<openvdb::CoordBBox> reach(leaves.leafCount());
     tbb::parallel_for(tbb::blocked_range<size_t>(0, leaves.leafCount()),
         [&](const tbb::blocked_range<size_t>& range) {
-            std::vector<openvdb::Coord>& origins = perThread.local();
             for (size_t n = range.begin(); n < range.end(); ++n) {
                 if (poll.stoppedAt(64 * (n - range.begin()))) return;  // every 64 index leaves
                 openvdb::CoordBBox cells;
@@ -64,8 +88,30 @@ std::vector<openvdb::Coord> candidateLeafOrigins(const ParticleIndex& particles,
                 const openvdb::Vec3d worldMax = (cells.max().asVec3d() + 0.5) * cellSize + effectiveRadius;
                 const openvdb::Vec3d indexMin = transform.worldToIndex(worldMin);
                 const openvdb::Vec3d indexMax = transform.worldToIndex(worldMax);
-                const openvdb::Coord lo(openvdb::Coord::ceil(indexMin) & ~int(FloatLeaf::DIM - 1));
-                const openvdb::Coord hi(openvdb::Coord::floor(indexMax) & ~int(FloatLeaf::DIM - 1));
+                reach[n] = openvdb::CoordBBox(openvdb::Coord::ceil(indexMin) & ~int(FloatLeaf::DIM - 1),
+                                              openvdb::Coord::floor(indexMax) & ~int(FloatLeaf::DIM - 1));
+            }
+        });
+    std::vector<openvdb::Coord> all;
+    if (poll.stopped()) return all;
+    double listed = 0.0;
+    for (const openvdb::CoordBBox& box : reach) {
+        double origins = 1.0;
+        for (int k = 0; k < 3; ++k) origins *= std::max(0.0, double(box.max()[k] - box.min()[k]) / FloatLeaf::DIM + 1.0);
+        listed += origins;
+    }
+    const double voxelSize = transform.voxelSize()[0];
+    // Listed per thread, then gathered: twice the list at the peak.
+    requireMemoryFor(2.0 * listed * double(sizeof(openvdb::Coord)), "listing the density leaves", voxelSize,
+                     effectiveRadius);
+
+    tbb::enumerable_thread_specific<std::vector<openvdb::Coord>> perThread;
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, reach.size()),
+        [&](const tbb::blocked_range<size_t>& range) {
+            std::vector<openvdb::Coord>& origins = perThread.local();
+            for (size_t n = range.begin(); n < range.end(); ++n) {
+                if (poll.stoppedAt(64 * (n - range.begin()))) return;
+                const openvdb::Coord lo = reach[n].min(), hi = reach[n].max();
                 openvdb::Coord origin;
                 for (origin[0] = lo[0]; origin[0] <= hi[0]; origin[0] += FloatLeaf::DIM)
                     for (origin[1] = lo[1]; origin[1] <= hi[1]; origin[1] += FloatLeaf::DIM)
@@ -73,14 +119,20 @@ std::vector<openvdb::Coord> candidateLeafOrigins(const ParticleIndex& particles,
                             origins.push_back(origin);
             }
         });
-    std::vector<openvdb::Coord> all;
     if (poll.stopped()) return all;
-    for (auto& origins : perThread) all.insert(all.end(), origins.begin(), origins.end());
+    all.reserve(size_t(listed));
+    for (auto& origins : perThread) {
+        all.insert(all.end(), origins.begin(), origins.end());
+        std::vector<openvdb::Coord>().swap(origins);
+    }
     // Coord's < is a total order, so the parallel sort gives std::sort's result; it can be
     // stopped (hundreds of thousands of origins, tens of ms).
     cancellation_internal::runStoppable(poll, [&] { tbb::parallel_sort(all.begin(), all.end()); });
     if (poll.stopped()) return all;
     all.erase(std::unique(all.begin(), all.end()), all.end());
+    std::ostringstream what;
+    what << "the density grid (up to " << all.size() << " leaves of 8^3 voxels)";
+    requireMemoryFor(double(all.size()) * kBytesPerDensityLeaf, what.str(), voxelSize, effectiveRadius);
     return all;
 }
 

@@ -114,6 +114,33 @@ TEST_F(CliTest, WarnsWhenRelaxationIsTooStrongForTheCalibration)
     EXPECT_TRUE(given.err.empty()) << given.err;
 }
 
+TEST_F(CliTest, ADensityGridLargerThanTheMemoryIsRefusedBeforeItIsAllocated)
+{
+#if defined(NONBLOPPY_TEST_ASAN)
+    GTEST_SKIP() << "AddressSanitizer reserves more address space than the limit this test sets";
+#else
+    // 4096 particles 3 apart, each with a sphere of 62 voxels across: about 6 GB of density
+    // leaves. Under a 1.5 GB limit the run ended in "out of memory" (bug hunt); on a
+    // smaller farm node, in the kernel's OOM killer.
+    std::string csv = "x,y,z\n";
+    for (int i = 0; i < 16 * 16 * 16; ++i) {
+        csv += std::to_string(3 * (i % 16)) + "," + std::to_string(3 * (i / 16 % 16)) + "," + std::to_string(3 * (i / 256))
+               + "\n";
+    }
+    const std::string input = dir() + "/in/sparse.csv", err = dir() + "/err.txt";
+    writeText(input, csv);
+    const std::string command = "ulimit -v 1500000 && " + quote(kCli) + " mesh " + quote(input) + " -o "
+                                + quote(out("s.ply")) + " --radius 1 --voxel-size 0.0325 --threshold 2 2>" + quote(err);
+    const int status = std::system(("sh -c " + quote(command)).c_str());
+    ASSERT_TRUE(WIFEXITED(status));
+    EXPECT_EQ(WEXITSTATUS(status), 1);
+    EXPECT_EQ(readText(err), "nonbloppy: " + input + ": the density grid (up to 5088448 leaves of 8^3 voxels) of these "
+                             "particles at --voxel-size 0.0325 and --radius 1 would take about 11.1 GB, more than the "
+                             "1.54 GB this process can use: give a larger --voxel-size or a smaller --radius\n");
+    EXPECT_TRUE(listDir(dir() + "/out").empty());
+#endif
+}
+
 TEST_F(CliTest, VerbosePrintsStagesOnStderr)
 {
     const RunResult r = meshCube("cube", "-v");
