@@ -132,10 +132,17 @@ TEST(FrameListTest, Errors)
               "--frames: bad range '-5' (expected N, A-B or A-B:STEP with A, B >= 0)");
     EXPECT_EQ(errorOf([] { parseFrameList("1-x"); }),
               "--frames: bad range '1-x' (expected N, A-B or A-B:STEP with A, B >= 0)");
-    EXPECT_EQ(errorOf([] { parseFrameList("99999999999"); }),
-              "--frames: bad frame number '99999999999' (expected N, A-B or A-B:STEP with A, B >= 0)");
     EXPECT_EQ(errorOf([] { parseFrameList("0-2000000000"); }),
               "--frames: more than 10000000 frames in '0-2000000000'");
+}
+
+TEST(FrameListTest, NumbersPastAnIntAreSaidToBe)
+{
+    EXPECT_EQ(errorOf([] { parseFrameList("2147483648"); }),
+              "--frames: frame number 2147483648 is past 2147483647, the largest nonbloppy takes");
+    EXPECT_EQ(errorOf([] { parseFrameList("1-12345678901"); }),
+              "--frames: frame number 12345678901 is past 2147483647, the largest nonbloppy takes");
+    EXPECT_EQ(parseFrameList("2147483647"), std::vector<int>{2147483647});
 }
 
 TEST(FrameListTest, FormatFoldsRuns)
@@ -202,6 +209,22 @@ TEST_F(FindFramesTest, FindsFramesInOrderAndPlansMissingOnes)
     ASSERT_EQ(some.frames.size(), 3u);
     EXPECT_EQ(some.frames[1].number, 3);
     EXPECT_EQ(some.missing, (std::vector<int>{1, 4}));
+}
+
+TEST_F(FindFramesTest, AFileWhoseNumberIsPastAnIntIsNamedNotLeftOut)
+{
+    // f_2147483648.vtk fit the pattern but no int: it was left out of the run unsaid, and
+    // alone it gave "no file matches".
+    touch("f_1.vtk");
+    touch("f_2147483648.vtk");
+    touch("f_12345678901.vtk");
+    const FramePattern braces = parseFramePattern(mDir + "/f_{}.vtk", "IN");
+    EXPECT_EQ(errorOf([&] { nonbloppy_tool::planFrames(braces, std::nullopt); }),
+              mDir + "/f_12345678901.vtk: its frame number is past 2147483647, the largest nonbloppy takes; give "
+                     "--frames to leave it out");
+    const nonbloppy_tool::FramePlan one = nonbloppy_tool::planFrames(braces, parseFrameList("1"));
+    ASSERT_EQ(one.frames.size(), 1u);
+    EXPECT_EQ(one.frames[0].input, mDir + "/f_1.vtk");
 }
 
 TEST_F(FindFramesTest, TwoNamesForOneFrameIsAnErrorWhenThatFrameIsPlanned)

@@ -159,7 +159,7 @@ std::string FramePattern::directory() const
     return fs::path(mPrefix + "0").parent_path().string();
 }
 
-std::optional<std::string> FramePattern::matchFileName(const std::string& fileName) const
+std::optional<std::string> FramePattern::matchDigits(const std::string& fileName) const
 {
     if (mKind == Kind::None) return std::nullopt;
     const std::string prefix = fs::path(mPrefix + "0").filename().string();
@@ -169,8 +169,16 @@ std::optional<std::string> FramePattern::matchFileName(const std::string& fileNa
     if (fileName.compare(fileName.size() - mSuffix.size(), mSuffix.size(), mSuffix) != 0) {
         return std::nullopt;
     }
-    const std::string digits = fileName.substr(namePrefix.size(),
-                                               fileName.size() - namePrefix.size() - mSuffix.size());
+    std::string digits = fileName.substr(namePrefix.size(), fileName.size() - namePrefix.size() - mSuffix.size());
+    if (!isDigits(digits)) return std::nullopt;
+    return digits;
+}
+
+std::optional<std::string> FramePattern::matchFileName(const std::string& fileName) const
+{
+    const std::optional<std::string> matched = matchDigits(fileName);
+    if (!matched) return std::nullopt;
+    const std::string& digits = *matched;
     const std::optional<int> number = parseNumber(digits);
     if (!number) return std::nullopt;
     // A fixed-width pattern names each frame one way only.
@@ -207,6 +215,13 @@ std::vector<int> parseFrameList(const std::string& text, const std::string& what
         const std::optional<int> first = parseNumber(trim(range.substr(0, dash)));
         const std::optional<int> last =
             dash == std::string::npos ? first : parseNumber(trim(range.substr(dash + 1)));
+        for (const std::string& number : {trim(range.substr(0, dash)),
+                                           dash == std::string::npos ? std::string() : trim(range.substr(dash + 1))}) {
+            if (isDigits(number) && !parseNumber(number)) {
+                throw UsageError(what + ": frame number " + number + " is past " + std::to_string(INT_MAX)
+                                 + ", the largest nonbloppy takes");
+            }
+        }
         if (!first || !last) {
             throw UsageError(what + ": bad " + std::string(dash == std::string::npos
                                             ? "frame number '" : "range '") + item
@@ -262,6 +277,13 @@ std::string formatFrameList(std::vector<int> frames)
 
 std::vector<Frame> findFrames(const FramePattern& input)
 {
+    std::string pastLargest;
+    return findFrames(input, pastLargest);
+}
+
+std::vector<Frame> findFrames(const FramePattern& input, std::string& pastLargest)
+{
+    pastLargest.clear();
     const std::string dir = input.directory();
     std::error_code ec;
     fs::directory_iterator it(dir.empty() ? fs::path(".") : fs::path(dir), ec);
@@ -273,8 +295,15 @@ std::vector<Frame> findFrames(const FramePattern& input)
     for (const fs::directory_entry& entry : it) {
         const std::string name = entry.path().filename().string();
         const std::optional<std::string> digits = input.matchFileName(name);
-        if (!digits) continue;
         std::error_code statError;
+        if (!digits) {
+            // Its digits spell a number past an int: not a frame, but not silently either.
+            if (input.matchDigits(name) && !entry.is_directory(statError)) {
+                const std::string path = (dir.empty() ? fs::path(name) : fs::path(dir) / name).string();
+                if (pastLargest.empty() || path < pastLargest) pastLargest = path;
+            }
+            continue;
+        }
         if (entry.is_directory(statError)) continue;
         Frame frame;
         frame.number = *parseNumber(*digits);
@@ -298,7 +327,12 @@ std::vector<Frame> findFrames(const FramePattern& input)
 FramePlan planFrames(const FramePattern& input, const std::optional<std::vector<int>>& requested)
 {
     FramePlan plan;
-    plan.onDisk = findFrames(input);
+    std::string pastLargest;
+    plan.onDisk = findFrames(input, pastLargest);
+    if (!requested && !pastLargest.empty()) {
+        throw nonbloppy::FileError(pastLargest + ": its frame number is past " + std::to_string(INT_MAX)
+                                   + ", the largest nonbloppy takes; give --frames to leave it out");
+    }
     if (!requested) {
         plan.frames = plan.onDisk;
     } else {

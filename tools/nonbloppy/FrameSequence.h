@@ -59,6 +59,9 @@ public:
     /// If the last path component @a fileName fits the pattern's file name, the frame's digits.
     /// `####` and `%04d` accept exactly the digits path() would write for the number.
     std::optional<std::string> matchFileName(const std::string& fileName) const;
+    /// The digits where the placeholder stands in @a fileName, whatever number they spell
+    /// (matchFileName() also wants a number that fits an int, spelled the pattern's way).
+    std::optional<std::string> matchDigits(const std::string& fileName) const;
 
     /// The directory part of the pattern ("" for the current directory).
     std::string directory() const;
@@ -94,6 +97,9 @@ std::string formatFrameList(std::vector<int> frames);
 /// Two files that give the same number are both kept (Frame::otherInput).
 /// @throw nonbloppy::FileError if the directory cannot be read.
 std::vector<Frame> findFrames(const FramePattern& input);
+/// findFrames(), and in @a pastLargest the first name (sorted) of a file that fits the
+/// pattern but whose number is past INT_MAX ("" if none).
+std::vector<Frame> findFrames(const FramePattern& input, std::string& pastLargest);
 
 /// The frames a run works on.
 struct FramePlan
@@ -105,6 +111,8 @@ struct FramePlan
 
 /// Every frame found when @a requested is empty, else the requested ones that exist
 /// (the rest in missing).
+/// @throw nonbloppy::FileError naming a file that fits the pattern but whose frame number
+///        is past INT_MAX, when @a requested is empty (it would be left out unsaid).
 /// @throw nonbloppy::FileError if two files give the number of a planned frame
 ///        ("fluid_01.vtk and fluid_1.vtk are both frame 1"): a leftover file of frame 1
 ///        does not stop a run of --frames 2.
