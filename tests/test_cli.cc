@@ -11,10 +11,13 @@
 #include "CliTestUtil.h"
 
 #include <nonbloppy/WriteParticles.h>
+#include <nonbloppy/WriteVdb.h>
+#include <openvdb/openvdb.h>
 #include <openvdb/version.h>
 
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -253,6 +256,23 @@ TEST_F(CliTest, InspectVdbListsDensityGrid)
     EXPECT_NE(json.out.find("\"grids\": ["), std::string::npos) << json.out;
     EXPECT_NE(json.out.find("\"name\": \"density\""), std::string::npos) << json.out;
     EXPECT_GT(jsonNumber(json.out, "active_voxels"), 0.0) << json.out;
+}
+
+TEST_F(CliTest, InspectShowsNanAndInfMetadataAsSuch)
+{
+    // Text said "null", JSON's word for them, which names no number.
+    openvdb::initialize();
+    openvdb::FloatGrid::Ptr grid = openvdb::FloatGrid::create(0.0f);
+    grid->setName("g");
+    grid->insertMeta("not_a_number", openvdb::DoubleMetadata(std::nan("")));
+    grid->insertMeta("too_far", openvdb::FloatMetadata(-std::numeric_limits<float>::infinity()));
+    nonbloppy::writeVdb({grid}, out("meta.vdb"));
+    const RunResult text = run("inspect " + quote(out("meta.vdb")));
+    ASSERT_EQ(text.exitCode, 0) << text.err;
+    EXPECT_NE(text.out.find("    not_a_number: nan\n"), std::string::npos) << text.out;
+    EXPECT_NE(text.out.find("    too_far: -inf\n"), std::string::npos) << text.out;
+    const nlohmann::json json = nlohmann::json::parse(run("inspect --json " + quote(out("meta.vdb"))).out);
+    EXPECT_TRUE(json["grids"][0]["metadata"]["not_a_number"].is_null()) << json.dump();
 }
 
 TEST_F(CliTest, InspectParticleFile)

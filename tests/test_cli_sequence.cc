@@ -692,6 +692,7 @@ TEST_F(CliSequenceTest, TheLoggedLengthsAndStepCapGivenBackMeshTheSameBytes)
     r = run(mesh + quote(out("uncapped_{}.ply")) + lengths + " --log " + quote(out("uncapped.jsonl")));
     ASSERT_EQ(r.exitCode, 0) << r.err;
     EXPECT_EQ(jsonNumber(readText(out("uncapped.jsonl")), "max_step"), 0.0);
+    EXPECT_NE(readText(out("uncapped.jsonl")).find("\"spacing\": null"), std::string::npos);  // none derived
     EXPECT_FALSE(derived == readText(out("uncapped_0001.ply")));
     // The summary says which cap a run used.
     const std::string single = "mesh " + quote(in("fluid_0001.vtk")) + " -c 1 -t 4 -o " + quote(out("one.ply"));

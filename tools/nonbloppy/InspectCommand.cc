@@ -383,11 +383,13 @@ std::string metadataJson(const openvdb::Metadata& meta)
     return jsonString(meta.str());
 }
 
-/// The text form: full precision for doubles (Metadata::str() keeps 6 digits).
+/// The text form: full precision for doubles (Metadata::str() keeps 6 digits); nan and inf
+/// as such (JSON has no word for them and says null).
 std::string metadataText(const openvdb::Metadata& meta)
 {
-    if (auto* m = dynamic_cast<const openvdb::DoubleMetadata*>(&meta)) return jsonNumber(m->value());
-    if (auto* m = dynamic_cast<const openvdb::FloatMetadata*>(&meta)) return jsonNumber(m->value());
+    const auto number = [](double value) { return std::isfinite(value) ? jsonNumber(value) : formatNumber(value); };
+    if (auto* m = dynamic_cast<const openvdb::DoubleMetadata*>(&meta)) return number(m->value());
+    if (auto* m = dynamic_cast<const openvdb::FloatMetadata*>(&meta)) return number(m->value());
     return meta.str();
 }
 

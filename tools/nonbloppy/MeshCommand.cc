@@ -18,6 +18,7 @@
 #include <nonbloppy/ReadMesh.h>
 #include <nonbloppy/ReadParticles.h>
 #include <nonbloppy/Timing.h>
+#include <nonbloppy/Version.h>
 #include <nonbloppy/WriteMesh.h>
 #include <nonbloppy/WriteVdb.h>
 
@@ -548,7 +549,8 @@ FrameOutcome writeFrame(const MeshOptions& o, MeshedFrame& frame, ProgressInterr
         StageScope stage(interrupter, frame.after, "write vdb");
         result.density->insertMeta("source_file", openvdb::StringMetadata(o.input));
         openvdb::MetaMap fileMetadata;
-        fileMetadata.insertMeta("creator", openvdb::StringMetadata(versionLine()));
+        // As convert's .vdb files (writeParticles()) say it; the file header holds OpenVDB's.
+        fileMetadata.insertMeta("creator", openvdb::StringMetadata(std::string("nonbloppy ") + nonbloppy::version()));
         openvdb::GridCPtrVec grids{result.density};
         appendVdbGrids(grids, result, frame.particles, o.outputs, o.vdbPath, &interrupter);
         cleanup.willWrite(o.vdbPath);
@@ -920,7 +922,10 @@ int runSequence(const MeshOptions& o)
         // As written: quads are split into two triangles unless --quads keeps them.
         report.faces = f.quads ? result.mesh.polygonCount() : result.mesh.triangleCount();
         report.timings = outcome.timings;
-        report.parameters = {{"spacing", p.spacing}, {"effective_radius", p.effectiveRadius},
+        // No spacing (every length given, none derived) is null, as in inspect --json; 0 read
+        // as a length. A max_step of 0 is the uncapped step that --max-step 0 gives back.
+        const double spacing = p.spacing > 0.0 ? p.spacing : std::numeric_limits<double>::quiet_NaN();
+        report.parameters = {{"spacing", spacing}, {"effective_radius", p.effectiveRadius},
                              {"threshold", p.threshold}, {"voxel_size", p.voxelSize},
                              {"blend", p.blend}, {"iterations", double(p.iterations)},
                              {"adaptivity", p.adaptivity}, {"region_leaves", double(p.regionLeaves)},
