@@ -153,10 +153,6 @@ lowerCase(std::string_view text)
     return out;
 }
 
-} // namespace
-
-namespace {
-
 /// The component number @a digits spells: 0 to 99 without a leading zero; -1 otherwise.
 int componentNumber(std::string_view digits)
 {
