@@ -225,6 +225,17 @@ TEST_F(FindFramesTest, AFileWhoseNumberIsPastAnIntIsNamedNotLeftOut)
     const nonbloppy_tool::FramePlan one = nonbloppy_tool::planFrames(braces, parseFrameList("1"));
     ASSERT_EQ(one.frames.size(), 1u);
     EXPECT_EQ(one.frames[0].input, mDir + "/f_1.vtk");
+    // A number padded otherwise than #### or %05d asks is another name, not a number past
+    // an int (the first version of this check said so of f_07.vtk and stopped the run).
+    touch("g_0001.vtk");
+    touch("g_07.vtk");
+    touch("g_00002.vtk");
+    for (const char* pattern : {"/g_####.vtk", "/g_%04d.vtk"}) {
+        const nonbloppy_tool::FramePlan padded = nonbloppy_tool::planFrames(parseFramePattern(mDir + pattern, "IN"),
+                                                                            std::nullopt);
+        ASSERT_EQ(padded.frames.size(), 1u) << pattern;
+        EXPECT_EQ(padded.frames[0].input, mDir + "/g_0001.vtk");
+    }
 }
 
 TEST_F(FindFramesTest, TwoNamesForOneFrameIsAnErrorWhenThatFrameIsPlanned)

@@ -124,6 +124,10 @@ TEST_F(CliSequenceTest, DirectoriesMaySpellPlaceholders)
     EXPECT_EQ(listDir(shot), (std::vector<std::string>{"fluid_0003.vtk", "fluid_0004.vtk", "m_3.obj", "m_4.obj",
                                                        "single.ply", "single.vdb"}));
 
+    // A file missing from such a directory is missing, not a pattern.
+    r = run("mesh " + quote(shot + "/gone.vtk") + " -o " + quote(shot + "/gone.ply"));
+    EXPECT_EQ(r.exitCode, 1);
+    EXPECT_EQ(r.err, "nonbloppy: cannot open " + shot + "/gone.vtk: No such file or directory\n");
     // Only a directory spelling one names no file, and frames are files: refused as before.
     r = run("mesh " + quote(dir() + "/take_{}/fluid.vtk") + " -o " + quote(out("m.obj")));
     EXPECT_EQ(r.exitCode, 2);

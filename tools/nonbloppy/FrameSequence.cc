@@ -298,7 +298,9 @@ std::vector<Frame> findFrames(const FramePattern& input, std::string& pastLarges
         std::error_code statError;
         if (!digits) {
             // Its digits spell a number past an int: not a frame, but not silently either.
-            if (input.matchDigits(name) && !entry.is_directory(statError)) {
+            // (Digits padded otherwise than the pattern's are simply another name.)
+            const std::optional<std::string> other = input.matchDigits(name);
+            if (other && !parseNumber(*other) && !entry.is_directory(statError)) {
                 const std::string path = (dir.empty() ? fs::path(name) : fs::path(dir) / name).string();
                 if (pastLargest.empty() || path < pastLargest) pastLargest = path;
             }

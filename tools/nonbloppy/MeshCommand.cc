@@ -722,7 +722,12 @@ bool isSequenceInput(const std::string& input)
     struct stat info;
     if (::stat(input.c_str(), &info) == 0) return false;
     if (parseFramePattern(input, "IN").hasPlaceholder()) return true;
-    if (placeholderInDirectory(input)) throw UsageError(placeholderInDirectoryError("IN", input));
+    // A placeholder only in a directory that does not exist: frames in directories, which
+    // nonbloppy does not take. In one that exists, a file is missing ("cannot open").
+    const std::string directory = std::filesystem::path(input).parent_path().string();
+    if (placeholderInDirectory(input) && ::stat(directory.c_str(), &info) != 0) {
+        throw UsageError(placeholderInDirectoryError("IN", input));
+    }
     return false;
 }
 
