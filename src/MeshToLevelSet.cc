@@ -50,17 +50,18 @@ void requireVerticesInRange(const SurfaceMesh& mesh, double voxelSize, float hal
 
 /// @throw ParameterError if the narrow band (the surface's area in voxels times 2·halfWidth,
 ///        within 8% of the active voxels counted on the dam-break surface) would need more
-///        memory than the machine has: meshToVolume's std::bad_alloc ends the process.
+///        memory than the process can still take (memoryHeadroomBytes()): meshToVolume's
+///        std::bad_alloc ends the process.
 void requireBandFitsInMemory(double area, double voxelSize, float halfWidth)
 {
     const double bandVoxels = area / (voxelSize * voxelSize) * 2.0 * double(halfWidth);
-    const double needed = bandVoxels * kPeakBytesPerBandVoxel, available = machine_memory_internal::usableMemoryBytes();
-    if (available > 0.0 && needed > available) {
+    const double needed = bandVoxels * kPeakBytesPerBandVoxel, available = machine_memory_internal::memoryHeadroomBytes();
+    if (available >= 0.0 && needed > available) {
         std::ostringstream msg;
         msg.precision(2);
         msg << "the level set's narrow band would hold about " << bandVoxels << " voxels, about "
             << needed / 1e9 << " GB at its peak, more than the " << available / 1e9
-            << " GB of memory: use a voxel size larger than " << voxelSize << " or a half width below "
+            << " GB this process can still take: use a voxel size larger than " << voxelSize << " or a half width below "
             << halfWidth;
         throw ParameterError(msg.str());
     }

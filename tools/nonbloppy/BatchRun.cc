@@ -358,7 +358,11 @@ bool reportingFailures(BatchState& state, size_t index, const BatchSettings& set
         state.stop = true;
     } catch (const std::bad_alloc&) {
         beforeReport();
-        state.failed(index, "out of memory");
+        // Each frame's memory checks see what the others hold as they start, not what they
+        // will take: frames that fit alone may not fit side by side.
+        state.failed(index, settings.frameJobs > 1 ? "out of memory with " + std::to_string(settings.frameJobs)
+                                                         + " frames at once; give a lower --frame-jobs"
+                                                   : std::string("out of memory"));
         if (!settings.keepGoing) state.stop = true;
     } catch (const std::exception& e) {
         beforeReport();
