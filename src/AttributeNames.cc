@@ -65,9 +65,21 @@ uniqueNames(const std::vector<NamedAttribute>& attributes, std::string (*word)(c
             std::string name = base;
             for (int suffix = 2;; ++suffix) {
                 const std::vector<std::string> columns = columnsOf(name, components);
-                if (std::none_of(columns.begin(), columns.end(),
-                                 [&](const std::string& c) { return taken.count(c) || isReserved(c); })) {
-                    taken.insert(columns.begin(), columns.end());
+                // A vector written as columns also holds the spellings of its next component:
+                // a scalar "a_2" beside the 2-component "a" (a_0, a_1) read back as one
+                // 3-component "a" and was gone.
+                // So does its bare name, without which a reader joins no run of that base.
+                std::vector<std::string> claimed = columns;
+                if (columns.size() > 1) {
+                    claimed.push_back(name);
+                    const std::string next = std::to_string(components);
+                    for (const std::string& spelling : {name + "_" + next, name + ":" + next, name + "[" + next + "]"}) {
+                        claimed.push_back(spelling);
+                    }
+                }
+                if (std::none_of(columns.begin(), columns.end(), isReserved)
+                    && std::none_of(claimed.begin(), claimed.end(), [&](const std::string& c) { return taken.count(c); })) {
+                    taken.insert(claimed.begin(), claimed.end());
                     break;
                 }
                 name = base + "_" + std::to_string(suffix);

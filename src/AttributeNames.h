@@ -43,7 +43,10 @@ std::vector<std::string> plyColumns(const std::string& base, int components);
 /// alphabet), then, if any column it gives is taken (by the format: @a isReserved, or by
 /// another attribute), the first of word_2, word_3, ... whose columns are all free.
 /// Names the format takes as they are claim theirs first, in order; renamed ones follow,
-/// so "a b" beside "a_b" becomes "a_b_2" and "a_b" stays.
+/// so "a b" beside "a_b" becomes "a_b_2" and "a_b" stays. An attribute written as several
+/// columns also claims its bare name and its next component's spellings (name_N, name:N,
+/// name[N] for N components), so that no other column joins its run on reading back: a
+/// scalar "a_2" beside a 2-component "a" is written as "a_2_2".
 /// Cost: O(A log A) set operations for A attributes (times their columns).
 std::vector<std::string> uniqueNames(const std::vector<NamedAttribute>& attributes,
                                      std::string (*word)(const std::string&), const ColumnsOf& columnsOf,

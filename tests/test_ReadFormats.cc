@@ -624,6 +624,42 @@ TEST_F(ReadFormatsTest, VdbQuaternionsMatricesAndSplitVectorsAreAttributesOfThei
     EXPECT_EQ(attribute(particles, "xform").type, ScalarType::Float32);
 }
 
+TEST_F(ReadFormatsTest, AScalarNamedAsAVectorsNextComponentStaysItsOwn)
+{
+    // "a" of 2 components went to PLY and .vdb as a_0, a_1 (CSV a:0, a:1) and a scalar "a_2"
+    // beside it read back as a third component: one attribute gone (second bug hunt).
+    const auto attributeOf = [](const std::string& name, int components, float first) {
+        ParticleAttribute a;
+        a.name = name;
+        a.components = components;
+        for (int k = 0; k < 2 * components; ++k) {
+            const float value = first + float(k);
+            const auto* bytes = reinterpret_cast<const unsigned char*>(&value);
+            a.bytes.insert(a.bytes.end(), bytes, bytes + 4);
+        }
+        return a;
+    };
+    for (const bool scalarFirst : {false, true}) {
+        ParticleSet particles;
+        particles.positions = {openvdb::Vec3f(0.0f), openvdb::Vec3f(1.0f, 2.0f, 3.0f)};
+        particles.attributes = {attributeOf("a", 2, 10.0f), attributeOf("a_2", 1, 20.0f)};
+        if (scalarFirst) std::swap(particles.attributes[0], particles.attributes[1]);
+        for (const std::string ext : {".ply", ".csv", ".vdb"}) {
+            const std::string file = path("next" + ext);
+            nonbloppy::writeParticles(particles, file);
+            const std::vector<std::string> written = nonbloppy::writtenAttributeNames(particles, file);
+            const ParticleSet back = readParticles(file);
+            ASSERT_EQ(back.attributes.size(), 2u) << ext << " " << scalarFirst;
+            for (size_t i = 0; i < 2; ++i) {
+                const ParticleAttribute& a = attribute(back, written[i]);
+                EXPECT_EQ(a.components, particles.attributes[i].components) << ext << " " << written[i];
+                EXPECT_EQ(a.asDouble(1, a.components - 1), particles.attributes[i].asDouble(1, a.components - 1))
+                    << ext << " " << written[i];
+            }
+        }
+    }
+}
+
 TEST_F(ReadFormatsTest, WhatNoAttributeCanTakeIsListedAsSkipped)
 {
     // A .vdb's groups and a PLY vertex's list properties were left out without a word.
