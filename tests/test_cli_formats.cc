@@ -256,6 +256,11 @@ TEST_F(CliFormatsTest, AttributeNamesKeepTheirInnerSpaces)
     EXPECT_EQ(joined.exitCode, 1);
     EXPECT_EQ(joined.err, "nonbloppy: " + path("spaced.csv") + ": unknown attribute 'myattr'; the particles have: "
                           "my attr, other\n");
+    // --vdb-points says what it renames, as convert does (it said nothing).
+    const RunResult points = run("mesh -q " + quote(path("spaced.csv")) + " -o " + quote(path("p.ply")) + " --vdb "
+                                 + quote(path("p.vdb")) + " --vdb-points");
+    ASSERT_EQ(points.exitCode, 0) << points.err;
+    EXPECT_EQ(points.err, "nonbloppy: warning: attribute 'my attr' is written to " + path("p.vdb") + " as 'my_attr'\n");
 }
 
 TEST_F(CliFormatsTest, IntegerAttributesReachTheMeshAsTheNearestParticlesValue)

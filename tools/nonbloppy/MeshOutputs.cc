@@ -41,6 +41,7 @@ std::atomic<bool> gObjWarningPrinted{false};
 std::atomic<bool> gRenameWarningPrinted{false};
 std::atomic<bool> gRoundingWarningPrinted{false};
 std::atomic<bool> gVdbRoundingWarningPrinted{false};
+std::atomic<bool> gVdbRenameWarningPrinted{false};
 
 } // namespace
 
@@ -106,6 +107,11 @@ void appendVdbGrids(openvdb::GridCPtrVec& grids, const nonbloppy::SurfaceResult&
     }
     if (o.vdbPoints) {
         grids.push_back(nonbloppy::makePointDataGrid(particles));
+        if (!particles.attributes.empty() && !gVdbRenameWarningPrinted.exchange(true)) {  // as convert says it
+            std::vector<std::string> original;
+            for (const auto& a : particles.attributes) original.push_back(a.name);
+            warnRenamedAttributes(original, nonbloppy::writtenAttributeNames(particles, vdbPath), vdbPath);
+        }
         if (!gVdbRoundingWarningPrinted) {
             const std::vector<std::string> rounded = nonbloppy::roundedAttributes(particles, vdbPath);
             if (!rounded.empty() && !gVdbRoundingWarningPrinted.exchange(true)) warnRounded(rounded[0], vdbPath);
