@@ -497,6 +497,11 @@ writeParticles(const ParticleSet& particles, const std::string& path, const Part
     requireSizes(particles, " (" + path + ")");
     if (ext == ".vdb") {
         requirePlaceablePositions(particles, " (" + path + ")");
+        try {
+            for (const ParticleAttribute& a : particles.attributes) io_internal::requireInt64Values(a, "a .vdb stores");
+        } catch (const ParameterError& e) {
+            throw ParameterError(e.what() + (" (" + path + ")"));  // named as the other refusals are
+        }
         openvdb::MetaMap metadata;
         metadata.insertMeta("creator", openvdb::StringMetadata(std::string("nonbloppy ") + version()));
         writeVdb({pointDataGridOfFinitePositions(particles, 0.0)}, path, metadata);

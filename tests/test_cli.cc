@@ -57,7 +57,7 @@ TEST_F(CliTest, MeshWritesObjAndVdbAndSummary)
     EXPECT_NE(r.out.find("region leaves        1024           (default)"), std::string::npos) << r.out;
     EXPECT_NE(r.out.find("rasterize density"), std::string::npos) << r.out;
     // Each timing line ends with the cores the stage kept busy, its CPU over wall-clock time.
-    EXPECT_NE(r.out.find("timings                    wall             cores\n"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("timings                      wall             cores\n"), std::string::npos) << r.out;
     const size_t total = r.out.find("\n  total ");
     ASSERT_NE(total, std::string::npos) << r.out;
     double totalSeconds = 0.0, totalCores = 0.0;

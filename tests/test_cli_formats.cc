@@ -657,8 +657,9 @@ TEST_F(CliFormatsTest, WideIntegersSurviveAVdbOrAreRefused)
     } catch (const nonbloppy::ParameterError& e) {
         message = e.what();
     }
+    // Named as the other refusals of writeParticles() are (it named no file).
     EXPECT_EQ(message, "attribute 'h' holds 18446744073709551615, above 9223372036854775807, the largest integer "
-                       "a .vdb stores");
+                       "a .vdb stores (" + path("huge.vdb") + ")");
     EXPECT_FALSE(std::filesystem::exists(path("huge.vdb")));
 }
 

@@ -558,7 +558,7 @@ std::string ResidentSampler::report(const nonbloppy::StageTimings& timings, size
         if (s < mSamples.size()) peak = std::max(peak, mSamples[s].bytes);
         const uint64_t above = peak > mBaseline ? peak - mBaseline : 0;
         char line[200];
-        std::snprintf(line, sizeof(line), "[memory]   %-20s peak %10s  %8.1f bytes/particle\n",
+        std::snprintf(line, sizeof(line), "[memory]   %-22s peak %10s  %8.1f bytes/particle\n",
                       entry.stage.c_str(), formatBytes(above).c_str(),
                       particles ? double(above) / double(particles) : 0.0);
         out += line;
@@ -567,7 +567,7 @@ std::string ResidentSampler::report(const nonbloppy::StageTimings& timings, size
     const uint64_t peak = peakResidentBytes();
     char line[200];
     std::snprintf(line, sizeof(line),
-                  "[memory]   %-20s peak %10s  %8.1f bytes/particle (getrusage ru_maxrss, whole "
+                  "[memory]   %-22s peak %10s  %8.1f bytes/particle (getrusage ru_maxrss, whole "
                   "process)\n", "process", formatBytes(peak).c_str(),
                   particles ? double(peak) / double(particles) : 0.0);
     out += line;

@@ -17,6 +17,7 @@
 #include <CLI/CLI.hpp>
 
 #include <cctype>
+#include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <filesystem>
@@ -101,6 +102,7 @@ inline std::string lowerExtension(const std::string& path)
 /// This is also how the library spells numbers in its parameter errors.
 inline std::string formatNumber(double value)
 {
+    if (std::isnan(value)) return "nan";  // whatever its sign bit ("-nan")
     std::ostringstream out;
     out << value;
     return out.str();

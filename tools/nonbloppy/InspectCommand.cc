@@ -323,11 +323,10 @@ int inspectMesh(const std::string& path, const nonbloppy::SurfaceMesh& mesh, boo
         printRow("closed", "no (no faces)");
         printRow("manifold", "no (no faces)");
     } else {
-        printRow("closed", std::string(m.closed ? "yes" : "no") + " ("
-                               + std::to_string(m.boundaryEdges) + " boundary edges)");
+        printRow("closed", std::string(m.closed ? "yes" : "no") + " (" + counted(m.boundaryEdges, "boundary edge") + ")");
         printRow("manifold", std::string(m.manifold ? "yes" : "no") + " ("
                                  + std::to_string(m.nonManifoldEdges) + " non-manifold, "
-                                 + std::to_string(m.inconsistentEdges) + " inconsistently oriented edges"
+                                 + counted(m.inconsistentEdges, "inconsistently oriented edge")
                                  + (m.closed ? "" : "; not closed") + ")");
     }
     printRow("area", formatNumber(m.area));
@@ -520,8 +519,10 @@ int inspectVdb(const std::string& path, bool json)
             line << "  " << formatCoord(bbox.min()) << "->" << formatCoord(bbox.max()) << "  "
                  << dim.x() << "x" << dim.y() << "x" << dim.z();
         }
-        line << "  " << formatCount(grid->activeVoxelCount()) << " active voxels  "
-             << grid->baseTree().leafCount() << " leaves  " << formatBytes(grid->memUsage());
+        const uint64_t voxels = grid->activeVoxelCount();
+        const size_t leaves = grid->baseTree().leafCount();
+        line << "  " << formatCount(voxels) << (voxels == 1 ? " active voxel  " : " active voxels  ") << leaves
+             << (leaves == 1 ? " leaf  " : " leaves  ") << formatBytes(grid->memUsage());
         if (const auto range = activeRange(*grid)) {
             line << "  values [" << formatNumber(range->first) << ", "
                  << formatNumber(range->second) << "]";

@@ -432,16 +432,17 @@ void printSummary(const MeshOptions& o, const nonbloppy::SurfaceResult& result,
 
     // Wall-clock time, its share, and the cores the stage kept busy (process CPU time over
     // wall-clock time): a stage far below the thread count waits on something serial.
-    out << "timings" << std::string(20, ' ') << "wall" << std::string(13, ' ') << "cores\n";
+    // 22 wide: "interpolate attributes", the longest stage name, stays in line.
+    out << "timings" << std::string(22, ' ') << "wall" << std::string(13, ' ') << "cores\n";
     const double total = timings.total();
     const auto cores = [](double cpuSeconds, double seconds) { return seconds > 0 ? cpuSeconds / seconds : 0.0; };
     for (const auto& entry : timings.entries) {
-        std::snprintf(line, sizeof(line), "  %-20s %8.3f s  (%4.1f%%)  %5.2f", entry.stage.c_str(),
+        std::snprintf(line, sizeof(line), "  %-22s %8.3f s  (%4.1f%%)  %5.2f", entry.stage.c_str(),
                       entry.seconds, total > 0 ? 100.0 * entry.seconds / total : 0.0,
                       cores(entry.cpuSeconds, entry.seconds));
         out << line << "\n";
     }
-    std::snprintf(line, sizeof(line), "  %-20s %8.3f s           %5.2f", "total", total,
+    std::snprintf(line, sizeof(line), "  %-22s %8.3f s           %5.2f", "total", total,
                   cores(timings.cpuTotal(), total));
     out << line << "\n";
     out.flush();
