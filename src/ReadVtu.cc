@@ -1366,6 +1366,12 @@ private:
         const std::string what = "'" + printable(name) + "'";
         ScalarType type;
         const char* typeName = xmlAttribute(attributes, "type", "");
+        if (std::strcmp(typeName, "String") == 0) {
+            // Names and labels have no place in an attribute: left out (its text and any
+            // appended block are not read) and said, as a .vdb's strings are. It was refused.
+            if (mFirstPiece) mParticles.skipped.push_back("string array '" + name + "'");
+            return;
+        }
         if (!vtuScalarType(typeName, type)) {
             fail(mPath, "unsupported type '" + printable(typeName) + "' of " + what);
         }

@@ -680,6 +680,19 @@ TEST_F(ReadFormatsTest, WhatNoAttributeCanTakeIsListedAsSkipped)
     EXPECT_EQ(listed.skipped, std::vector<std::string>{"list property 'ids'"});
     EXPECT_EQ(attribute(listed, "w").asDouble(0), 0.5);
     EXPECT_TRUE(readParticles(dataPath("cube_8_particles.vtk")).skipped.empty());
+
+    // A VTU string array (names, labels) made the whole file unreadable.
+    const std::string vtu = write("labelled.vtu",
+        "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"0.1\">\n<UnstructuredGrid>\n"
+        "<Piece NumberOfPoints=\"2\" NumberOfCells=\"0\">\n<Points>\n"
+        "<DataArray type=\"Float32\" NumberOfComponents=\"3\" format=\"ascii\">0 0 0 1 2 3</DataArray>\n</Points>\n"
+        "<PointData>\n<DataArray type=\"String\" Name=\"label\" format=\"ascii\">97 0 98 0</DataArray>\n"
+        "<DataArray type=\"Float32\" Name=\"w\" format=\"ascii\">0.5 1.5</DataArray>\n</PointData>\n"
+        "</Piece>\n</UnstructuredGrid>\n</VTKFile>\n");
+    const ParticleSet labelled = readParticles(vtu);
+    EXPECT_EQ(labelled.skipped, std::vector<std::string>{"string array 'label'"});
+    ASSERT_EQ(labelled.attributes.size(), 1u);
+    EXPECT_EQ(attribute(labelled, "w").asDouble(1), 1.5);
 }
 
 TEST_F(ReadFormatsTest, ComponentsPastTheThirdRoundTripThroughEveryFormat)
