@@ -89,6 +89,19 @@ TEST_F(CliTest, SpacingTurnsOnVolumeOffsetAndSmoothingAndNoSmoothTurnsItOff)
     EXPECT_NE(smoothedObj, plainObj);
 }
 
+TEST_F(CliTest, TheSummaryCountsPolygonsAsInspectDoes)
+{
+    const RunResult r = meshCube("quads", "--quads");
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    const std::string inspected = run("inspect " + quote(out("quads.obj"))).out;
+    const size_t at = inspected.find("  faces            ");
+    ASSERT_NE(at, std::string::npos) << inspected;
+    const std::string counts = inspected.substr(at + 19, inspected.find('\n', at) - at - 19);  // "N (T triangles, Q quads)"
+    EXPECT_NE(r.out.find("  polygons             " + counts.substr(0, counts.find(' ')) + " "), std::string::npos)
+        << r.out;
+    EXPECT_NE(r.out.find(counts.substr(counts.find('('))), std::string::npos) << r.out << "\n" << counts;
+}
+
 TEST_F(CliTest, QuietPrintsNothing)
 {
     const RunResult r = meshCube("cube", "--quiet");

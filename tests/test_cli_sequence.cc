@@ -294,6 +294,8 @@ TEST_F(CliSequenceTest, SkipExistingResumes)
     const std::string log = readText(dir() + "/run.jsonl");
     EXPECT_EQ(count(log, "\"status\": \"skipped\""), 2u) << log;
     EXPECT_EQ(count(log, "\"status\": \"done\""), 1u) << log;
+    // Skipped on all its outputs, the mesh and the .vdb (it named the mesh alone).
+    EXPECT_NE(r.out.find("skipped, its 2 outputs exist"), std::string::npos) << r.out;
 
     // Without --skip-existing every frame is made again.
     ASSERT_EQ(meshSequence(dir() + "/out", "").exitCode, 0);

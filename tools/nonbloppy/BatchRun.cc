@@ -86,7 +86,8 @@ public:
         logLine("{\"frame\": " + std::to_string(job.frame.number) + ", \"status\": \"skipped\", "
                 "\"input\": " + jsonString(job.frame.input) + ", \"output\": "
                 + jsonString(job.outputs.front()) + ", \"reason\": \"outputs exist\"}");
-        progress(index, "skipped, " + job.outputs.front() + " exists");
+        progress(index, job.outputs.size() == 1 ? "skipped, " + job.outputs.front() + " exists"
+                                                : "skipped, its " + std::to_string(job.outputs.size()) + " outputs exist");
     }
 
     void done(size_t index, const FrameReport& report, double seconds)

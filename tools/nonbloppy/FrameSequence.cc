@@ -233,6 +233,10 @@ std::vector<int> parseFrameList(const std::string& text, const std::string& what
         int step = 1;
         if (colon != std::string::npos) {
             const std::optional<int> s = parseNumber(stepText);
+            if (!s && isDigits(stepText)) {
+                throw UsageError(what + ": step " + stepText + " is past " + std::to_string(INT_MAX)
+                                 + ", the largest nonbloppy takes");
+            }
             if (!s || *s < 1) {
                 throw UsageError(what + ": bad step in '" + item
                                                 + "' (must be an integer >= 1)");

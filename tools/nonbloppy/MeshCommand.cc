@@ -422,8 +422,7 @@ void printSummary(const MeshOptions& o, const nonbloppy::SurfaceResult& result,
     row("vertices", std::to_string(mesh.points.size()), "");
     if (o.quads) {
         row("polygons", std::to_string(mesh.polygonCount()),
-            "(" + std::to_string(mesh.quads.size()) + " quads, "
-                + std::to_string(mesh.triangles.size()) + " triangles)");
+            "(" + counted(mesh.triangles.size(), "triangle") + ", " + counted(mesh.quads.size(), "quad") + ")");  // as inspect
     } else {
         row("triangles", std::to_string(mesh.triangleCount()), "");
     }
