@@ -5,7 +5,9 @@
 /// Table layout: a UTF-8 byte order mark is skipped, and so are lines starting with '#' and
 /// blank lines; the first other line names the columns, separated by ',' or ';' or tabs or
 /// spaces (the first of these found
-/// in the header is the separator), names optionally quoted. Positions are the columns
+/// in the header is the separator), names and values optionally quoted (a separator inside
+/// double quotes is no separator). A column without a name (the row numbers pandas and R
+/// write first) is left out and listed in ParticleSet::skipped. Positions are the columns
 /// x, y, z (any case), or ParaView's `Points:0..2`, or `<name>_x/_y/_z` with name
 /// position, pos or p. Every other column is an attribute; two or three consecutive columns
 /// `<name>:0,:1,:2` (ParaView), `<name>_x,_y,_z`, `<name>[0..2]` or `<name>.x,.y,.z` form
@@ -67,9 +69,22 @@ splitLine(std::string_view line, char separator, std::vector<std::string_view>& 
         }
         return;
     }
+    // A separator inside double quotes is part of the field (RFC 4180: a column "a,b");
+    // lines without quotes, nearly all, take the fast search.
+    const bool quoted = line.find('"') != std::string_view::npos;
     size_t start = 0;
     while (true) {
-        const size_t end = line.find(separator, start);
+        size_t end = start;
+        if (quoted) {
+            bool inQuotes = false;
+            while (end < line.size() && (inQuotes || line[end] != separator)) {
+                if (line[end] == '"') inQuotes = !inQuotes;
+                ++end;
+            }
+            if (end == line.size()) end = std::string_view::npos;
+        } else {
+            end = line.find(separator, start);
+        }
         fields.push_back(trimmed(line.substr(start, end == std::string_view::npos ? end : end - start)));
         if (end == std::string_view::npos) break;
         start = end + 1;
@@ -78,9 +93,13 @@ splitLine(std::string_view line, char separator, std::vector<std::string_view>& 
 
 struct Column
 {
-    int attribute = -1;  ///< index into the attribute list, or -1 for a position
+    int attribute = -1;  ///< index into the attribute list, -1 for a position, kUnnamed
     int component = 0;   ///< axis for positions, component for attributes
 };
+
+/// Column::attribute of a column without a name: the row numbers pandas' to_csv() and R's
+/// write.csv() put first, left out (and said: ParticleSet::skipped).
+constexpr int kUnnamed = -2;
 
 bool
 parseDoubleField(std::string_view text, double& value)
@@ -164,7 +183,10 @@ parseTable(StreamReader& in, const std::string& path)
     int axisColumn[3] = {-1, -1, -1};
     for (size_t i = 0; i < fields.size(); ++i) {
         const std::string name(trimmed(fields[i]));
-        if (name.empty()) fail(path, "empty column name in header (column " + std::to_string(i + 1) + ")");
+        if (name.empty()) {
+            columns[i] = {kUnnamed, 0};
+            continue;
+        }
         std::string base;
         const int component = tableComponentOf(name, base);
         const int axis = tablePositionAxis(name);
@@ -210,6 +232,7 @@ parseTable(StreamReader& in, const std::string& path)
         for (size_t i = 0; i < fields.size(); ++i) {
             const std::string_view field = trimmed(fields[i]);
             const int attribute = columns[i].attribute;
+            if (attribute == kUnnamed) continue;
             int64_t whole;
             if (attribute >= 0 && integral[size_t(attribute)] && io_internal::parseWhole(field, whole)) {
                 appendBytes(particles.attributes[size_t(attribute)].bytes, whole);
@@ -242,6 +265,9 @@ parseTable(StreamReader& in, const std::string& path)
                 particles.attributes[a].bytes.reserve(rows * size_t(componentCounts[a]) * 8);
             }
         }
+    }
+    for (size_t i = 0; i < columns.size(); ++i) {
+        if (columns[i].attribute == kUnnamed) particles.skipped.push_back("unnamed column " + std::to_string(i + 1));
     }
     for (size_t a = 0; a < names.size(); ++a) {
         ParticleAttribute& attribute = particles.attributes[a];

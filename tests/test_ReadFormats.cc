@@ -486,6 +486,24 @@ TEST_F(ReadFormatsTest, CsvWithAByteOrderMarkAsExcelWritesIt)
     }
 }
 
+TEST_F(ReadFormatsTest, CsvFromPandasAndRWithTheirRowNumbersAndQuotes)
+{
+    // pandas' to_csv() and R's write.csv() put the row numbers first, under no name: the
+    // file was refused ("empty column name"). A quoted name holding the separator was
+    // split in two ("line 2 has 4 fields, the header 5").
+    const std::string pandas = write("pandas.csv", ",x,y,z,speed\n0,0.5,0,0,1.5\n1,1,2,3,2.5\n");
+    const std::string r = write("r.csv", "\"\",\"x\",\"y\",\"z\",\"a,b\"\n\"1\",0.5,0,0,7\n\"2\",1,2,3,8\n");
+    for (const std::string& file : {pandas, r}) {
+        const ParticleSet particles = readParticles(file);
+        ASSERT_EQ(particles.size(), 2u) << file;
+        EXPECT_EQ(particles.positions[1], openvdb::Vec3f(1.0f, 2.0f, 3.0f)) << file;
+        ASSERT_EQ(particles.attributes.size(), 1u) << file;
+        EXPECT_EQ(particles.skipped, std::vector<std::string>{"unnamed column 1"}) << file;
+    }
+    EXPECT_EQ(attribute(readParticles(pandas), "speed").asDouble(1), 2.5);
+    EXPECT_EQ(attribute(readParticles(r), "a,b").asDouble(1), 8.0);
+}
+
 TEST_F(ReadFormatsTest, CsvComponentSpellingsFormVectorsOnlyWhenTheyAreOne)
 {
     // speed_x alone is a scalar of that name (it was read as a 1-component "speed", so a

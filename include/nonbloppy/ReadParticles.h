@@ -33,8 +33,10 @@
 ///           plus any others; consecutive `name:0, name:1, ...` (up to 100), `name_0, ...`,
 ///           `name[0], ...`, `name_x/_y/_z` or `name.x/.y/.z` form a vector `name` unless a
 ///           column is itself called `name`; a lone `name_x` keeps its name),
-///           separated by ',', ';', tabs or spaces; attributes are int64 if every value is
-///           an integer, else float64.
+///           separated by ',', ';', tabs or spaces, names and values optionally quoted;
+///           a column without a name (pandas' and R's row numbers) is left out and listed in
+///           ParticleSet::skipped; attributes are int64 if every value is an integer, else
+///           float64.
 /// - `.json` `[[x, y, z], ...]` (positions only).
 /// A file with zero particles is read without complaint (the pipeline rejects it later).
 /// Cost: one pass over the file. `.vtk`, `.ply`, `.xyz`, `.bgeo` (gzip inflated in chunks),
