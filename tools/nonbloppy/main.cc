@@ -27,7 +27,6 @@
 #if defined(__GLIBC__)
 #include <malloc.h>
 #endif
-#include <memory>
 #include <new>
 #include <regex>
 #include <sstream>
@@ -223,65 +222,13 @@ int run(int argc, char** argv)
     return fail("no command given; run 'nonbloppy --help'", kExitUsage);
 }
 
-/// std::cout's buffer where stdout is not a terminal: bytes written with write(2), keeping
-/// the errno of the first write that failed. Through stdio, the failure came at some flush
-/// mid-run and its errno was gone by the end, so a full disk said "cannot write standard
-/// output" without a reason. A terminal keeps stdio's line buffering (and rarely fills).
-class StandardOutputBuffer : public std::streambuf
-{
-public:
-    StandardOutputBuffer() { setp(mBuffer, mBuffer + sizeof(mBuffer)); }
-    /// errno of the first failed write (EIO if it wrote nothing without one), or 0.
-    int firstError() const { return mError; }
-
-protected:
-    int_type overflow(int_type c) override
-    {
-        if (!drain()) return traits_type::eof();
-        if (!traits_type::eq_int_type(c, traits_type::eof())) {
-            *pptr() = traits_type::to_char_type(c);
-            pbump(1);
-        }
-        return traits_type::not_eof(c);
-    }
-    int sync() override { return drain() ? 0 : -1; }
-
-private:
-    /// Write the buffered bytes; after a failure the rest are dropped (stdout is lost).
-    bool drain()
-    {
-        bool written = mError == 0;
-        for (const char* p = pbase(); written && p < pptr();) {
-            const ssize_t n = ::write(STDOUT_FILENO, p, size_t(pptr() - p));
-            if (n < 0 && errno == EINTR) continue;
-            if (n <= 0) {
-                mError = n < 0 ? errno : EIO;
-                written = false;
-            } else {
-                p += n;
-            }
-        }
-        setp(mBuffer, mBuffer + sizeof(mBuffer));
-        return written;
-    }
-
-    char mBuffer[1 << 16];
-    int mError = 0;
-};
-
 /// @a status, or kExitError after one line on stderr if what the command printed on stdout
 /// could not all be written (a full disk, a closed descriptor): a script reading
 /// `inspect --json > info.json` must not take an empty file for success. A reader that went
 /// away (EPIPE, '| head -1') asked for the rest to be dropped, and a failed command has
 /// already said why it failed.
-int finishStandardOutput(int status, const StandardOutputBuffer* buffer)
+int finishStandardOutput(int status)
 {
-    if (buffer) {
-        std::cout.flush();
-        const int error = buffer->firstError();
-        if (error == 0 || error == EPIPE || status != 0) return status;
-        return fail(std::string("cannot write standard output: ") + std::strerror(error), kExitError);
-    }
     errno = 0;
     std::cout.flush();
     const bool lost = !std::cout || std::fflush(stdout) != 0 || std::ferror(stdout);
@@ -337,12 +284,5 @@ int main(int argc, char** argv)
     mallopt(M_MMAP_THRESHOLD, 32 << 20);
     mallopt(M_TRIM_THRESHOLD, 256 << 20);
 #endif
-    std::unique_ptr<StandardOutputBuffer> buffer;
-    if (!::isatty(STDOUT_FILENO)) {
-        buffer = std::make_unique<StandardOutputBuffer>();
-        std::cout.rdbuf(buffer.get());
-    }
-    const int status = finishStandardOutput(runCommand(argc, argv), buffer.get());
-    std::cout.rdbuf(nullptr);  // the buffer goes before std::cout, which must not flush into it
-    return status;
+    return finishStandardOutput(runCommand(argc, argv));
 }
