@@ -179,11 +179,11 @@ tableComponentOf(const std::string& name, std::string& base)
             }
         }
     }
-    // name:c, name_c or name[c]
+    // name:c (ParaView's spelling, and writeParticles()') or name[c]; not name_c, which
+    // tables use for scalars of their own ("p_1", "w_0").
     const bool bracket = !name.empty() && name.back() == ']';
-    const size_t open = bracket ? name.rfind('[') : name.find_last_of(":_");
+    const size_t open = bracket ? name.rfind('[') : name.rfind(':');
     if (open == std::string::npos || open == 0) return -1;
-    if (!bracket && name[open] != ':' && name[open] != '_') return -1;
     const size_t end = bracket ? name.size() - 1 : name.size();
     const int component = componentNumber(std::string_view(name).substr(open + 1, end - open - 1));
     if (component < 0) return -1;

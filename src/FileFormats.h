@@ -79,8 +79,8 @@ std::string requireMeshExtension(const std::string& path);
 std::string printable(std::string_view text, size_t maxLength = 40);
 
 /// If the table (CSV/TXT) column @a name is "<base><suffix>" with suffix one of the
-/// component spellings (_x .x, _y .y, _z .z, any case, for 0 to 2, or :c _c [c] for any c
-/// up to 99, as ParaView and writeParticles() spell components past the third), the
+/// component spellings (_x .x, _y .y, _z .z, any case, for 0 to 2, or :c [c] for any c up
+/// to 99, as ParaView and writeParticles() spell components past the third), the
 /// component, with @a base set; else -1.
 int tableComponentOf(const std::string& name, std::string& base);
 
@@ -193,6 +193,11 @@ const char* vtkTypeName(ScalarType type);
 ///        9223372036854775807, the largest integer @a holder") if @a attribute is UInt64
 ///        and holds a value no int64 can (@a holder: "a .vdb stores", "a mesh attribute holds").
 void requireInt64Values(const ParticleAttribute& attribute, const char* holder);
+
+/// Metadata of a points grid writeParticles() made: the names, separated by spaces, of the
+/// attributes it wrote as scalars name_0, name_1, ... (OpenVDB has no type of their
+/// component count), which readParticles() joins again.
+constexpr const char* kSplitAttributesKey = "nonbloppy_split_attributes";
 
 /// The largest magnitude up to which a double holds every integer (2^53).
 constexpr int64_t kExactInDouble = int64_t(1) << 53;

@@ -9,11 +9,11 @@
 /// double quotes is no separator). A column without a name (the row numbers pandas and R
 /// write first) is left out and listed in ParticleSet::skipped. Positions are the columns
 /// x, y, z (any case), or ParaView's `Points:0..2`, or `<name>_x/_y/_z` with name
-/// position, pos or p. Every other column is an attribute; two or three consecutive columns
-/// `<name>:0,:1,:2` (ParaView), `<name>_x,_y,_z`, `<name>[0..2]` or `<name>.x,.y,.z` form
-/// one attribute `<name>` of that many components, unless another column is called `<name>`;
-/// a lone `<name>_x` is a scalar of that name. An attribute whose values are all integers
-/// is Int64, else Float64.
+/// position, pos or p. Every other column is an attribute; consecutive columns
+/// `<name>:0,:1,...` (ParaView; up to 100), `<name>[0],[1],...`, `<name>_x,_y,_z` or
+/// `<name>.x,.y,.z` form one attribute `<name>` of that many components, unless another
+/// column is called `<name>`; a lone `<name>_x` is a scalar of that name. An attribute
+/// whose values are all integers is Int64, else Float64.
 ///
 /// Both are read through a StreamReader (a bounded buffer) straight into the final arrays:
 /// table rows line by line, an attribute's values stored as int64 while every one is a
@@ -167,9 +167,16 @@ parseTable(StreamReader& in, const std::string& path)
     std::string_view headerLine;
     if (!nextLine(headerLine)) fail(path, "empty table: no header row");
     const std::string header(headerLine);  // the reader's buffer moves on
+    // The separator is looked for outside quotes: "x;y;z;\"a,b\"" is separated by ';'.
+    std::string unquoted;
+    bool inQuotes = false;
+    for (const char c : header) {
+        if (c == '"') inQuotes = !inQuotes;
+        else if (!inQuotes) unquoted += c;
+    }
     char separator = ' ';
     for (char candidate : {',', ';', '\t'}) {
-        if (header.find(candidate) != std::string_view::npos) {
+        if (unquoted.find(candidate) != std::string::npos) {
             separator = candidate;
             break;
         }

@@ -49,6 +49,7 @@
 #include <map>
 #include <memory>
 #include <streambuf>
+#include <sstream>
 #include <type_traits>
 #include <vector>
 
@@ -90,15 +91,20 @@ copyAttribute(const PointDataGrid& grid, size_t arrayIndex, size_t count, Partic
     }
 }
 
-/// @a attributes with runs of scalars "<base>_0", "<base>_1", ... (or _x, _y, _z) of one type
-/// joined into one attribute of that many components (groupColumns()): writeParticles()
-/// splits so what OpenVDB has no attribute type for (4 floats, say, or 5 integers).
-std::vector<ParticleAttribute> joinComponents(std::vector<ParticleAttribute> attributes)
+/// @a attributes with runs of scalars "<base>_0", "<base>_1", ... of one type joined into one
+/// attribute of that many components (groupColumns()), for each base in @a split (the grid's
+/// kSplitAttributesKey): writeParticles() splits so what OpenVDB has no attribute type for
+/// (4 floats, say, or 5 integers). Other scalars keep their names, whatever they spell.
+std::vector<ParticleAttribute> joinComponents(std::vector<ParticleAttribute> attributes,
+                                              const std::vector<std::string>& split)
 {
     std::vector<AttributeColumn> columns;
     for (size_t i = 0; i < attributes.size(); ++i) {
         AttributeColumn column{i, attributes[i].name, std::string(), -1, int(attributes[i].type)};
-        if (attributes[i].components == 1) column.component = suffixComponentOf(column.name, column.base);
+        if (attributes[i].components == 1) {
+            column.component = suffixComponentOf(column.name, column.base);
+            if (std::find(split.begin(), split.end(), column.base) == split.end()) column.component = -1;
+        }
         columns.push_back(std::move(column));
     }
     std::vector<ParticleAttribute> joined;
@@ -210,7 +216,12 @@ convertGrid(const PointDataGrid& grid, const std::string& path)
         else continue;  // a type registered after OpenVDB 10's own (which are all above)
         particles.attributes.push_back(std::move(attribute));
     }
-    particles.attributes = joinComponents(std::move(particles.attributes));
+    std::vector<std::string> split;
+    if (const auto listed = grid.getMetadata<openvdb::StringMetadata>(kSplitAttributesKey)) {
+        std::istringstream words(listed->value());
+        for (std::string word; words >> word;) split.push_back(word);
+    }
+    particles.attributes = joinComponents(std::move(particles.attributes), split);
     for (const auto& group : descriptor.groupMap()) particles.skipped.push_back("group '" + group.first + "'");
     return particles;
 }

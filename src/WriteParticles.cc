@@ -445,6 +445,7 @@ pointDataGridOfFinitePositions(const ParticleSet& particles, double voxelSize)
         *index, wrapper, *transform);
     grid->setName("points");
     const std::vector<std::string> names = namesForExtension(particles, ".vdb");
+    std::string split;  // the attributes written as scalars name_0, name_1, ...
     for (size_t i = 0; i < particles.attributes.size(); ++i) {
         const ParticleAttribute& a = particles.attributes[i];
         if (a.components == 3) {
@@ -461,6 +462,7 @@ pointDataGridOfFinitePositions(const ParticleSet& particles, double voxelSize)
         }
         io_internal::requireInt64Values(a, "a .vdb stores");  // the widest integer a .vdb attribute holds
         const std::vector<std::string> columns = vdbColumns(names[i], a.components);
+        if (columns.size() > 1) split += (split.empty() ? "" : " ") + names[i];
         for (int c = 0; c < a.components; ++c) {
             const std::string& name = columns[size_t(c)];
             switch (a.type) {
@@ -477,6 +479,9 @@ pointDataGridOfFinitePositions(const ParticleSet& particles, double voxelSize)
             }
         }
     }
+    // Which runs of scalars readParticles() joins again (io_internal::kSplitAttributesKey):
+    // only these, so that another program's scalars w_0, w_1 stay two.
+    if (!split.empty()) grid->insertMeta(io_internal::kSplitAttributesKey, openvdb::StringMetadata(split));
     return grid;
 }
 

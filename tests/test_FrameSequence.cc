@@ -143,6 +143,7 @@ TEST(FrameListTest, NumbersPastAnIntAreSaidToBe)
     EXPECT_EQ(errorOf([] { parseFrameList("1-12345678901"); }),
               "--frames: frame number 12345678901 is past 2147483647, the largest nonbloppy takes");
     EXPECT_EQ(parseFrameList("2147483647"), std::vector<int>{2147483647});
+    EXPECT_EQ(parseFrameList("00000000001"), std::vector<int>{1});  // padding, not a large number
     EXPECT_EQ(errorOf([] { parseFrameList("1-2:2147483648"); }),
               "--frames: step 2147483648 is past 2147483647, the largest nonbloppy takes");
 }

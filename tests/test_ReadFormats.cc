@@ -502,6 +502,9 @@ TEST_F(ReadFormatsTest, CsvFromPandasAndRWithTheirRowNumbersAndQuotes)
     }
     EXPECT_EQ(attribute(readParticles(pandas), "speed").asDouble(1), 2.5);
     EXPECT_EQ(attribute(readParticles(r), "a,b").asDouble(1), 8.0);
+    // The separator is the first found outside quotes (',' inside "a,b" chose the comma).
+    const std::string semicolons = write("semi.csv", "x;y;z;\"a,b\"\n0;0;0;1,5\n");
+    EXPECT_EQ(fileErrorOf(semicolons), "bad number '1,5' on line 2 (" + semicolons + ")");
 }
 
 TEST_F(ReadFormatsTest, CsvComponentSpellingsFormVectorsOnlyWhenTheyAreOne)
@@ -621,8 +624,8 @@ TEST_F(ReadFormatsTest, VdbPointDataGridWithAttributes)
 
 TEST_F(ReadFormatsTest, VdbQuaternionsMatricesAndSplitVectorsAreAttributesOfTheirComponents)
 {
-    // Quaternions and matrices were skipped without a word, and the 4 scalars c_0..c_3
-    // that writeParticles() makes of a 4-component attribute came back as 4 attributes.
+    // Quaternions and matrices were skipped without a word. Scalars c_0..c_3 of another
+    // program's stay four (only those writeParticles() split and lists are joined again).
     openvdb::initialize();
     const std::vector<openvdb::Vec3R> positions{{0.0, 0.0, 0.0}, {1.0, 2.0, 3.0}};
     const std::string file = path("extras.vdb");
@@ -631,15 +634,40 @@ TEST_F(ReadFormatsTest, VdbQuaternionsMatricesAndSplitVectorsAreAttributesOfThei
     ASSERT_EQ(particles.size(), 2u);
     std::vector<std::string> names;
     for (const ParticleAttribute& a : particles.attributes) names.push_back(a.name + "/" + std::to_string(a.components));
-    EXPECT_EQ(names, (std::vector<std::string>{"temperature/1", "orient/4", "xform/16", "stress/9", "c/4"}));
+    EXPECT_EQ(names, (std::vector<std::string>{"temperature/1", "orient/4", "xform/16", "stress/9", "c_0/1", "c_1/1",
+                                               "c_2/1", "c_3/1"}));
     for (size_t n = 0; n < particles.size(); ++n) {
         for (int c = 0; c < 4; ++c) EXPECT_EQ(attribute(particles, "orient").asDouble(n, c), double(c + 1));
         for (int c = 0; c < 16; ++c) EXPECT_EQ(attribute(particles, "xform").asDouble(n, c), double(c));
         for (int c = 0; c < 9; ++c) EXPECT_EQ(attribute(particles, "stress").asDouble(n, c), double(c) + 0.5);
-        for (int c = 0; c < 4; ++c) EXPECT_EQ(attribute(particles, "c").asDouble(n, c), double(10 + c));
+        for (int c = 0; c < 4; ++c) EXPECT_EQ(attribute(particles, "c_" + std::to_string(c)).asDouble(n), double(10 + c));
     }
     EXPECT_EQ(attribute(particles, "stress").type, ScalarType::Float64);
     EXPECT_EQ(attribute(particles, "xform").type, ScalarType::Float32);
+}
+
+TEST_F(ReadFormatsTest, ScalarsNamedLikeComponentsStayScalarsInCsvAndVdb)
+{
+    // a_0, a_1 of their own came back from .vdb and .csv as one 2-component "a", and a
+    // table's p_1 was taken for a position (review). PLY's convention (name_0, name_1 is a
+    // vector) is unchanged.
+    ParticleSet particles;
+    particles.positions = {openvdb::Vec3f(0.0f), openvdb::Vec3f(1.0f, 2.0f, 3.0f)};
+    for (const char* name : {"a_0", "a_1", "p_1"}) {
+        ParticleAttribute a;
+        a.name = name;
+        a.type = ScalarType::Int32;
+        a.bytes.resize(8, 1);
+        particles.attributes.push_back(a);
+    }
+    for (const std::string ext : {".csv", ".vdb"}) {
+        nonbloppy::writeParticles(particles, path("scalars" + ext));
+        const ParticleSet back = readParticles(path("scalars" + ext));
+        std::vector<std::string> names;
+        for (const ParticleAttribute& a : back.attributes) names.push_back(a.name + "/" + std::to_string(a.components));
+        EXPECT_EQ(names, (std::vector<std::string>{"a_0/1", "a_1/1", "p_1/1"})) << ext;
+        EXPECT_EQ(back.positions[1], openvdb::Vec3f(1.0f, 2.0f, 3.0f)) << ext;
+    }
 }
 
 TEST_F(ReadFormatsTest, AScalarNamedAsAVectorsNextComponentStaysItsOwn)

@@ -31,7 +31,8 @@ namespace nonbloppy {
 ///        polygon references a vertex the mesh does not have ("polygon P references vertex
 ///        I but the mesh has N vertices", polygons numbered triangles first, then quads);
 ///        or if the band (area/h² · 2·halfWidth voxels, at about 32 bytes each at the peak)
-///        would need more than the machine's physical memory;
+///        would need more than the process can still take (the machine's memory, ulimit -v
+///        or -d, or its cgroup's memory.max, less what it holds);
 ///        CancelledError("interrupted during mesh to level set") if @a interrupter says so.
 NONBLOPPY_API openvdb::FloatGrid::Ptr meshToLevelSet(const SurfaceMesh& mesh, double voxelSize,
                                        float halfWidth = 3.0f,

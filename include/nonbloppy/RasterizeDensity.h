@@ -40,7 +40,8 @@ struct DensitySettings
 /// @param particles    the particle index (its cell size does not affect the result)
 /// @param settings     r_e and h in world units, or a caller's transform
 /// @param interrupter  optional; start("rasterize density"), then wasInterrupted() every
-///                     64 particle-index leaves while listing candidate leaves, every 1 ms
+///                     64 particle-index leaves in each of the two passes that count and
+///                     list the candidate leaves, every 1 ms
 ///                     (from a helper thread) while sorting them, before each column once
 ///                     8 density leaves of the task are done (~0.1–1 ms of work) with
 ///                     wasInterrupted(percent) at each task's end, every 4096 leaves
@@ -49,8 +50,13 @@ struct DensitySettings
 /// Thread-safety: reentrant; the index is only read.
 /// @throw ParameterError if r_e or h is not finite or ≤ 0, h < kMinCellSize, a given
 ///        transform is not a uniform scale, r_e/h > kMaxVoxelsPerRadius, or @a particles
-///        holds particles in cells outside kMinCellsPerRadius..kMaxCellsPerRadius of r_e;
-///        CancelledError if @a interrupter says so.
+///        holds particles in cells outside kMinCellsPerRadius..kMaxCellsPerRadius of r_e,
+///        or, before anything is allocated, if even half the bytes of the candidate leaves
+///        (and their internal nodes) exceed what the process can still take (the machine's
+///        memory, ulimit -v or -d, or its cgroup's memory.max, less what it holds: "the
+///        density grid (up to N leaves of 8^3 voxels) of these particles at --voxel-size h
+///        and --radius r would take A to B GB, more than the C GB this process can still
+///        take: ..."); CancelledError if @a interrupter says so.
 NONBLOPPY_API openvdb::FloatGrid::Ptr rasterizeDensity(const ParticleIndex& particles,
                                          const DensitySettings& settings,
                                          openvdb::util::NullInterrupter* interrupter = nullptr);

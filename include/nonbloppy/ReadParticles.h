@@ -25,14 +25,15 @@
 ///           byte order, Float32/Float64 points; every PointData array in its type.
 /// - `.vdb`  the first openvdb::points::PointDataGrid: world positions from `P` plus every
 ///           numeric, vector, quaternion (4 components) and matrix attribute (9 or 16,
-///           row by row); group and string attributes are skipped. Consecutive scalars
-///           `name_0, name_1, ...` (or `_x, _y, _z`) of one type form one attribute `name`,
-///           as writeParticles() splits what OpenVDB has no type for. A .vdb without a
-///           PointDataGrid (e.g. a density cache) is an error.
+///           row by row); group and string attributes are skipped. The scalars
+///           `name_0, name_1, ...` that writeParticles() splits an attribute into (OpenVDB has
+///           no type for 2 or 4 components, say; it lists them in the grid's metadata
+///           "nonbloppy_split_attributes") form one attribute `name` again; other scalars keep
+///           their names. A .vdb without a PointDataGrid (e.g. a density cache) is an error.
 /// - `.csv`, `.txt`  a header row naming the columns (x, y, z or ParaView's Points:0..2,
-///           plus any others; consecutive `name:0, name:1, ...` (up to 100), `name_0, ...`,
-///           `name[0], ...`, `name_x/_y/_z` or `name.x/.y/.z` form a vector `name` unless a
-///           column is itself called `name`; a lone `name_x` keeps its name),
+///           plus any others; consecutive `name:0, name:1, ...` (up to 100), `name[0], ...`,
+///           `name_x/_y/_z` or `name.x/.y/.z` form a vector `name` unless a column is itself
+///           called `name`; a lone `name_x` keeps its name; `name_0` is a scalar),
 ///           separated by ',', ';', tabs or spaces, names and values optionally quoted;
 ///           a column without a name (pandas' and R's row numbers) is left out and listed in
 ///           ParticleSet::skipped; attributes are int64 if every value is an integer, else

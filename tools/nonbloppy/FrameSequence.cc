@@ -43,8 +43,11 @@ std::string padded(int number, int width)
 /// A non-negative frame number; nullopt if @a s is not one or does not fit an int.
 std::optional<int> parseNumber(const std::string& s)
 {
-    if (!isDigits(s) || s.size() > 10) return std::nullopt;
-    const long long value = std::stoll(s);
+    if (!isDigits(s)) return std::nullopt;
+    // Zeros in front are padding, whatever their number ("00000000001" is 1).
+    const std::string digits = s.substr(std::min(s.find_first_not_of('0'), s.size() - 1));
+    if (digits.size() > 10) return std::nullopt;
+    const long long value = std::stoll(digits);
     if (value > INT_MAX) return std::nullopt;
     return static_cast<int>(value);
 }
