@@ -9,6 +9,7 @@
 
 #include "../src/AtomicFile.h"
 #include "CliTestUtil.h"
+#include "TestUtil.h"  // NONBLOPPY_TEST_ASAN
 
 #include <nonbloppy/WriteParticles.h>
 #include <nonbloppy/WriteVdb.h>
