@@ -68,19 +68,26 @@ void requireMemoryFor(double fewestBytes, double mostBytes, const std::string& w
 
 /// Bytes of the density grid whose leaves have @a origins (sorted, distinct): the leaves,
 /// and the internal nodes above them, one per 128³ and per 4096³ voxels holding a leaf
-/// (33 KB and 262 KB: isolated droplets each take nodes of their own).
+/// (33 KB and 262 KB: isolated droplets each take nodes of their own). The upper nodes are
+/// counted from the distinct lower ones, a list about a hundred times shorter.
 double densityGridBytes(const std::vector<openvdb::Coord>& origins)
 {
     using Node1 = openvdb::FloatTree::RootNodeType::ChildNodeType::ChildNodeType;
     using Node2 = openvdb::FloatTree::RootNodeType::ChildNodeType;
-    const auto distinctParents = [&](int dim) {
-        std::vector<openvdb::Coord> parents(origins.size());
-        for (size_t n = 0; n < origins.size(); ++n) parents[n] = origins[n] & ~(dim - 1);
-        tbb::parallel_sort(parents.begin(), parents.end());
-        return double(std::unique(parents.begin(), parents.end()) - parents.begin());
+    // Masked origins are not in order (x, y, z order puts (0,8,200) before (0,16,0), whose
+    // parents are (0,0,128) and (0,0,0)): sorted again, then made distinct.
+    const auto keepDistinct = [](std::vector<openvdb::Coord>& coords) {
+        tbb::parallel_sort(coords.begin(), coords.end());
+        coords.erase(std::unique(coords.begin(), coords.end()), coords.end());
     };
-    return double(origins.size()) * kBytesPerDensityLeaf + distinctParents(int(Node1::DIM)) * double(sizeof(Node1))
-           + distinctParents(int(Node2::DIM)) * double(sizeof(Node2));
+    std::vector<openvdb::Coord> parents(origins.size());
+    for (size_t n = 0; n < origins.size(); ++n) parents[n] = origins[n] & ~int(Node1::DIM - 1);
+    keepDistinct(parents);
+    const double lowerNodes = double(parents.size());
+    for (openvdb::Coord& parent : parents) parent &= ~int(Node2::DIM - 1);
+    keepDistinct(parents);
+    return double(origins.size()) * kBytesPerDensityLeaf + lowerNodes * double(sizeof(Node1))
+           + double(parents.size()) * double(sizeof(Node2));
 }
 
 /// Origins of the density leaves that may hold a voxel within r_e of a particle: for each
