@@ -28,19 +28,6 @@ namespace {
 
 using namespace nonbloppy;
 
-template<typename T>
-ParticleAttribute
-makeAttribute(const std::string& name, ScalarType type, int components, const std::vector<T>& values)
-{
-    ParticleAttribute attribute;
-    attribute.name = name;
-    attribute.type = type;
-    attribute.components = components;
-    attribute.bytes.resize(values.size() * sizeof(T));
-    std::memcpy(attribute.bytes.data(), values.data(), attribute.bytes.size());
-    return attribute;
-}
-
 const openvdb::Mat3d kA(0.5, -1.0, 2.0, 3.0, 0.25, -0.75, 1.5, 1.0, -2.0);
 const openvdb::Vec3d kB(0.1, -0.2, 0.3);
 constexpr double kSpacing = 0.1;
@@ -64,9 +51,9 @@ ballWithFields()
         f.insert(f.end(), {v[0], v[1], v[2]});
         id.push_back(kFirstId + int64_t(j));
     }
-    particles.attributes.push_back(makeAttribute("c", ScalarType::Float32, 1, c));
-    particles.attributes.push_back(makeAttribute("f", ScalarType::Float64, 3, f));
-    particles.attributes.push_back(makeAttribute("id", ScalarType::Int64, 1, id));
+    particles.attributes.push_back(ParticleAttribute::of("c", 1, c));
+    particles.attributes.push_back(ParticleAttribute::of("f", 3, f));
+    particles.attributes.push_back(ParticleAttribute::of("id", 1, id));
     return particles;
 }
 
@@ -191,7 +178,7 @@ TEST(InterpolateAttributes, OfEquallyNearParticlesTheFirstGivesItsValue)
                                openvdb::Vec3f(0.0f, 0.3f, 0.0f)};
         std::vector<int16_t> cell{7, 8, 9, 3, 2, 1, 5, 5, 5};
         if (swapped) std::swap(particles.positions[0], particles.positions[1]);
-        particles.attributes.push_back(makeAttribute("cell", ScalarType::Int16, 3, cell));
+        particles.attributes.push_back(ParticleAttribute::of("cell", 3, cell));
         SurfaceMesh mesh;
         mesh.points = {openvdb::Vec3s(0.0f, 0.0f, 0.0f), openvdb::Vec3s(0.0f, 0.29f, 0.0f)};
         interpolateAttributes(mesh, particles, {"cell"}, 0.5);
@@ -241,12 +228,12 @@ TEST(InterpolateAttributes, NamesAndErrors)
     // A uint64 past int64 (a hash, say) has no place in the 64-bit signed integers.
     std::vector<uint64_t> hashes(fx.particles.size(), 5);
     hashes[3] = std::numeric_limits<uint64_t>::max();
-    fx.particles.attributes.push_back(makeAttribute("h", ScalarType::UInt64, 1, hashes));
+    fx.particles.attributes.push_back(ParticleAttribute::of("h", 1, hashes));
     EXPECT_EQ(nonbloppy_test::messageOf<ParameterError>([&] { interpolateAttributes(fx.mesh, fx.particles, {"h"}, fx.radius); }),
               "attribute 'h' holds 18446744073709551615, above 9223372036854775807, the largest integer a mesh "
               "attribute holds");
     hashes.assign(hashes.size(), uint64_t(std::numeric_limits<int64_t>::max()));  // the largest that fits
-    fx.particles.attributes.back() = makeAttribute("h", ScalarType::UInt64, 1, hashes);
+    fx.particles.attributes.back() = ParticleAttribute::of("h", 1, hashes);
     interpolateAttributes(fx.mesh, fx.particles, {"h"}, fx.radius);
     EXPECT_EQ(fx.mesh.attributes.back().integers.at(0), std::numeric_limits<int64_t>::max());
 }

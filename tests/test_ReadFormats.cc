@@ -654,11 +654,7 @@ TEST_F(ReadFormatsTest, ScalarsNamedLikeComponentsStayScalarsInCsvAndVdb)
     ParticleSet particles;
     particles.positions = {openvdb::Vec3f(0.0f), openvdb::Vec3f(1.0f, 2.0f, 3.0f)};
     for (const char* name : {"a_0", "a_1", "p_1"}) {
-        ParticleAttribute a;
-        a.name = name;
-        a.type = ScalarType::Int32;
-        a.bytes.resize(8, 1);
-        particles.attributes.push_back(a);
+        particles.attributes.push_back(ParticleAttribute::of(name, 1, std::vector<int32_t>{7, 8}));
     }
     for (const std::string ext : {".csv", ".vdb"}) {
         nonbloppy::writeParticles(particles, path("scalars" + ext));
@@ -675,15 +671,9 @@ TEST_F(ReadFormatsTest, AScalarNamedAsAVectorsNextComponentStaysItsOwn)
     // "a" of 2 components went to PLY and .vdb as a_0, a_1 (CSV a:0, a:1) and a scalar "a_2"
     // beside it read back as a third component: one attribute gone (second bug hunt).
     const auto attributeOf = [](const std::string& name, int components, float first) {
-        ParticleAttribute a;
-        a.name = name;
-        a.components = components;
-        for (int k = 0; k < 2 * components; ++k) {
-            const float value = first + float(k);
-            const auto* bytes = reinterpret_cast<const unsigned char*>(&value);
-            a.bytes.insert(a.bytes.end(), bytes, bytes + 4);
-        }
-        return a;
+        std::vector<float> values;
+        for (int k = 0; k < 2 * components; ++k) values.push_back(first + float(k));
+        return ParticleAttribute::of(name, components, values);
     };
     for (const bool scalarFirst : {false, true}) {
         ParticleSet particles;
@@ -748,19 +738,15 @@ TEST_F(ReadFormatsTest, ComponentsPastTheThirdRoundTripThroughEveryFormat)
     ParticleSet particles;
     particles.positions = {openvdb::Vec3f(0.0f), openvdb::Vec3f(1.0f, 2.0f, 3.0f)};
     for (const int components : {4, 9, 16}) {
-        ParticleAttribute a;
-        a.name = "q" + std::to_string(components);
-        a.type = components == 9 ? ScalarType::Int32 : ScalarType::Float32;
-        a.components = components;
+        std::vector<float> floats;
+        std::vector<int32_t> ints;
         for (int k = 0; k < 2 * components; ++k) {
-            const unsigned char* bytes;
-            const float asFloat = float(k) + 0.25f;
-            const int32_t asInt = k - 7;
-            bytes = a.type == ScalarType::Int32 ? reinterpret_cast<const unsigned char*>(&asInt)
-                                                : reinterpret_cast<const unsigned char*>(&asFloat);
-            a.bytes.insert(a.bytes.end(), bytes, bytes + 4);
+            floats.push_back(float(k) + 0.25f);
+            ints.push_back(k - 7);
         }
-        particles.attributes.push_back(a);
+        const std::string name = "q" + std::to_string(components);
+        particles.attributes.push_back(components == 9 ? ParticleAttribute::of(name, components, ints)
+                                                       : ParticleAttribute::of(name, components, floats));
     }
     for (const std::string ext : {".csv", ".vdb", ".ply", ".vtk", ".vtu"}) {
         const std::string file = path("round" + ext);

@@ -149,6 +149,27 @@ TEST(ReadParticles, RealVtkFilesHaveTheDocumentedCountsAndAttributes)
     }
 }
 
+TEST(ParticleAttribute, OfTypesTheValuesAfterTheirCppTypeAndKeepsTheirBytes)
+{
+    using nonbloppy::ParticleAttribute;
+    using nonbloppy::scalarTypeOf;
+    static_assert(scalarTypeOf<int8_t>() == ScalarType::Int8 && scalarTypeOf<uint8_t>() == ScalarType::UInt8);
+    static_assert(scalarTypeOf<int16_t>() == ScalarType::Int16 && scalarTypeOf<uint16_t>() == ScalarType::UInt16);
+    static_assert(scalarTypeOf<int32_t>() == ScalarType::Int32 && scalarTypeOf<uint32_t>() == ScalarType::UInt32);
+    static_assert(scalarTypeOf<int64_t>() == ScalarType::Int64 && scalarTypeOf<uint64_t>() == ScalarType::UInt64);
+    static_assert(scalarTypeOf<float>() == ScalarType::Float32 && scalarTypeOf<double>() == ScalarType::Float64);
+
+    const ParticleAttribute velocity = ParticleAttribute::of("velocity", 3, std::vector<double>{1, 2, 3, 4, 5, 6.5});
+    EXPECT_EQ(velocity.name, "velocity");
+    EXPECT_EQ(velocity.type, ScalarType::Float64);
+    EXPECT_EQ(velocity.components, 3);
+    EXPECT_EQ(velocity.size(), 2u);
+    EXPECT_EQ(velocity.asDouble(1, 2), 6.5);
+    const ParticleAttribute id = ParticleAttribute::of("id", 1, std::vector<uint64_t>{~uint64_t(0)});
+    EXPECT_EQ(id.bytes, std::vector<unsigned char>(8, 0xff));
+    EXPECT_TRUE(ParticleAttribute::of("none", 1, std::vector<int16_t>{}).bytes.empty());
+}
+
 TEST(ReadParticles, Cube8HasItsExactAsciiCoordinates)
 {
     const ParticleSet particles = readParticles(dataPath("cube_8_particles.vtk"));

@@ -483,15 +483,9 @@ TEST_F(CliFormatsTest, RenamedAttributesStayDistinctAndReadBack)
     ParticleSet particles;
     particles.positions = {{0.0f, 0.0f, 0.0f}, {1.0f, 0.0f, 0.0f}};
     const auto add = [&](const std::string& name, int components, float first) {
-        ParticleAttribute a;
-        a.name = name;
-        a.type = nonbloppy::ScalarType::Float32;
-        a.components = components;
         std::vector<float> values;
         for (int k = 0; k < 2 * components; ++k) values.push_back(first + float(k));
-        a.bytes.resize(values.size() * sizeof(float));
-        std::memcpy(a.bytes.data(), values.data(), a.bytes.size());
-        particles.attributes.push_back(a);
+        particles.attributes.push_back(ParticleAttribute::of(name, components, values));
     };
     add("a b", 1, 10.0f);
     add("a_b", 1, 20.0f);
@@ -534,11 +528,7 @@ TEST_F(CliFormatsTest, RenamedAttributesAreNamedInAWarning)
     // error. Then the command line: attributes renamed for the output format got no word.
     ParticleSet two;
     two.positions = {{0.0f, 0.0f, 0.0f}, {1.0f, 0.0f, 0.0f}};
-    ParticleAttribute a;
-    a.name = "a b";
-    a.type = nonbloppy::ScalarType::Float32;
-    a.bytes.resize(2 * sizeof(float));
-    two.attributes.push_back(a);
+    two.attributes.push_back(ParticleAttribute::of("a b", 1, std::vector<float>{0.0f, 0.0f}));
     EXPECT_EQ(nonbloppy::writtenAttributeNames(two, path("p.xyz")), std::vector<std::string>{""});
     try {
         nonbloppy::writtenAttributeNames(two, path("p.obj"));
@@ -612,25 +602,13 @@ TEST_F(CliFormatsTest, WideIntegersSurviveAVdbOrAreRefused)
     // -2147483648. A uint64 above 2^63 - 1 read back as -9.22e18.
     ParticleSet particles;
     particles.positions = {{0.0f, 0.0f, 0.0f}};
-    const auto add = [&](const std::string& name, nonbloppy::ScalarType type, const void* values, size_t bytes,
-                         int components) {
-        ParticleAttribute a;
-        a.name = name;
-        a.type = type;
-        a.components = components;
-        a.bytes.resize(bytes);
-        std::memcpy(a.bytes.data(), values, bytes);
-        particles.attributes.push_back(a);
-    };
-    const uint32_t wide32[3] = {4000000000u, 1u, 2u};
-    const int64_t wide64[3] = {int64_t(1) << 40, -5, 7};
-    add("u", nonbloppy::ScalarType::UInt32, wide32, sizeof(wide32), 3);
-    add("i", nonbloppy::ScalarType::Int64, wide64, sizeof(wide64), 3);
+    particles.attributes.push_back(ParticleAttribute::of("u", 3, std::vector<uint32_t>{4000000000u, 1u, 2u}));
+    particles.attributes.push_back(ParticleAttribute::of("i", 3, std::vector<int64_t>{int64_t(1) << 40, -5, 7}));
     // Scalars above 2^53 keep every bit (they went through a double: 2^62 + 1 became 2^62).
     const int64_t id = (int64_t(1) << 62) + 1;
     const uint64_t largest = uint64_t(std::numeric_limits<int64_t>::max());
-    add("id", nonbloppy::ScalarType::Int64, &id, sizeof(id), 1);
-    add("largest", nonbloppy::ScalarType::UInt64, &largest, sizeof(largest), 1);
+    particles.attributes.push_back(ParticleAttribute::of("id", 1, std::vector<int64_t>{id}));
+    particles.attributes.push_back(ParticleAttribute::of("largest", 1, std::vector<uint64_t>{largest}));
     const std::string file = path("wide.vdb");
     nonbloppy::writeParticles(particles, file);
     const ParticleSet back = nonbloppy::readParticles(file);
@@ -649,8 +627,7 @@ TEST_F(CliFormatsTest, WideIntegersSurviveAVdbOrAreRefused)
         std::memcpy(&value, a->bytes.data(), sizeof(value));
         EXPECT_EQ(value, expected) << name;
     }
-    const uint64_t huge = std::numeric_limits<uint64_t>::max();
-    add("h", nonbloppy::ScalarType::UInt64, &huge, sizeof(huge), 1);
+    particles.attributes.push_back(ParticleAttribute::of("h", 1, std::vector<uint64_t>{std::numeric_limits<uint64_t>::max()}));
     std::string message;
     try {
         nonbloppy::writeParticles(particles, path("huge.vdb"));
@@ -669,20 +646,9 @@ TEST_F(CliFormatsTest, PlyKeeps64BitIntegersAsIntegersWhereTheyFit32Bits)
     // averaged by mesh --attributes); now as int or uint where every value fits.
     ParticleSet particles;
     particles.positions = {{0.0f, 0.0f, 0.0f}, {1.0f, 0.0f, 0.0f}};
-    const auto add = [&](const std::string& name, nonbloppy::ScalarType type, const void* values) {
-        ParticleAttribute a;
-        a.name = name;
-        a.type = type;
-        a.bytes.resize(2 * 8);
-        std::memcpy(a.bytes.data(), values, a.bytes.size());
-        particles.attributes.push_back(a);
-    };
-    const int64_t small[2] = {-2147483648LL, 2147483647LL};
-    const int64_t large[2] = {0, int64_t(1) << 40};
-    const uint64_t smallUnsigned[2] = {0, 4294967295ULL};
-    add("id", nonbloppy::ScalarType::Int64, small);
-    add("big", nonbloppy::ScalarType::Int64, large);
-    add("count", nonbloppy::ScalarType::UInt64, smallUnsigned);
+    particles.attributes.push_back(ParticleAttribute::of("id", 1, std::vector<int64_t>{-2147483648LL, 2147483647LL}));
+    particles.attributes.push_back(ParticleAttribute::of("big", 1, std::vector<int64_t>{0, int64_t(1) << 40}));
+    particles.attributes.push_back(ParticleAttribute::of("count", 1, std::vector<uint64_t>{0, 4294967295ULL}));
     nonbloppy::writeParticles(particles, path("p.ply"));
     const std::string header = readText(path("p.ply")).substr(0, 200);
     EXPECT_NE(header.find("property int id\nproperty double big\nproperty uint count\n"), std::string::npos) << header;

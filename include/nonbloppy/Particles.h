@@ -25,7 +25,10 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
 #include <string>
+#include <type_traits>
+#include <utility>
 #include <vector>
 
 namespace nonbloppy {
@@ -70,6 +73,25 @@ NONBLOPPY_API const char* scalarTypeName(ScalarType type);
 /// True for the eight integer types, false for Float32 and Float64.
 NONBLOPPY_API bool isIntegerType(ScalarType type);
 
+/// The ScalarType of the C++ type @a T: scalarTypeOf<float>() is Float32,
+/// scalarTypeOf<uint64_t>() UInt64. Only the ten types ScalarType names compile.
+template<typename T>
+constexpr ScalarType scalarTypeOf()
+{
+    static_assert(std::is_arithmetic_v<T> && !std::is_same_v<T, bool> && (sizeof(T) <= 8),
+                  "a particle attribute holds 8- to 64-bit integers, float or double");
+    if constexpr (std::is_floating_point_v<T>) {
+        static_assert(sizeof(T) == 4 || sizeof(T) == 8, "float or double");
+        return sizeof(T) == 4 ? ScalarType::Float32 : ScalarType::Float64;
+    } else if constexpr (std::is_signed_v<T>) {
+        return sizeof(T) == 1 ? ScalarType::Int8 : sizeof(T) == 2 ? ScalarType::Int16
+             : sizeof(T) == 4 ? ScalarType::Int32 : ScalarType::Int64;
+    } else {
+        return sizeof(T) == 1 ? ScalarType::UInt8 : sizeof(T) == 2 ? ScalarType::UInt16
+             : sizeof(T) == 4 ? ScalarType::UInt32 : ScalarType::UInt64;
+    }
+}
+
 /// One named per-particle attribute (e.g. "velocity", 3 × Float32), stored in its own
 /// type so nothing is lost on the way from reader to writer.
 struct NONBLOPPY_API ParticleAttribute
@@ -78,6 +100,22 @@ struct NONBLOPPY_API ParticleAttribute
     ScalarType type = ScalarType::Float32;  ///< stored type of each component
     int components = 1;                  ///< 1 for scalars, 3 for vectors, ...
     std::vector<unsigned char> bytes;    ///< native-endian values, particle-major
+
+    /// The attribute @a name holding @a values, @a components per particle (particle-major:
+    /// particle 0's components, then particle 1's), typed after @a T (scalarTypeOf()).
+    /// Cost: one copy of the values.
+    /// Example: ParticleAttribute::of("velocity", 3, std::vector<float>{vx0, vy0, vz0, ...}).
+    template<typename T>
+    static ParticleAttribute of(std::string name, int components, const std::vector<T>& values)
+    {
+        ParticleAttribute attribute;
+        attribute.name = std::move(name);
+        attribute.type = scalarTypeOf<T>();
+        attribute.components = components;
+        attribute.bytes.resize(values.size() * sizeof(T));
+        if (!values.empty()) std::memcpy(attribute.bytes.data(), values.data(), attribute.bytes.size());
+        return attribute;
+    }
 
     /// Number of particles the attribute holds values for.
     size_t size() const;
