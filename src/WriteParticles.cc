@@ -6,7 +6,6 @@
 
 #include <nonbloppy/Error.h>
 #include <nonbloppy/ParticleIndex.h>
-#include <nonbloppy/Version.h>
 #include <nonbloppy/WriteVdb.h>
 
 #include "AtomicFile.h"
@@ -507,9 +506,7 @@ writeParticles(const ParticleSet& particles, const std::string& path, const Part
         } catch (const ParameterError& e) {
             throw ParameterError(e.what() + (" (" + path + ")"));  // named as the other refusals are
         }
-        openvdb::MetaMap metadata;
-        metadata.insertMeta("creator", openvdb::StringMetadata(std::string("nonbloppy ") + version()));
-        writeVdb({pointDataGridOfFinitePositions(particles, 0.0)}, path, metadata);
+        writeVdb({pointDataGridOfFinitePositions(particles, 0.0)}, path);
         return;
     }
     writeFileAtomically(path, [&](std::ostream& os) {

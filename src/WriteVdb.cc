@@ -7,6 +7,7 @@
 #include <nonbloppy/WriteVdb.h>
 
 #include <nonbloppy/Error.h>
+#include <nonbloppy/Version.h>
 
 #include "AtomicFile.h"
 
@@ -144,7 +145,11 @@ void writeVdb(const openvdb::GridCPtrVec& grids, const std::string& path,
         std::ofstream os;
         os.open(temp.tempPath(), std::ios_base::out | std::ios_base::binary | std::ios_base::trunc);
         errno = 0;
-        if (os) StreamArchive().writeSeekable(os, grids, fileMetadata);
+        openvdb::MetaMap metadata(fileMetadata);
+        if (!metadata["creator"]) {
+            metadata.insertMeta("creator", openvdb::StringMetadata(std::string("nonbloppy ") + version()));
+        }
+        if (os) StreamArchive().writeSeekable(os, grids, metadata);
         if (os) os.close();
         if (!os) throw FileError("cannot write " + path + ": " + std::strerror(errno ? errno : EIO));
     } catch (const Error&) {

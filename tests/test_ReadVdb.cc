@@ -3,6 +3,7 @@
 
 #include <nonbloppy/Error.h>
 #include <nonbloppy/ReadVdb.h>
+#include <nonbloppy/Version.h>
 #include <nonbloppy/WriteVdb.h>
 
 #include <gtest/gtest.h>
@@ -56,6 +57,17 @@ TEST_F(ReadVdbTest, ReadsBackEveryGridAndTheFileMetadata)
     EXPECT_EQ(contents.formatVersion, std::to_string(openvdb::OPENVDB_LIBRARY_MAJOR_VERSION) + "."
                                           + std::to_string(openvdb::OPENVDB_LIBRARY_MINOR_VERSION) + "/"
                                           + std::to_string(openvdb::OPENVDB_FILE_VERSION));
+}
+
+TEST_F(ReadVdbTest, AFileWrittenWithoutACreatorNamesNonbloppyAndItsVersion)
+{
+    openvdb::initialize();
+    openvdb::FloatGrid::Ptr density = openvdb::FloatGrid::create(0.0f);
+    density->tree().setValue(openvdb::Coord(1, 2, 3), 1.0f);
+    const std::string file = path("plain.vdb");
+    nonbloppy::writeVdb({density}, file);
+    EXPECT_EQ(readVdbFile(file).metadata.metaValue<std::string>("creator"),
+              std::string("nonbloppy ") + nonbloppy::version());
 }
 
 TEST_F(ReadVdbTest, EveryTruncationIsAOneLineErrorNamingTheFile)

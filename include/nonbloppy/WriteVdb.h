@@ -15,7 +15,8 @@
 namespace nonbloppy {
 
 /// Write @a grids to @a path (temporary file, then rename), with @a fileMetadata as the
-/// file's metadata. Grids keep their own metadata (names, class, nonbloppy parameters).
+/// file's metadata, plus "creator" = "nonbloppy VERSION" unless @a fileMetadata has one.
+/// Grids keep their own metadata (names, class, nonbloppy parameters).
 /// Written without compression timestamps, so the same grids give the same bytes.
 /// Cost: one pass over the grids' voxels to write the temporary file, then one read of it
 /// to hash its bytes into the file UUID, written in place before the rename.

@@ -18,7 +18,6 @@
 #include <nonbloppy/ReadMesh.h>
 #include <nonbloppy/ReadParticles.h>
 #include <nonbloppy/Timing.h>
-#include <nonbloppy/Version.h>
 #include <nonbloppy/WriteMesh.h>
 #include <nonbloppy/WriteVdb.h>
 
@@ -450,6 +449,22 @@ void printSummary(const MeshOptions& o, const nonbloppy::SurfaceResult& result,
 // ---------------------------------------------------------------------------------------
 // The command
 
+/// The warnings a run of the mesh command gives once, however many of its frames (meshed
+/// one after another or by concurrent frame jobs) would give them.
+struct OnceWarnings
+{
+    std::atomic<bool> facesEndInside{false};
+    std::atomic<bool> coarseFloats{false};
+    std::atomic<bool> lengthsMoved{false};
+    std::atomic<bool> meshInput{false};
+    std::atomic<bool> attributesNotRead{false};
+    OutputWarnings outputs;  ///< those of --attributes, --vdb-surface and --vdb-points
+    /// The first frame meshed and its parameters, which warnIfLengthsMove() compares the
+    /// later frames with.
+    std::mutex firstFrameMutex;
+    std::optional<std::pair<int, nonbloppy::ResolvedParameters>> firstFrame;
+};
+
 /// What meshing one frame produced: the library's result and every stage's seconds
 /// (the tool's own "read particles", "write mesh", "write vdb" included).
 struct FrameOutcome
@@ -468,7 +483,7 @@ struct MeshedFrame
 };
 
 /// Read o.input and build the surface (with its attributes); writes nothing.
-MeshedFrame meshFrameSurface(const MeshOptions& o, ProgressInterrupter& interrupter)
+MeshedFrame meshFrameSurface(const MeshOptions& o, ProgressInterrupter& interrupter, OnceWarnings& once)
 {
     MeshedFrame frame;
     {
@@ -479,8 +494,7 @@ MeshedFrame meshFrameSurface(const MeshOptions& o, ProgressInterrupter& interrup
         throw nonbloppy::FileError("no particles in " + o.input);
     }
     // Once per run, and only where the particles' attributes are used.
-    static std::atomic<bool> skippedSaid{false};
-    if (o.outputs.needParticles() && !frame.particles.skipped.empty() && !skippedSaid.exchange(true)) {
+    if (o.outputs.needParticles() && !frame.particles.skipped.empty() && !once.attributesNotRead.exchange(true)) {
         std::cerr << "nonbloppy: warning: not read from " << o.input << ": " << joinedSkipped(frame.particles)
                   << std::endl;
     }
@@ -510,7 +524,7 @@ MeshedFrame meshFrameSurface(const MeshOptions& o, ProgressInterrupter& interrup
     throwIfInterrupted();
     if (!o.outputs.attributes.empty()) {
         nonbloppy::ScopedStageTimer timer(frame.after, "interpolate attributes");
-        addSurfaceAttributes(frame.result, frame.particles, o.outputs, o.output, &interrupter);
+        addSurfaceAttributes(frame.result, frame.particles, o.outputs, o.output, once.outputs, &interrupter);
     }
     return frame;
 }
@@ -528,7 +542,7 @@ enum class OnInterrupt
 /// removed again. The files the outputs replaced are handed to @a remover once the frame
 /// has succeeded. Returns the surface and every stage's seconds.
 FrameOutcome writeFrame(const MeshOptions& o, MeshedFrame& frame, ProgressInterrupter& interrupter,
-                        BackgroundRemover& remover, OnInterrupt onInterrupt)
+                        BackgroundRemover& remover, OnceWarnings& once, OnInterrupt onInterrupt)
 {
     const bool stoppable = onInterrupt == OnInterrupt::Stop;
     OutputCleanup cleanup;
@@ -548,13 +562,10 @@ FrameOutcome writeFrame(const MeshOptions& o, MeshedFrame& frame, ProgressInterr
         if (!result.density) throw nonbloppy::Error("no density grid to write");
         StageScope stage(interrupter, frame.after, "write vdb");
         result.density->insertMeta("source_file", openvdb::StringMetadata(o.input));
-        openvdb::MetaMap fileMetadata;
-        // As convert's .vdb files (writeParticles()) say it; the file header holds OpenVDB's.
-        fileMetadata.insertMeta("creator", openvdb::StringMetadata(std::string("nonbloppy ") + nonbloppy::version()));
         openvdb::GridCPtrVec grids{result.density};
-        appendVdbGrids(grids, result, frame.particles, o.outputs, o.vdbPath, &interrupter);
+        appendVdbGrids(grids, result, frame.particles, o.outputs, o.vdbPath, once.outputs, &interrupter);
         cleanup.willWrite(o.vdbPath);
-        nonbloppy::writeVdb(grids, o.vdbPath, fileMetadata);
+        nonbloppy::writeVdb(grids, o.vdbPath);  // its "creator" is "nonbloppy VERSION", as convert's
         cleanup.written();
     }
     if (stoppable) throwIfInterrupted();
@@ -571,25 +582,12 @@ FrameOutcome writeFrame(const MeshOptions& o, MeshedFrame& frame, ProgressInterr
 /// Read o.input, build the surface, write o.output (and o.vdbPath): meshFrameSurface(), then
 /// writeFrame(), which an interrupt stops. Used for a single file; a sequence writes each
 /// frame while the next one is meshed.
-FrameOutcome meshFrame(const MeshOptions& o, ProgressInterrupter& interrupter, BackgroundRemover& remover)
+FrameOutcome meshFrame(const MeshOptions& o, ProgressInterrupter& interrupter, BackgroundRemover& remover,
+                       OnceWarnings& once)
 {
-    MeshedFrame frame = meshFrameSurface(o, interrupter);
-    return writeFrame(o, frame, interrupter, remover, OnInterrupt::Stop);
+    MeshedFrame frame = meshFrameSurface(o, interrupter, once);
+    return writeFrame(o, frame, interrupter, remover, once, OnInterrupt::Stop);
 }
-
-/// The warnings a run of the mesh command gives once, however many of its frames (meshed
-/// one after another or by concurrent frame jobs) would give them.
-struct OnceWarnings
-{
-    std::atomic<bool> facesEndInside{false};
-    std::atomic<bool> coarseFloats{false};
-    std::atomic<bool> lengthsMoved{false};
-    std::atomic<bool> meshInput{false};
-    /// The first frame meshed and its parameters, which warnIfLengthsMove() compares the
-    /// later frames with.
-    std::mutex firstFrameMutex;
-    std::optional<std::pair<int, nonbloppy::ResolvedParameters>> firstFrame;
-};
 
 /// How far a sequence's spacing estimate may move from the first frame's, as a fraction of
 /// it, before warnIfLengthsMove() says so: each derived length moves by as much, and 1% of h
@@ -915,7 +913,7 @@ int runSequence(const MeshOptions& o)
     // Writes a meshed frame, warns, and reports it; the frame's memory goes on return.
     const auto writeAndReport = [&](const MeshOptions& f, const BatchJob& job, MeshedFrame& frame,
                                     ProgressInterrupter& interrupter, ResidentSampler* sampler) {
-        const FrameOutcome outcome = writeFrame(f, frame, interrupter, remover, OnInterrupt::Finish);
+        const FrameOutcome outcome = writeFrame(f, frame, interrupter, remover, once, OnInterrupt::Finish);
         warnAboutFrame(f, outcome.result, once);
         warnIfLengthsMove(job.frame.number, outcome.result.parameters, o.maxStepOpt->count() > 0, once);
 
@@ -952,7 +950,7 @@ int runSequence(const MeshOptions& o)
             o.verbose, false, "frame " + std::to_string(job.frame.number) + ": ");
         std::shared_ptr<ResidentSampler> sampler;
         if (o.verbose) sampler = std::make_shared<ResidentSampler>();
-        auto frame = std::make_shared<MeshedFrame>(meshFrameSurface(f, *interrupter));
+        auto frame = std::make_shared<MeshedFrame>(meshFrameSurface(f, *interrupter, once));
         return std::function<FrameReport()>([&writeAndReport, f, job, interrupter, sampler, frame]() mutable {
             const FrameReport report = writeAndReport(f, job, *frame, *interrupter, sampler.get());
             frame.reset();
@@ -1005,10 +1003,10 @@ int runMesh(const MeshOptions& o)
     // Declared before the outcome, so that the replaced mesh is freed while the outcome's
     // memory is given back and the summary printed.
     BackgroundRemover remover;
+    OnceWarnings once;
     try {
-        const FrameOutcome outcome = meshFrame(o, interrupter, remover);
+        const FrameOutcome outcome = meshFrame(o, interrupter, remover, once);
         interrupter.clearLine();
-        OnceWarnings once;
         warnAboutFrame(o, outcome.result, once);
         if (sampler) {
             sampler->stop();

@@ -37,12 +37,6 @@ std::vector<std::string> splitNames(const std::string& list)
     return names;
 }
 
-std::atomic<bool> gObjWarningPrinted{false};
-std::atomic<bool> gRenameWarningPrinted{false};
-std::atomic<bool> gRoundingWarningPrinted{false};
-std::atomic<bool> gVdbRoundingWarningPrinted{false};
-std::atomic<bool> gVdbRenameWarningPrinted{false};
-
 } // namespace
 
 void addMeshOutputOptions(CLI::App* cmd, MeshOutputOptions& o, CLI::Option* vdbOption)
@@ -75,23 +69,22 @@ void requireAttributes(const nonbloppy::ParticleSet& particles, const MeshOutput
 
 void addSurfaceAttributes(nonbloppy::SurfaceResult& result, const nonbloppy::ParticleSet& particles,
                           const MeshOutputOptions& o, const std::string& meshPath,
-                          openvdb::util::NullInterrupter* interrupter)
+                          OutputWarnings& once, openvdb::util::NullInterrupter* interrupter)
 {
     if (o.attributes.empty()) return;
     const std::vector<std::string> names = splitNames(o.attributes);
     nonbloppy::interpolateAttributes(result.mesh, particles, names,
                                      result.parameters.effectiveRadius, interrupter);
     const std::string ext = lowerExtension(meshPath);
-    if (ext == ".obj" && !result.mesh.attributes.empty() && !gObjWarningPrinted.exchange(true)) {
+    if (ext == ".obj" && !result.mesh.attributes.empty() && !once.objDropsAttributes.exchange(true)) {
         std::cerr << "nonbloppy: warning: OBJ cannot store vertex attributes; write .ply or .vtk "
                      "to keep --attributes" << std::endl;
     }
-    if (!gRoundingWarningPrinted) {  // once per run: the scan is for the first frame that needs it
+    if (!once.meshRounds) {  // the scan is for the first frame that needs it
         const std::vector<std::string> rounded = nonbloppy::roundedAttributes(result.mesh, meshPath);
-        if (!rounded.empty() && !gRoundingWarningPrinted.exchange(true)) warnRounded(rounded[0], meshPath);
+        if (!rounded.empty() && !once.meshRounds.exchange(true)) warnRounded(rounded[0], meshPath);
     }
-    // Once per run: the frames of a sequence carry the same attributes.
-    if (ext != ".obj" && !result.mesh.attributes.empty() && !gRenameWarningPrinted.exchange(true)) {
+    if (ext != ".obj" && !result.mesh.attributes.empty() && !once.meshRenames.exchange(true)) {
         std::vector<std::string> original;
         for (const auto& a : result.mesh.attributes) original.push_back(a.name);
         warnRenamedAttributes(original, nonbloppy::writtenAttributeNames(result.mesh, meshPath), meshPath);
@@ -100,21 +93,21 @@ void addSurfaceAttributes(nonbloppy::SurfaceResult& result, const nonbloppy::Par
 
 void appendVdbGrids(openvdb::GridCPtrVec& grids, const nonbloppy::SurfaceResult& result,
                     const nonbloppy::ParticleSet& particles, const MeshOutputOptions& o, const std::string& vdbPath,
-                    openvdb::util::NullInterrupter* interrupter)
+                    OutputWarnings& once, openvdb::util::NullInterrupter* interrupter)
 {
     if (o.vdbSurface) {
         grids.push_back(nonbloppy::meshToLevelSet(result.mesh, result.parameters.voxelSize, 3.0f, interrupter));
     }
     if (o.vdbPoints) {
         grids.push_back(nonbloppy::makePointDataGrid(particles));
-        if (!particles.attributes.empty() && !gVdbRenameWarningPrinted.exchange(true)) {  // as convert says it
+        if (!particles.attributes.empty() && !once.vdbRenames.exchange(true)) {  // as convert says it
             std::vector<std::string> original;
             for (const auto& a : particles.attributes) original.push_back(a.name);
             warnRenamedAttributes(original, nonbloppy::writtenAttributeNames(particles, vdbPath), vdbPath);
         }
-        if (!gVdbRoundingWarningPrinted) {
+        if (!once.vdbRounds) {
             const std::vector<std::string> rounded = nonbloppy::roundedAttributes(particles, vdbPath);
-            if (!rounded.empty() && !gVdbRoundingWarningPrinted.exchange(true)) warnRounded(rounded[0], vdbPath);
+            if (!rounded.empty() && !once.vdbRounds.exchange(true)) warnRounded(rounded[0], vdbPath);
         }
     }
 }

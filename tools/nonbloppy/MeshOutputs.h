@@ -16,6 +16,7 @@
 #include <openvdb/openvdb.h>
 #include <openvdb/util/NullInterrupter.h>
 
+#include <atomic>
 #include <string>
 
 namespace nonbloppy_tool {
@@ -28,6 +29,17 @@ struct MeshOutputOptions
 
     /// True if the particles (positions and attributes) are needed after meshing.
     bool needParticles() const { return !attributes.empty() || vdbPoints; }
+};
+
+/// The warnings the extra outputs give once per run, however many frames it writes (the
+/// frames of a sequence carry the same attributes). One per run of the mesh command.
+struct OutputWarnings
+{
+    std::atomic<bool> objDropsAttributes{false};
+    std::atomic<bool> meshRounds{false};
+    std::atomic<bool> meshRenames{false};
+    std::atomic<bool> vdbRounds{false};
+    std::atomic<bool> vdbRenames{false};
 };
 
 /// Declare --attributes, --vdb-surface and --vdb-points on @a cmd (the last two need
@@ -45,19 +57,21 @@ void checkAttributeList(const MeshOutputOptions& options);
 void requireAttributes(const nonbloppy::ParticleSet& particles, const MeshOutputOptions& options);
 
 /// With --attributes, interpolate the named attributes of @a particles to the final
-/// vertices of result.mesh (see nonbloppy::interpolateAttributes). Warns once on stderr
-/// when @a meshPath is an OBJ file, which cannot store them.
+/// vertices of result.mesh (see nonbloppy::interpolateAttributes). Warns once per run (@a once)
+/// on stderr when @a meshPath is an OBJ file, which cannot store them, or stores one rounded
+/// or renamed.
 void addSurfaceAttributes(nonbloppy::SurfaceResult& result, const nonbloppy::ParticleSet& particles,
                           const MeshOutputOptions& options, const std::string& meshPath,
-                          openvdb::util::NullInterrupter* interrupter);
+                          OutputWarnings& once, openvdb::util::NullInterrupter* interrupter);
 
 /// Append to @a grids what --vdb-surface ("surface" level set at the density's voxel
-/// size) and --vdb-points ("points" PointDataGrid, warned once per run if @a vdbPath
-/// stores an attribute rounded) ask for. The level set, seconds on large
-/// frames, asks @a interrupter as it goes (nonbloppy::CancelledError on a stop).
+/// size) and --vdb-points ("points" PointDataGrid, warned once per run (@a once) if
+/// @a vdbPath stores an attribute rounded or renamed) ask for. The level set, seconds on
+/// large frames, asks @a interrupter as it goes (nonbloppy::CancelledError on a stop).
 void appendVdbGrids(openvdb::GridCPtrVec& grids, const nonbloppy::SurfaceResult& result,
                     const nonbloppy::ParticleSet& particles, const MeshOutputOptions& options,
-                    const std::string& vdbPath, openvdb::util::NullInterrupter* interrupter);
+                    const std::string& vdbPath, OutputWarnings& once,
+                    openvdb::util::NullInterrupter* interrupter);
 
 } // namespace nonbloppy_tool
 
