@@ -462,8 +462,7 @@ holdsIntegersPastDouble(const ParticleAttribute& attribute)
     for (size_t at = 0; at + 8 <= attribute.bytes.size(); at += 8) {
         uint64_t bits;
         std::memcpy(&bits, attribute.bytes.data() + at, 8);
-        const bool exact = isSigned ? int64_t(bits) >= -kExactInDouble && int64_t(bits) <= kExactInDouble
-                                    : bits <= uint64_t(kExactInDouble);
+        const bool exact = isSigned ? exactInDouble(int64_t(bits)) : bits <= uint64_t(kExactInDouble);
         if (!exact) return true;
     }
     return false;

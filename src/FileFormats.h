@@ -201,6 +201,8 @@ constexpr const char* kSplitAttributesKey = "nonbloppy_split_attributes";
 
 /// The largest magnitude up to which a double holds every integer (2^53).
 constexpr int64_t kExactInDouble = int64_t(1) << 53;
+/// True if a double holds @a value exactly: |value| <= 2^53 (past it, doubles skip integers).
+constexpr bool exactInDouble(int64_t value) { return value >= -kExactInDouble && value <= kExactInDouble; }
 
 /// Whether 64-bit integer attribute @a attribute (Int64 or UInt64; false for other types)
 /// holds a value past ±kExactInDouble, which a double rounds.

@@ -440,11 +440,10 @@ roundedAttributes(const SurfaceMesh& mesh, const std::string& path)
     const std::string ext = io_internal::requireMeshExtension(path);
     std::vector<std::string> rounded;
     if (ext != ".ply") return rounded;  // VTK has vtktypeint64; OBJ leaves attributes out
-    const auto exact = [](int64_t value) {
-        return value >= -io_internal::kExactInDouble && value <= io_internal::kExactInDouble;
-    };
     for (const MeshAttribute& a : mesh.attributes) {
-        if (a.integer && !std::all_of(a.integers.begin(), a.integers.end(), exact)) rounded.push_back(a.name);
+        if (a.integer && !std::all_of(a.integers.begin(), a.integers.end(), io_internal::exactInDouble)) {
+            rounded.push_back(a.name);
+        }
     }
     return rounded;
 }
