@@ -36,6 +36,7 @@
 #include <cmath>
 #include <cstring>
 #include <string_view>
+#include <unordered_set>
 
 namespace nonbloppy {
 namespace io_internal {
@@ -210,10 +211,9 @@ parseTable(StreamReader& in, const std::string& path)
     }
     std::vector<std::string> names;
     std::vector<int> componentCounts;
+    std::unordered_set<std::string> seen;  // a scan per column made wide headers quadratic
     for (const ColumnGroup& group : groupColumns(attributeColumns)) {
-        if (std::find(names.begin(), names.end(), group.name) != names.end()) {
-            fail(path, "duplicate column '" + printable(group.name) + "'");
-        }
+        if (!seen.insert(group.name).second) fail(path, "duplicate column '" + printable(group.name) + "'");
         for (size_t c = 0; c < group.columns.size(); ++c) {
             columns[attributeColumns[group.columns[c]].index] = {int(names.size()), int(c)};
         }
