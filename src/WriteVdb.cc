@@ -147,7 +147,7 @@ void writeVdb(const openvdb::GridCPtrVec& grids, const std::string& path,
         errno = 0;
         openvdb::MetaMap metadata(fileMetadata);
         if (!metadata["creator"]) {
-            metadata.insertMeta("creator", openvdb::StringMetadata(std::string("nonbloppy ") + version()));
+            metadata.insertMeta("creator", openvdb::StringMetadata(versionLine()));
         }
         if (os) StreamArchive().writeSeekable(os, grids, metadata);
         if (os) os.close();

@@ -59,15 +59,16 @@ TEST_F(ReadVdbTest, ReadsBackEveryGridAndTheFileMetadata)
                                           + std::to_string(openvdb::OPENVDB_FILE_VERSION));
 }
 
-TEST_F(ReadVdbTest, AFileWrittenWithoutACreatorNamesNonbloppyAndItsVersion)
+TEST_F(ReadVdbTest, AFileWrittenWithoutACreatorNamesNonbloppyAndOpenVdbWithTheirVersions)
 {
     openvdb::initialize();
     openvdb::FloatGrid::Ptr density = openvdb::FloatGrid::create(0.0f);
     density->tree().setValue(openvdb::Coord(1, 2, 3), 1.0f);
     const std::string file = path("plain.vdb");
     nonbloppy::writeVdb({density}, file);
-    EXPECT_EQ(readVdbFile(file).metadata.metaValue<std::string>("creator"),
-              std::string("nonbloppy ") + nonbloppy::version());
+    EXPECT_EQ(readVdbFile(file).metadata.metaValue<std::string>("creator"), nonbloppy::versionLine());
+    EXPECT_EQ(nonbloppy::versionLine(), std::string("nonbloppy ") + nonbloppy::version() + " (OpenVDB "
+                                            + openvdb::getLibraryVersionString() + ")");
 }
 
 TEST_F(ReadVdbTest, EveryTruncationIsAOneLineErrorNamingTheFile)

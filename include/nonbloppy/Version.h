@@ -7,6 +7,8 @@
 
 #include <nonbloppy/Export.h>
 
+#include <string>
+
 /// Major version of the headers (incompatible API changes).
 #define NONBLOPPY_VERSION_MAJOR 0
 /// Minor version of the headers (additions; ABI may change while MAJOR is 0).
@@ -21,6 +23,10 @@ namespace nonbloppy {
 /// The version of the library actually linked, "MAJOR.MINOR.PATCH"; compare with
 /// NONBLOPPY_VERSION_STRING to detect a header/library mismatch.
 NONBLOPPY_API const char* version();
+
+/// "nonbloppy MAJOR.MINOR.PATCH (OpenVDB X.Y.Z)": this library and the OpenVDB it runs
+/// with, as `nonbloppy --version` prints them and writeVdb() records them ("creator").
+NONBLOPPY_API std::string versionLine();
 
 } // namespace nonbloppy
 

@@ -15,7 +15,8 @@
 namespace nonbloppy {
 
 /// Write @a grids to @a path (temporary file, then rename), with @a fileMetadata as the
-/// file's metadata, plus "creator" = "nonbloppy VERSION" unless @a fileMetadata has one.
+/// file's metadata, plus "creator" = versionLine() ("nonbloppy 0.1.0 (OpenVDB 10.0.1)")
+/// unless @a fileMetadata has one.
 /// Grids keep their own metadata (names, class, nonbloppy parameters).
 /// Written without compression timestamps, so the same grids give the same bytes.
 /// Cost: one pass over the grids' voxels to write the temporary file, then one read of it

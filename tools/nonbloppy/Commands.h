@@ -52,9 +52,6 @@ Command setupInspectCommand(CLI::App& parent);
 /// Declare `nonbloppy convert` on @a parent.
 Command setupConvertCommand(CLI::App& parent);
 
-/// "nonbloppy 0.1.0 (OpenVDB 10.0.1)".
-std::string versionLine();
-
 /// Warn on stderr, one line per attribute, where a writer renamed one for @a path's format
 /// (@a original[i] written as @a written[i]; an empty written name is an attribute dropped,
 /// which the caller reports itself): "nonbloppy: warning: attribute 'a b' is written to

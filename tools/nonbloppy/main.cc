@@ -16,7 +16,6 @@
 #include <nonbloppy/Version.h>
 
 #include <openvdb/Exceptions.h>
-#include <openvdb/version.h>
 
 #include <algorithm>
 #include <cerrno>
@@ -38,12 +37,6 @@
 #include <unistd.h>
 
 namespace nonbloppy_tool {
-
-std::string versionLine()
-{
-    return std::string("nonbloppy ") + nonbloppy::version() + " (OpenVDB "
-           + openvdb::getLibraryVersionString() + ")";
-}
 
 namespace {
 
@@ -176,7 +169,7 @@ int run(int argc, char** argv)
     using namespace nonbloppy_tool;
 
     CLI::App app("nonbloppy: surface meshes from fluid-simulation particles", "nonbloppy");
-    app.set_version_flag("--version", versionLine(), "Print the version and exit");
+    app.set_version_flag("--version", nonbloppy::versionLine(), "Print the version and exit");
     app.require_subcommand(1, 1);
     app.footer("Run 'nonbloppy help COMMAND' or 'nonbloppy COMMAND --help' for a command's "
                "options.");
