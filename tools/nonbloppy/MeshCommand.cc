@@ -560,12 +560,17 @@ FrameOutcome writeFrame(const MeshOptions& o, MeshedFrame& frame, ProgressInterr
 
     if (!o.vdbPath.empty()) {
         if (!result.density) throw nonbloppy::Error("no density grid to write");
-        StageScope stage(interrupter, frame.after, "write vdb");
         result.density->insertMeta("source_file", openvdb::StringMetadata(o.input));
         openvdb::GridCPtrVec grids{result.density};
-        appendVdbGrids(grids, result, frame.particles, o.outputs, o.vdbPath, once.outputs, &interrupter);
+        if (o.outputs.vdbSurface || o.outputs.vdbPoints) {
+            // A stage of its own: the surface's level set takes seconds, which "write vdb"
+            // showed as if it were disk time (bug hunt).
+            StageScope stage(interrupter, frame.after, "build vdb grids");
+            appendVdbGrids(grids, result, frame.particles, o.outputs, o.vdbPath, once.outputs, &interrupter);
+        }
+        StageScope stage(interrupter, frame.after, "write vdb");
         cleanup.willWrite(o.vdbPath);
-        nonbloppy::writeVdb(grids, o.vdbPath);  // its "creator" is "nonbloppy VERSION", as convert's
+        nonbloppy::writeVdb(grids, o.vdbPath);  // its "creator" is versionLine(), as convert's
         cleanup.written();
     }
     if (stoppable) throwIfInterrupted();
