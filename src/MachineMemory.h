@@ -87,6 +87,22 @@ inline double cgroupHeadroomBytes()
     return -1.0;
 }
 
+/// @a bytes for a message, three significant digits in the largest unit that keeps the
+/// number at 1 or more: "512 kB", "131 MB", "3.35 GB", "960 GB" (a refusal under a small
+/// ulimit said "0.00131 GB").
+inline std::string formatBytes(double bytes)
+{
+    static const char* const kUnits[] = {"bytes", "kB", "MB", "GB", "TB", "PB"};
+    int unit = 0;
+    while (unit < 5 && bytes >= 999.5) {
+        bytes /= 1000.0;
+        ++unit;
+    }
+    char text[48];
+    std::snprintf(text, sizeof(text), "%.3g %s", bytes, kUnits[unit]);
+    return text;
+}
+
 /// The memory this process can still take, in bytes: the machine's physical memory, or less
 /// where ulimit -v or -d or the memory cgroup says so, minus what is held now, measured as
 /// each limit counts it (its resident set against the

@@ -60,8 +60,8 @@ void requireBandFitsInMemory(double area, double voxelSize, float halfWidth)
         std::ostringstream msg;
         msg.precision(2);
         msg << "the level set's narrow band would hold about " << bandVoxels << " voxels, about "
-            << needed / 1e9 << " GB at its peak, more than the " << available / 1e9
-            << " GB this process can still take: use a voxel size larger than " << voxelSize << " or a half width below "
+            << machine_memory_internal::formatBytes(needed) << " at its peak, more than the "
+            << machine_memory_internal::formatBytes(available) << " this process can still take: use a voxel size larger than " << voxelSize << " or a half width below "
             << halfWidth;
         throw ParameterError(msg.str());
     }

@@ -46,7 +46,7 @@ constexpr size_t kLeavesPerPoll = 8;
 /// separately allocated 512 values, and malloc's header for each.
 constexpr double kBytesPerDensityLeaf = double(sizeof(FloatLeaf)) + double(FloatLeaf::SIZE * sizeof(float)) + 32.0;
 
-/// @throw ParameterError("... would take 3.6 to 7.3 GB, more than the 2.7 GB this process
+/// @throw ParameterError("... would take 3.6 GB to 7.3 GB, more than the 2.7 GB this process
 ///        can still take: ...") if even @a fewestBytes of @a what ("the density grid (up
 ///        to N leaves of 8^3 voxels)") exceed what the process can still allocate
 ///        (memoryHeadroomBytes()). A voxel size far below the spacing made the process
@@ -56,13 +56,14 @@ void requireMemoryFor(double fewestBytes, double mostBytes, const std::string& w
 {
     const double headroom = machine_memory_internal::memoryHeadroomBytes();
     if (!(headroom >= 0.0) || !(fewestBytes > headroom)) return;
+    using machine_memory_internal::formatBytes;
     std::ostringstream msg;
     msg.precision(3);
     msg << what << " of these particles at --voxel-size " << voxelSize << " and --radius " << effectiveRadius
-        << " would take " << fewestBytes / 1e9;
-    if (mostBytes > fewestBytes) msg << " to " << mostBytes / 1e9;
-    msg << " GB, more than the " << headroom / 1e9
-        << " GB this process can still take: give a larger --voxel-size or a smaller --radius";
+        << " would take " << formatBytes(fewestBytes);
+    if (mostBytes > fewestBytes) msg << " to " << formatBytes(mostBytes);
+    msg << ", more than the " << formatBytes(headroom)
+        << " this process can still take: give a larger --voxel-size or a smaller --radius";
     throw ParameterError(msg.str());
 }
 

@@ -99,7 +99,7 @@ TEST(MeshToLevelSet, VerticesAndBandsItCannotHoldAreRefusedBeforeAnyGridIsMade)
     sail.triangles = {{0, 1, 2}};
     const std::string message =
         nonbloppy_test::messageOf<ParameterError>([&] { nonbloppy::meshToLevelSet(sail, 0.01); });
-    EXPECT_EQ(message.rfind("the level set's narrow band would hold about 3e+10 voxels, about 9.6e+02 GB at its "
+    EXPECT_EQ(message.rfind("the level set's narrow band would hold about 3e+10 voxels, about 960 GB at its "
                             "peak, more than the ", 0), 0u) << message;
     const std::string advice = " GB this process can still take: use a voxel size larger than 0.01 or a half width "
                                "below 3";

@@ -155,13 +155,17 @@ TEST_F(CliTest, ADensityGridLargerThanTheMemoryIsRefusedBeforeItIsAllocated)
     // thread stacks, the particles and their index): below 1.54 GB.
     const std::string message = readText(err);
     const std::string head = "nonbloppy: " + input + ": the density grid (up to 5088448 leaves of 8^3 voxels) of "
-                             "these particles at --voxel-size 0.0325 and --radius 1 would take 5.57 to 11.1 GB, more "
+                             "these particles at --voxel-size 0.0325 and --radius 1 would take 5.57 GB to 11.1 GB, more "
                              "than the ";
-    const std::string tail = " GB this process can still take: give a larger --voxel-size or a smaller --radius\n";
+    const std::string tail = " this process can still take: give a larger --voxel-size or a smaller --radius\n";
     ASSERT_EQ(message.rfind(head, 0), 0u) << message;
     ASSERT_GT(message.size(), head.size() + tail.size());
     EXPECT_EQ(message.substr(message.size() - tail.size()), tail) << message;
-    const double headroom = std::stod(message.substr(head.size()));
+    size_t digits = 0;
+    double headroom = std::stod(message.substr(head.size()), &digits);  // in GB, or MB below 1 GB
+    const std::string unit = message.substr(head.size() + digits, 3);
+    if (unit == " MB") headroom /= 1000.0;
+    else EXPECT_EQ(unit, " GB") << message;
     EXPECT_GT(headroom, 0.5);
     EXPECT_LT(headroom, 1.54);
     EXPECT_TRUE(listDir(dir() + "/out").empty());

@@ -55,7 +55,7 @@ struct DensitySettings
 ///        (and their internal nodes) exceed what the process can still take (the machine's
 ///        memory, ulimit -v or -d, or its cgroup's memory.max, less what it holds: "the
 ///        density grid (up to N leaves of 8^3 voxels) of these particles at --voxel-size h
-///        and --radius r would take A to B GB, more than the C GB this process can still
+///        and --radius r would take A GB to B GB, more than the C GB this process can still
 ///        take: ..."); CancelledError if @a interrupter says so.
 NONBLOPPY_API openvdb::FloatGrid::Ptr rasterizeDensity(const ParticleIndex& particles,
                                          const DensitySettings& settings,
