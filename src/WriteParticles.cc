@@ -324,6 +324,12 @@ appendNumber(std::string& out, const ParticleAttribute& a, size_t n, int c)
     default: result = std::to_chars(buffer, buffer + 64, int64_t(a.asDouble(n, c))); break;
     }
     out.append(buffer, result.ptr);
+    // A whole float written "300" read back as an integer attribute, which mesh --attributes
+    // carries as the nearest particle's value instead of a mean (bug hunt): "300.0".
+    const bool isFloat = a.type == ScalarType::Float32 || a.type == ScalarType::Float64;
+    if (isFloat && std::all_of(buffer, result.ptr, [](char ch) { return ch == '-' || (ch >= '0' && ch <= '9'); })) {
+        out += ".0";
+    }
 }
 
 void

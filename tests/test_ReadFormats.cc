@@ -646,6 +646,25 @@ TEST_F(ReadFormatsTest, VdbQuaternionsMatricesAndSplitVectorsAreAttributesOfThei
     EXPECT_EQ(attribute(particles, "xform").type, ScalarType::Float32);
 }
 
+TEST_F(ReadFormatsTest, WholeFloatsStayFloatsThroughCsv)
+{
+    // A float 300 went out as "300" and came back as an integer attribute, which mesh
+    // --attributes carries as the nearest particle's value instead of a mean (bug hunt).
+    ParticleSet particles;
+    particles.positions = {openvdb::Vec3f(0.0f), openvdb::Vec3f(1.0f, 2.0f, 3.0f)};
+    particles.attributes.push_back(ParticleAttribute::of("temperature", 1, std::vector<float>{300.0f, 301.0f}));
+    particles.attributes.push_back(ParticleAttribute::of("level", 1, std::vector<double>{-0.0, 1e22}));
+    particles.attributes.push_back(ParticleAttribute::of("id", 1, std::vector<int32_t>{7, 8}));
+    nonbloppy::writeParticles(particles, path("whole.csv"));
+    EXPECT_EQ(readBytes(path("whole.csv")), "x,y,z,temperature,level,id\n0,0,0,300.0,-0.0,7\n1,2,3,301.0,1e+22,8\n");
+    const ParticleSet back = readParticles(path("whole.csv"));
+    EXPECT_FALSE(nonbloppy::isIntegerType(attribute(back, "temperature").type));
+    EXPECT_EQ(attribute(back, "temperature").asDouble(1), 301.0);
+    EXPECT_FALSE(nonbloppy::isIntegerType(attribute(back, "level").type));
+    EXPECT_EQ(attribute(back, "level").asDouble(1), 1e22);
+    EXPECT_TRUE(nonbloppy::isIntegerType(attribute(back, "id").type));
+}
+
 TEST_F(ReadFormatsTest, ScalarsNamedLikeComponentsStayScalarsInCsvAndVdb)
 {
     // a_0, a_1 of their own came back from .vdb and .csv as one 2-component "a", and a
