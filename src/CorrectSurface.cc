@@ -364,6 +364,11 @@ size_t surface_stages_internal::repairFoldsUnchecked(SurfaceMesh& mesh, const op
 
 void offsetSurface(SurfaceMesh& mesh, double distance)
 {
+    if (!std::isfinite(distance)) {  // NaN made every vertex NaN
+        std::ostringstream msg;
+        msg << "offset distance must be finite, got " << distance;
+        throw ParameterError(msg.str());
+    }
     requireNormals(mesh);
     const float d = float(distance);
     tbb::parallel_for(tbb::blocked_range<size_t>(0, mesh.points.size()),

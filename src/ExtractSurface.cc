@@ -43,12 +43,20 @@ namespace {
 
 using FloatLeaf = openvdb::FloatTree::LeafNodeType;
 
-/// @throw ParameterError unless @a threshold is finite and @a adaptivity lies in [0,1].
-void checkExtractParameters(double threshold, double adaptivity)
+/// @throw ParameterError unless @a threshold is finite and above @a background (the grid's
+/// value outside its active voxels, which must count as outside: at or below it the surface
+/// was empty, without a word) and @a adaptivity lies in [0,1].
+void checkExtractParameters(double threshold, double adaptivity, double background)
 {
     if (!std::isfinite(threshold)) {
         std::ostringstream msg;
         msg << "--threshold must be finite, got " << threshold;
+        throw ParameterError(msg.str());
+    }
+    if (!(threshold > background)) {
+        std::ostringstream msg;
+        msg << "--threshold must lie above the density grid's background value " << background
+            << " (its value outside the fluid), got " << threshold;
         throw ParameterError(msg.str());
     }
     if (!(adaptivity >= 0.0 && adaptivity <= 1.0)) {
@@ -89,7 +97,7 @@ void orientOutwards(SurfaceMesh& mesh)
 template<typename GridT>
 void extractInto(const GridT& density, double threshold, double adaptivity, SurfaceMesh& mesh)
 {
-    checkExtractParameters(threshold, adaptivity);
+    checkExtractParameters(threshold, adaptivity, double(density.background()));
     openvdb::tools::volumeToMesh(density, mesh.points, mesh.triangles, mesh.quads, threshold, adaptivity);
     orientOutwards(mesh);
     mesh.normals.clear();
@@ -805,6 +813,7 @@ bool extractByRegionImpl(const openvdb::FloatGrid& density, double threshold, Su
 size_t tileDeepInterior(openvdb::FloatGrid& density, double threshold)
 {
     requireDensityClass(density, "tileDeepInterior");
+    checkExtractParameters(threshold, 0.0, double(density.background()));
     using LeafT = openvdb::FloatTree::LeafNodeType;
     openvdb::FloatTree& tree = density.tree();
     openvdb::tree::LeafManager<openvdb::FloatTree> leaves(tree);
@@ -883,7 +892,7 @@ void extractByRegion(const openvdb::FloatGrid& density, double threshold, Surfac
                      openvdb::util::NullInterrupter* interrupter, size_t leavesPerRegion,
                      int minLayersPerRegion, openvdb::FloatTree* release)
 {
-    checkExtractParameters(threshold, 0.0);
+    checkExtractParameters(threshold, 0.0, double(density.background()));
     cancellation_internal::CancelPoll poll(interrupter, "extract surface");
     poll.throwIfStopped();
     if (!extractByRegionImpl(density, threshold, mesh, poll, std::max<size_t>(leavesPerRegion, 1),

@@ -1,12 +1,18 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "TestUtil.h"
 
+#include <nonbloppy/ComputeNormals.h>
+#include <nonbloppy/CorrectSurface.h>
 #include <nonbloppy/Error.h>
 #include <nonbloppy/ExtractSurface.h>
 #include <nonbloppy/ParticleIndex.h>
 #include <nonbloppy/RasterizeDensity.h>
 
 #include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <sstream>
 
 using namespace nonbloppy;
 
@@ -91,7 +97,37 @@ TEST(ExtractSurface, RefusesALevelSetWhichWouldComeOutInsideOut)
     wide->setGridClass(openvdb::GRID_LEVEL_SET);
     EXPECT_EQ(nonbloppy_test::messageOf<ParameterError>([&] { extractSurface(*wide, 0.0); }),
               "extractSurface " + expected);
-    // The same values classed as anything else are meshed: the class is the caller's statement.
+    // The same values classed as anything else are refused for their background: outside the
+    // active voxels the grid holds 3, above the threshold, which is inside.
     sphere->setGridClass(openvdb::GRID_UNKNOWN);
-    EXPECT_NO_THROW(extractSurface(*sphere, 0.0));
+    EXPECT_EQ(nonbloppy_test::messageOf<ParameterError>([&] { extractSurface(*sphere, 0.0); }),
+              "--threshold must lie above the density grid's background value 3 (its value outside the fluid), got 0");
+}
+
+TEST(ExtractSurface, AThresholdAtOrBelowTheBackgroundIsRefused)
+{
+    // r_0 <= 0 returned an empty mesh without a word (bug hunt), and tileDeepInterior() and
+    // offsetSurface() took NaN (the latter made every vertex NaN).
+    const ParticleIndex index = ParticleIndex::build({kCentre}, 0.5);
+    DensitySettings settings;
+    settings.effectiveRadius = 1.0;
+    settings.voxelSize = 0.1;
+    const openvdb::FloatGrid::Ptr grid = rasterizeDensity(index, settings);
+    for (const double threshold : {0.0, -1.0}) {
+        std::ostringstream expected;
+        expected << "--threshold must lie above the density grid's background value 0 (its value outside the "
+                    "fluid), got " << threshold;
+        EXPECT_EQ(nonbloppy_test::messageOf<ParameterError>([&] { extractSurface(*grid, threshold); }), expected.str());
+        EXPECT_EQ(nonbloppy_test::messageOf<ParameterError>([&] { tileDeepInterior(*grid, threshold); }), expected.str());
+    }
+    EXPECT_EQ(nonbloppy_test::messageOf<ParameterError>([&] { tileDeepInterior(*grid, std::nan("")); }),
+              "--threshold must be finite, got nan");
+    SurfaceMesh mesh = extractSurface(*grid, 1.0);
+    EXPECT_GT(mesh.points.size(), 10u);
+    computeNormals(mesh);
+    EXPECT_EQ(nonbloppy_test::messageOf<ParameterError>([&] { offsetSurface(mesh, std::nan("")); }),
+              "offset distance must be finite, got nan");
+    EXPECT_EQ(nonbloppy_test::messageOf<ParameterError>([&] {
+                  offsetSurface(mesh, std::numeric_limits<double>::infinity());
+              }), "offset distance must be finite, got inf");
 }

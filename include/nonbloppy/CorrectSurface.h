@@ -88,7 +88,8 @@ NONBLOPPY_API size_t repairFolds(SurfaceMesh& mesh, const std::vector<openvdb::V
 
 /// Move every vertex by @a distance (world units, > 0 outwards) along its unit normal, which
 /// must have been computed (computeNormals()); vertices with a zero normal stay put.
-/// @throw ParameterError if mesh.normals and mesh.points differ in size.
+/// @throw ParameterError if @a distance is not finite ("offset distance must be finite, got
+///        nan") or mesh.normals and mesh.points differ in size.
 NONBLOPPY_API void offsetSurface(SurfaceMesh& mesh, double distance);
 
 /// How preserveVolume() spreads its offset over the surface.

@@ -29,8 +29,10 @@ namespace nonbloppy {
 /// their own density grids slab by slab, asking the interrupter in between; the result has
 /// the same vertices and polygons as this function's, in another order.
 /// Thread-safety: reentrant; the grid is only read.
-/// @throw ParameterError if adaptivity lies outside [0,1], threshold is not finite or the
-///        grid is classed as a level set (GRID_LEVEL_SET: smaller values inside).
+/// @throw ParameterError if adaptivity lies outside [0,1], threshold is not finite or not
+///        above the grid's background value (0 for rasterizeDensity()'s: "--threshold must lie
+///        above the density grid's background value 0 (its value outside the fluid), got 0"),
+///        or the grid is classed as a level set (GRID_LEVEL_SET: smaller values inside).
 NONBLOPPY_API SurfaceMesh extractSurface(const openvdb::FloatGrid& density, double threshold,
                            double adaptivity = 0.0);
 /// The same for a double-precision density a caller computed or edited; parameters, cost,
@@ -45,7 +47,8 @@ NONBLOPPY_API SurfaceMesh extractSurface(const openvdb::DoubleGrid& density, dou
 /// scanning, and storing, fewer voxels. The grid's values inside are no longer exact.
 /// Cost: O(leaves · 512) to find leaf minima, parallel. Returns the number of leaves replaced.
 /// Thread-safety: not for the same grid concurrently (it is modified).
-/// @throw ParameterError if the grid is classed as a level set, as extractSurface().
+/// @throw ParameterError if the grid is classed as a level set or @a threshold is not finite
+///        or not above the grid's background value, as extractSurface().
 NONBLOPPY_API size_t tileDeepInterior(openvdb::FloatGrid& density, double threshold);
 
 } // namespace nonbloppy
