@@ -287,12 +287,7 @@ double cancellation_internal::calibrateRelaxedThreshold(double effectiveRadiusOv
     if (iterations < 0) {
         throw ParameterError("--iterations must be >= 0, got " + std::to_string(iterations));
     }
-    if (!(maxStepOverSpacing >= 0.0) || !std::isfinite(maxStepOverSpacing)) {
-        std::ostringstream msg;
-        msg << "--max-step must be >= 0, got " << maxStepOverSpacing << " spacings";
-        throw ParameterError(msg.str());
-    }
-    const double maxStep = maxStepOverSpacing;
+    const double maxStep = parameter_checks_internal::stepCap(maxStepOverSpacing, " spacings");
     const double blobThreshold = cancellation_internal::calibrateThreshold(ratio, poll);  // checks the ratio
     if (iterations == 0 || blend == 0.0) return blobThreshold;
 

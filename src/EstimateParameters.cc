@@ -409,10 +409,7 @@ void checkParameters(const SurfaceParameters& params)
         throw ParameterError("method must be Paper or Faithful, got " + std::to_string(int(params.method)));
     }
     if (params.volumeOffset) parameter_checks_internal::requireVolumeOffset(*params.volumeOffset);
-    if (params.method == Method::Faithful && params.maxStep &&
-        (!(*params.maxStep >= 0.0) || !std::isfinite(*params.maxStep))) {
-        throw ParameterError("--max-step must be >= 0, got " + formatNumber(*params.maxStep));
-    }
+    if (params.method == Method::Faithful && params.maxStep) parameter_checks_internal::stepCap(*params.maxStep);
     // The limits between lengths, where the lengths are given; resolveParameters() checks
     // them again once the others are derived.
     requireLengthLimits(params.effectiveRadius, params.voxelSize);
@@ -474,7 +471,8 @@ ResolvedParameters resolveParametersWith(const SurfaceParameters& params, const 
     out.method = params.method;
     const bool faithful = params.method == Method::Faithful;
     if (faithful) {
-        out.maxStep = params.maxStep ? *params.maxStep : kDefaultMaxStepOverSpacing * out.spacing;
+        out.maxStep = params.maxStep ? parameter_checks_internal::stepCap(*params.maxStep)
+                                     : kDefaultMaxStepOverSpacing * out.spacing;
     }
     bool calibratedForRelaxedSurface = false;
     if (params.threshold) out.threshold = *params.threshold;

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 /// @file ParameterChecks.h
 /// @brief One wording, across the library, for a length that must be positive and finite,
-///        and for an enumerator out of range.
+///        a step cap, and an enumerator out of range.
 #pragma once
 
 #include <nonbloppy/CorrectSurface.h>
@@ -33,6 +33,19 @@ inline void requireVolumeOffset(VolumeOffset offset)
 {
     if (offset == VolumeOffset::Uniform || offset == VolumeOffset::Convex) return;
     throw ParameterError("volume offset must be Uniform or Convex, got " + std::to_string(int(offset)));
+}
+
+/// @a maxStep as the relaxation takes it: +inf, a natural way to say "no cap", is 0 (the
+/// uncapped step); it was refused as "--max-step must be >= 0, got inf" (bug hunt).
+/// @throw ParameterError("--max-step must be >= 0 (0 or inf: no cap), got -1" followed by
+///        @a unit, e.g. " spacings") if it is negative or NaN.
+inline double stepCap(double maxStep, const char* unit = "")
+{
+    if (maxStep == HUGE_VAL) return 0.0;
+    if (maxStep >= 0.0) return maxStep;
+    std::ostringstream msg;
+    msg << "--max-step must be >= 0 (0 or inf: no cap), got " << maxStep << unit;
+    throw ParameterError(msg.str());
 }
 
 } // namespace parameter_checks_internal

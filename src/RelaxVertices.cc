@@ -487,10 +487,7 @@ void instruction_set_internal::relaxVertices(SurfaceMesh& mesh, const ParticleIn
         msg << "--iterations must be >= 0, got " << settings.iterations;
         throw ParameterError(msg.str());
     }
-    if (!(settings.maxStep >= 0.0) || !std::isfinite(settings.maxStep)) {
-        msg << "--max-step must be >= 0, got " << settings.maxStep;
-        throw ParameterError(msg.str());
-    }
+    const double maxStep = parameter_checks_internal::stepCap(settings.maxStep);
     particle_index_internal::requireCellsPerRadius(particles, settings.effectiveRadius);
     if (settings.iterations == 0 || settings.blend == 0.0 || mesh.points.empty()) return;
 
@@ -506,7 +503,7 @@ void instruction_set_internal::relaxVertices(SurfaceMesh& mesh, const ParticleIn
     std::atomic<size_t> groupsDone{0};
     tbb::parallel_for(tbb::blocked_range<size_t>(0, groupStart.size() - 1, 64),
         RelaxGroupsOp{particles, order, groupStart, mesh.points, settings.iterations,
-                      float(settings.effectiveRadius), float(settings.blend), float(settings.maxStep), poll,
+                      float(settings.effectiveRadius), float(settings.blend), float(maxStep), poll,
                       groupsDone, avx2});
     poll.throwIfStopped();
 }

@@ -326,6 +326,21 @@ TEST(EstimateParameters, ResolveReportsWhatWasGivenAndChecksRanges)
     }
 }
 
+TEST(EstimateParameters, AnInfiniteStepCapResolvesToNoCap)
+{
+    const auto ball = latticeParticles(0.05, 0.3, [](const openvdb::Vec3d& x) { return x.length() < 0.25; });
+    SurfaceParameters params;
+    params.maxStep = std::numeric_limits<double>::infinity();
+    const ResolvedParameters infinite = resolveParameters(params, ball);
+    params.maxStep = 0.0;
+    const ResolvedParameters none = resolveParameters(params, ball);
+    EXPECT_EQ(infinite.maxStep, 0.0);
+    EXPECT_EQ(infinite.threshold, none.threshold);
+    params.maxStep = -0.5;
+    EXPECT_EQ(nonbloppy_test::messageOf<ParameterError>([&] { resolveParameters(params, ball); }),
+              "--max-step must be >= 0 (0 or inf: no cap), got -0.5");
+}
+
 TEST(EstimateParameters, LengthsDerivedFromTheEstimateAreNamedAsSuch)
 {
     // Positions in metres of a fluid with 1 µm spacing: the voxel size s/2 is below OpenVDB's

@@ -206,7 +206,7 @@ TEST(Fidelity, RelaxedThresholdTakesTheStepCapIntoAccount)
         calibrateRelaxedThreshold(2.0, 0.3, 2, nullptr, -1.0);
         ADD_FAILURE() << "no exception";
     } catch (const ParameterError& error) {
-        EXPECT_STREQ(error.what(), "--max-step must be >= 0, got -1 spacings");
+        EXPECT_STREQ(error.what(), "--max-step must be >= 0 (0 or inf: no cap), got -1 spacings");
     }
 }
 

@@ -290,6 +290,22 @@ TEST(RelaxVertices, RejectsBadSettings)
     expectMessage(noRadius, "--radius must be > 0, got 0");
     noRadius.effectiveRadius = -std::numeric_limits<double>::infinity();
     expectMessage(noRadius, "--radius must be finite, got -inf");
+    RelaxSettings badCap = relaxSettings(0.3, 2);
+    badCap.maxStep = -1.0;
+    expectMessage(badCap, "--max-step must be >= 0 (0 or inf: no cap), got -1");
+    badCap.maxStep = std::nan("");
+    expectMessage(badCap, "--max-step must be >= 0 (0 or inf: no cap), got nan");
+}
+
+TEST(RelaxVertices, AnInfiniteStepCapIsNoCap)
+{
+    // It was refused as "--max-step must be >= 0, got inf" (bug hunt).
+    OneParticle uncapped, infinite;
+    RelaxSettings settings = relaxSettings(0.5, 2);
+    relaxVertices(uncapped.mesh, uncapped.index, settings);
+    settings.maxStep = std::numeric_limits<double>::infinity();
+    relaxVertices(infinite.mesh, infinite.index, settings);
+    EXPECT_EQ(infinite.mesh.points, uncapped.mesh.points);
 }
 
 TEST(RelaxVertices, VerticesThatAreNotFiniteStayPutAndTheOthersRelaxAsWithoutThem)

@@ -129,7 +129,7 @@ struct SurfaceParameters
     bool keepDensity = true;
     Method method = Method::Faithful;       ///< Paper: the plain method; see Method
     /// Faithful only: cap on how far one relaxation step moves a vertex, world units
-    /// (RelaxSettings::maxStep), ≥ 0; default kDefaultMaxStepOverSpacing·s, 0 for no cap
+    /// (RelaxSettings::maxStep), ≥ 0; default kDefaultMaxStepOverSpacing·s, 0 or +inf for no cap
     /// (also when every length was given and s is unknown).
     std::optional<double> maxStep;
     /// Faithful only: offset the relaxed surface along its normals so that it encloses N·s³

@@ -21,7 +21,8 @@ struct RelaxSettings
     double blend = 0.3;            ///< c in [0,1]: 0 leaves vertices alone, 1 jumps to the mean
     int iterations = 2;            ///< t ≥ 0
     /// Cap on how far one iteration may move a vertex, world units: a longer step keeps its
-    /// direction and is shortened to maxStep. 0 (the default) is the paper's uncapped step.
+    /// direction and is shortened to maxStep. 0 (the default) or +inf is the paper's
+    /// uncapped step.
     /// Guards against spikes where a vertex sees only a few particles.
     double maxStep = 0.0;
 };
