@@ -444,6 +444,19 @@ integerValue(const unsigned char* p, ScalarType type, int64_t& value)
 }
 
 void
+requireCountableValues(const ParticleAttribute& attribute, const std::string& suffix)
+{
+    if (attribute.components < 1) {
+        throw ParameterError("attribute '" + attribute.name + "' has " + std::to_string(attribute.components) +
+                             " components, at least 1 needed" + suffix);
+    }
+    if (scalarSize(attribute.type) == 0) {
+        throw ParameterError("attribute '" + attribute.name + "' has the unknown scalar type " +
+                             std::to_string(int(attribute.type)) + suffix);
+    }
+}
+
+void
 requireInt64Values(const ParticleAttribute& attribute, const char* holder)
 {
     if (attribute.type != ScalarType::UInt64) return;

@@ -189,6 +189,11 @@ const char* plyTypeName(ScalarType type);
 /// The legacy VTK data type name of @a type ("float", "unsigned_int", "vtktypeint64", ...).
 const char* vtkTypeName(ScalarType type);
 
+/// @throw ParameterError("attribute 'id' has -1 components, at least 1 needed" or "attribute
+///        'id' has the unknown scalar type 17", then @a suffix) for an attribute whose values
+///        cannot be counted; a caller's struct gave "has 0 values for 2000 particles".
+void requireCountableValues(const ParticleAttribute& attribute, const std::string& suffix = "");
+
 /// @throw ParameterError("attribute 'h' holds 18446744073709551615, above
 ///        9223372036854775807, the largest integer @a holder") if @a attribute is UInt64
 ///        and holds a value no int64 can (@a holder: "a .vdb stores", "a mesh attribute holds").

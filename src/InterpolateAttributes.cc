@@ -130,6 +130,7 @@ checkAttributes(const ParticleSet& particles, const std::vector<std::string>& na
     std::vector<const ParticleAttribute*> attributes;
     for (const std::string& name : resolveAttributeNames(particles, names)) {
         const ParticleAttribute& attribute = *particles.findAttribute(name);
+        io_internal::requireCountableValues(attribute);
         if (attribute.size() != particles.size()) {
             throw ParameterError("attribute '" + attribute.name + "' has " +
                                  std::to_string(attribute.size()) + " values for " +

@@ -110,10 +110,7 @@ void
 requireSizes(const ParticleSet& particles, const std::string& suffix)
 {
     for (const ParticleAttribute& a : particles.attributes) {
-        if (a.components < 1) {
-            throw ParameterError("attribute '" + a.name + "' has " + std::to_string(a.components) +
-                                 " components, at least 1 needed" + suffix);
-        }
+        io_internal::requireCountableValues(a, suffix);
         if (a.size() != particles.size()
             || a.bytes.size() != particles.size() * size_t(a.components) * scalarSize(a.type)) {
             throw ParameterError("attribute '" + a.name + "' does not hold one value per particle" + suffix);

@@ -236,6 +236,15 @@ TEST(InterpolateAttributes, NamesAndErrors)
     fx.particles.attributes.back() = ParticleAttribute::of("h", 1, hashes);
     interpolateAttributes(fx.mesh, fx.particles, {"h"}, fx.radius);
     EXPECT_EQ(fx.mesh.attributes.back().integers.at(0), std::numeric_limits<int64_t>::max());
+
+    // A caller's attribute of no countable shape was "has 0 values for N particles".
+    fx.particles.attributes.back().components = -1;
+    EXPECT_EQ(nonbloppy_test::messageOf<ParameterError>([&] { interpolateAttributes(fx.mesh, fx.particles, {"h"}, fx.radius); }),
+              "attribute 'h' has -1 components, at least 1 needed");
+    fx.particles.attributes.back().components = 1;
+    fx.particles.attributes.back().type = ScalarType(17);
+    EXPECT_EQ(nonbloppy_test::messageOf<ParameterError>([&] { interpolateAttributes(fx.mesh, fx.particles, {"h"}, fx.radius); }),
+              "attribute 'h' has the unknown scalar type 17");
 }
 
 /// Counts start() and end() calls; says stop from the start of the stage when @a stop.
