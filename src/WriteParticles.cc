@@ -22,6 +22,7 @@
 #pragma GCC visibility pop
 
 #include <algorithm>
+#include <cmath>
 #include <cctype>
 #include <charconv>
 #include <cstdint>
@@ -30,6 +31,8 @@
 #include <limits>
 #include <ostream>
 #include <set>
+#include <sstream>
+#include <string>
 #include <type_traits>
 
 namespace nonbloppy {
@@ -434,12 +437,24 @@ pointDataGridOfFinitePositions(const ParticleSet& particles, double voxelSize)
     openvdb::initialize();
     std::vector<openvdb::Vec3R> positions(particles.positions.begin(), particles.positions.end());
     const openvdb::points::PointAttributeVector<openvdb::Vec3R> wrapper(positions);
+    if (std::isnan(voxelSize)) throw ParameterError("--voxel-size must be finite, got nan");  // it picked one
     if (!(voxelSize > 0.0)) {
         voxelSize = positions.size() > 1 ? double(openvdb::points::computeVoxelSize(wrapper, 8)) : 1.0;
     } else {
         // OpenVDB's own message for these is an ArithmeticError, not a nonbloppy::Error.
         if (!std::isfinite(voxelSize)) throw ParameterError("--voxel-size must be finite, got inf");
         openvdb_scale_internal::requireOpenVdbScale(voxelSize, kMinCellSize, "--voxel-size");
+    }
+    // Voxel coordinates are 32-bit: past them particles far apart shared voxel -2^31 (bug hunt).
+    double largest = 0.0;
+    for (const openvdb::Vec3R& p : positions) {
+        for (int axis = 0; axis < 3; ++axis) largest = std::max(largest, std::abs(p[axis]));
+    }
+    if (largest / voxelSize > openvdb_scale_internal::kMaxIndexCoordinate) {
+        std::ostringstream msg;
+        msg << "particle coordinates up to " << largest << " are too far from the origin for a voxel size of "
+            << voxelSize << " (32-bit index space)";
+        throw ParameterError(msg.str());
     }
     const auto transform = openvdb::math::Transform::createLinearTransform(voxelSize);
     const auto index = openvdb::tools::createPointIndexGrid<PointIndexGrid>(wrapper, *transform);

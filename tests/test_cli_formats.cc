@@ -786,3 +786,17 @@ TEST_F(CliFormatsTest, AttributesOfTheWrongShapeAreNamedAndNothingIsWritten)
     EXPECT_EQ(nonbloppy_test::messageOf<nonbloppy::ParameterError>([&] { nonbloppy::makePointDataGrid(particles); }),
               "attribute 'speed' does not hold one value per particle");
 }
+
+TEST_F(CliFormatsTest, APointsGridRefusesVoxelSizesThatWouldLoseThePositions)
+{
+    // 0.001 put the particles at +1e9 and -3e7 both in voxel -2^31; NaN picked a size silently.
+    ParticleSet particles;
+    particles.positions = {{0.0f, 0.0f, 0.0f}, {1e9f, 0.0f, 0.0f}, {-3e7f, 2.0f, 5.0f}};
+    EXPECT_EQ(nonbloppy_test::messageOf<nonbloppy::ParameterError>([&] { nonbloppy::makePointDataGrid(particles, 0.001); }),
+              "particle coordinates up to 1e+09 are too far from the origin for a voxel size of 0.001 (32-bit index space)");
+    EXPECT_EQ(nonbloppy_test::messageOf<nonbloppy::ParameterError>([&] { nonbloppy::makePointDataGrid(particles, std::nan("")); }),
+              "--voxel-size must be finite, got nan");
+    const auto grid = openvdb::gridPtrCast<openvdb::points::PointDataGrid>(nonbloppy::makePointDataGrid(particles, 10.0));
+    ASSERT_TRUE(grid);
+    EXPECT_EQ(openvdb::points::pointCount(grid->tree()), 3u);
+}

@@ -88,7 +88,11 @@ NONBLOPPY_API void requireParticleOutputFile(const std::string& path);
 /// "name_<c>"). The grid
 /// holds the particles in voxel order: readParticles() gives them back in that order.
 /// @a voxelSize ≤ 0 picks one with about 8 points per voxel (points::computeVoxelSize).
-/// @throw ParameterError for an infinite @a voxelSize or one below kMinCellSize, a uint64
+/// A @a voxelSize far above the particles' extent keeps their positions to about
+/// voxelSize·6e-8 only (OpenVDB stores them as float offsets within their voxel).
+/// @throw ParameterError for a NaN or infinite @a voxelSize or one below kMinCellSize, one
+///        that puts a particle past 32-bit voxel coordinates ("particle coordinates up to
+///        1e+09 are too far from the origin for a voxel size of 0.001 (32-bit index space)"), a uint64
 ///        value above 2^63 - 1, a non-finite position, or an attribute that does not hold
 ///        one value per particle (as writeParticles(), without the path).
 /// Returned as GridBase so this header stays light (cast with
