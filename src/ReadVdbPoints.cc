@@ -509,13 +509,16 @@ public:
     }
 
     /// A GridDescriptor (GridDescriptor::read): unique name, type, instance parent, offsets.
-    /// Returns the grid's name.
-    std::string gridDescriptor(uint32_t version)
+    /// Returns the grid's name; @a instance (if given) says whether it names a parent whose
+    /// tree it shares (a grid copied with GridBase::copy(), written once).
+    std::string gridDescriptor(uint32_t version, bool* instance = nullptr)
     {
         const std::string name = string("grid name");
         const std::string grid = "grid '" + printable(name) + "'";
         string("type name of " + grid);
-        if (version >= openvdb::OPENVDB_FILE_VERSION_GRID_INSTANCING) string("instance parent of " + grid);
+        std::string parent;
+        if (version >= openvdb::OPENVDB_FILE_VERSION_GRID_INSTANCING) parent = string("instance parent of " + grid);
+        if (instance) *instance = !parent.empty();
         skip(3 * 8, grid + " descriptor");
         return name;
     }
@@ -1256,7 +1259,8 @@ void checkLayout(const VdbSource& source, const std::string& path)
     check.metaMap("the file");
     const uint32_t gridCount = check.gridCount();
     for (uint32_t i = 0; i < gridCount; ++i) {
-        const std::string name = check.gridDescriptor(version);
+        bool instance = false;
+        const std::string name = check.gridDescriptor(version, &instance);
         const size_t gridStart = check.pos();
         // The descriptor ends with three offsets: grid, blocks, end of the grid.
         check.seek(gridStart - 24);
@@ -1281,7 +1285,10 @@ void checkLayout(const VdbSource& source, const std::string& path)
         // io::File reads the grid from its grid offset (where the walk below starts, right
         // after the descriptor) and seeks to its block offset: one pointing elsewhere made
         // it read past the end of the file into uninitialised lengths (gigabytes, minutes).
-        if (gridPosition != int64_t(gridStart) || blockPosition < int64_t(gridStart) || blockPosition > end) {
+        // An instance stores no tree, so io::Archive leaves its block offset 0 (a file with
+        // one was refused: bug hunt).
+        const bool blocksInside = blockPosition >= int64_t(gridStart) && blockPosition <= end;
+        if (gridPosition != int64_t(gridStart) || !(blocksInside || (instance && blockPosition == 0))) {
             check.corrupt("corrupt grid '" + printable(name) + "' (its grid and block offsets " +
                           std::to_string(gridPosition) + " and " + std::to_string(blockPosition) +
                           " do not lie between its start " + std::to_string(gridStart) + " and end " +

@@ -71,6 +71,24 @@ TEST_F(ReadVdbTest, AFileWrittenWithoutACreatorNamesNonbloppyAndOpenVdbWithTheir
                                             + openvdb::getLibraryVersionString() + ")");
 }
 
+TEST_F(ReadVdbTest, GridsSharingATreeReadBack)
+{
+    // A grid copied with copy() shares its tree; the file stores the tree once and the copy
+    // as an instance with block offset 0, which the layout check refused as corrupt (bug hunt).
+    openvdb::initialize();
+    openvdb::FloatGrid::Ptr a = openvdb::tools::createLevelSetSphere<openvdb::FloatGrid>(1.0f, openvdb::Vec3f(0.0f), 0.1f);
+    a->setName("a");
+    openvdb::FloatGrid::Ptr b = a->copy();
+    b->setName("b");
+    const std::string file = path("shared.vdb");
+    nonbloppy::writeVdb({a, b}, file);
+    const nonbloppy::VdbFileContents contents = readVdbFile(file);
+    ASSERT_EQ(contents.grids.size(), 2u);
+    EXPECT_EQ(contents.grids[1]->getName(), "b");
+    EXPECT_EQ(contents.grids[1]->activeVoxelCount(), a->activeVoxelCount());
+    EXPECT_GT(a->activeVoxelCount(), 1000u);
+}
+
 TEST_F(ReadVdbTest, EveryTruncationIsAOneLineErrorNamingTheFile)
 {
     // io::File read these with gigabyte allocations and messages of a billion spaces, or
