@@ -238,9 +238,12 @@ groupColumns(const std::vector<AttributeColumn>& columns)
     // A set, not a scan per run: 60,000 columns took 10 s (bug hunt).
     std::unordered_set<std::string_view> names;
     for (const AttributeColumn& column : columns) names.insert(column.name);
+    // A base an earlier run took stays with it: v_x v_y v_z then v_0 v_1 made two
+    // attributes 'v' (PLY), of which mesh --attributes kept one, or refused the file (CSV).
+    std::unordered_set<std::string> grouped;
     std::vector<ColumnGroup> groups;
     for (ColumnGroup& run : runs) {
-        if (run.columns.size() >= 2 && names.count(run.name) == 0) {
+        if (run.columns.size() >= 2 && names.count(run.name) == 0 && grouped.insert(run.name).second) {
             groups.push_back(std::move(run));
         } else {
             for (size_t i : run.columns) groups.push_back(ColumnGroup{columns[i].name, {i}});

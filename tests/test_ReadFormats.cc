@@ -646,6 +646,25 @@ TEST_F(ReadFormatsTest, VdbQuaternionsMatricesAndSplitVectorsAreAttributesOfThei
     EXPECT_EQ(attribute(particles, "xform").type, ScalarType::Float32);
 }
 
+TEST_F(ReadFormatsTest, TwoRunsOfTheSameBaseGiveOneVectorAndScalars)
+{
+    // v_x v_y v_z and v_0 v_1 became two attributes 'v' (PLY), of which mesh --attributes
+    // kept one; CSV refused the file ("duplicate column 'v"). The first run keeps the name.
+    const ParticleSet ply = readParticles(write("runs.ply", "ply\nformat ascii 1.0\nelement vertex 1\n"
+        "property float x\nproperty float y\nproperty float z\nproperty float v_x\nproperty float v_y\n"
+        "property float v_z\nproperty float v_0\nproperty float v_1\nend_header\n0 0 0 1 2 3 4 5\n"));
+    std::vector<std::string> names;
+    for (const ParticleAttribute& a : ply.attributes) names.push_back(a.name + "/" + std::to_string(a.components));
+    EXPECT_EQ(names, (std::vector<std::string>{"v/3", "v_0/1", "v_1/1"}));
+    EXPECT_EQ(attribute(ply, "v_1").asDouble(0), 5.0);
+
+    const ParticleSet csv = readParticles(write("runs.csv", "x,y,z,v:0,v:1,v:2,v_x,v_y,v_z\n0,0,0,1,2,3,4,5,6\n"));
+    names.clear();
+    for (const ParticleAttribute& a : csv.attributes) names.push_back(a.name + "/" + std::to_string(a.components));
+    EXPECT_EQ(names, (std::vector<std::string>{"v/3", "v_x/1", "v_y/1", "v_z/1"}));
+    EXPECT_EQ(attribute(csv, "v_z").asDouble(0), 6.0);
+}
+
 TEST_F(ReadFormatsTest, WholeFloatsStayFloatsThroughCsv)
 {
     // A float 300 went out as "300" and came back as an integer attribute, which mesh
