@@ -334,12 +334,26 @@ public:
     ParticleSet read()
     {
         readHeader();
-        for (const PlyElement& element : mElements) {
-            if (element.name == "vertex") {
-                readVertices(element);
-                return std::move(mData);  // the rest of the file is not needed
+        for (size_t e = 0; e < mElements.size(); ++e) {
+            const PlyElement& element = mElements[e];
+            if (element.name != "vertex") {
+                skipElement(element);
+                continue;
             }
-            skipElement(element);
+            readVertices(element);
+            // The elements after it (a mesh's faces) are not read, only named; data after
+            // the last element (more rows than the header counts) was dropped silently.
+            for (size_t other = 0; other < mElements.size(); ++other) {
+                if (other != e && mElements[other].count > 0) mData.skipped.push_back("element '" + mElements[other].name + "'");
+            }
+            if (e + 1 == mElements.size()) {
+                mInput.skipSpace();
+                if (!mInput.atEnd()) {
+                    fail(mPath, "PLY data goes on for " + std::to_string(mInput.remaining()) + " bytes after the " +
+                                std::to_string(element.count) + " vertices the header declares");
+                }
+            }
+            return std::move(mData);
         }
         fail(mPath, "PLY file has no vertex element");
     }

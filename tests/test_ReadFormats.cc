@@ -646,6 +646,32 @@ TEST_F(ReadFormatsTest, VdbQuaternionsMatricesAndSplitVectorsAreAttributesOfThei
     EXPECT_EQ(attribute(particles, "xform").type, ScalarType::Float32);
 }
 
+TEST_F(ReadFormatsTest, PlyDataPastTheDeclaredVerticesIsAnErrorAndOtherElementsAreNamed)
+{
+    // A row more than the header counts was dropped silently (bug hunt); CSV, XYZ and VTK
+    // refuse theirs. Trailing line breaks are no data.
+    const std::string header = "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\n"
+                               "property float z\nend_header\n";
+    const std::string extra = write("extra.ply", header + "0 0 0\n1 1 1\n2 2 2\n");
+    EXPECT_EQ(nonbloppy_test::messageOf<FileError>([&] { readParticles(extra); }),
+              "PLY data goes on for 6 bytes after the 2 vertices the header declares (" + extra + ")");
+    EXPECT_EQ(readParticles(write("ends.ply", header + "0 0 0\n1 1 1\n\n \n")).size(), 2u);
+    const float values[6] = {0, 0, 0, 1, 1, 1};
+    const std::string binary = "ply\nformat binary_little_endian 1.0\nelement vertex 2\nproperty float x\n"
+                               "property float y\nproperty float z\nend_header\n"
+                               + std::string(reinterpret_cast<const char*>(values), sizeof(values));
+    const std::string junk = write("junk.ply", binary + "JUNK");
+    EXPECT_EQ(nonbloppy_test::messageOf<FileError>([&] { readParticles(junk); }),
+              "PLY data goes on for 4 bytes after the 2 vertices the header declares (" + junk + ")");
+    EXPECT_EQ(readParticles(write("newline.ply", binary + "\n")).size(), 2u);
+    // A mesh's faces are not read, but named (convert warned of nothing).
+    const ParticleSet mesh = readParticles(write("mesh.ply", "ply\nformat ascii 1.0\nelement vertex 3\n"
+        "property float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\n"
+        "end_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n"));
+    EXPECT_EQ(mesh.size(), 3u);
+    EXPECT_EQ(mesh.skipped, std::vector<std::string>{"element 'face'"});
+}
+
 TEST_F(ReadFormatsTest, TwoRunsOfTheSameBaseGiveOneVectorAndScalars)
 {
     // v_x v_y v_z and v_0 v_1 became two attributes 'v' (PLY), of which mesh --attributes

@@ -133,8 +133,8 @@ struct NONBLOPPY_API ParticleSet
     std::vector<ParticleAttribute> attributes;  ///< each holds positions.size() values
     /// Per-particle data the file holds that no attribute could take, each said as
     /// "group 'splash'", "string attribute 'name'" (.vdb), "string array 'label'" (VTU,
-    /// VTP), "unnamed column 1" (CSV: pandas' and R's row numbers) or "list property 'ids'"
-    /// (PLY),
+    /// VTP), "unnamed column 1" (CSV: pandas' and R's row numbers), "list property 'ids'"
+    /// or "element 'face'" (PLY: an element other than the vertices, e.g. a mesh's faces),
     /// so that a caller can tell its user what a conversion leaves behind.
     std::vector<std::string> skipped;
 
