@@ -838,8 +838,10 @@ public:
             } else if (key == "CELLS" || key == "VERTICES" || key == "LINES" ||
                        key == "POLYGONS" || key == "TRIANGLE_STRIPS") {
                 uint64_t cells = 0;
-                if (key == "POLYGONS" && words.size() == 3 && parseCount(words[1], cells) && cells > 0) {
-                    mSawPolygons = true;
+                if (words.size() == 3 && parseCount(words[1], cells) && cells > 0) {
+                    if (key == "POLYGONS") mSawPolygons = true;
+                    const bool surface = key == "POLYGONS" || key == "LINES" || key == "TRIANGLE_STRIPS";
+                    if (surface && !(key == "POLYGONS" && mWantPolygons)) mData.skippedSections.push_back(key + " section");
                 }
                 readCells(key, words);
             } else if (key == "CELL_TYPES") {

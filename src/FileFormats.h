@@ -327,6 +327,9 @@ struct VtkData
     std::vector<openvdb::Vec3f> points;       ///< POINTS (double converted to float)
     std::vector<NumericArray> pointArrays;    ///< every POINT_DATA array, in file order
     PolygonList polygons;                     ///< POLYGONS, only if asked for
+    /// The surface sections not kept, "POLYGONS section", "LINES section", "TRIANGLE_STRIPS
+    /// section" (declaring at least one cell; POLYGONS when kept is not listed).
+    std::vector<std::string> skippedSections;
 };
 
 /// Decode a legacy VTK file (ASCII or big-endian BINARY; version 2 to 5.1 cell layouts;

@@ -290,6 +290,7 @@ readVtkParticles(const std::string& path)
     VtkData vtk = parseVtk(stream, path, /*wantPolygons=*/false);
     ParticleSet particles;
     particles.positions = std::move(vtk.points);
+    particles.skipped = std::move(vtk.skippedSections);  // a mesh's polygons, say
     particles.attributes.reserve(vtk.pointArrays.size());
     for (NumericArray& array : vtk.pointArrays) {
         ParticleAttribute attribute;

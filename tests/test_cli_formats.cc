@@ -385,15 +385,25 @@ TEST_F(CliFormatsTest, IntegerAttributesReachTheMeshAsTheNearestParticlesValue)
     EXPECT_FALSE(fs::exists(path("h.vtk")));
 }
 
-TEST_F(CliFormatsTest, APlyMeshGivenAsParticlesIsSaidToBeOne)
+TEST_F(CliFormatsTest, AMeshGivenAsParticlesIsSaidToBeOne)
 {
     // A mesh from an earlier run given back as IN: its vertices are meshed, with a warning.
     const std::string cube = kData + "/cube_2366_particles.vtk";
     ASSERT_EQ(run("mesh -q " + quote(cube) + " -o " + quote(path("surface.ply"))).exitCode, 0);
     const RunResult again = run("mesh -q " + quote(path("surface.ply")) + " -o " + quote(path("again.ply")));
     EXPECT_EQ(again.exitCode, 0) << again.err;
-    EXPECT_EQ(again.err, "nonbloppy: warning: " + path("surface.ply") + " is a mesh (its header declares faces): "
-                         "its vertices were meshed as particles\n");
+    EXPECT_EQ(again.err, "nonbloppy: warning: " + path("surface.ply") + " is a mesh (its element 'face' was not "
+                         "read): its vertices were meshed as particles\n");
+    // A legacy VTK mesh alike (it was meshed without a word: bug hunt), and convert says so.
+    ASSERT_EQ(run("mesh -q " + quote(cube) + " -o " + quote(path("surface.vtk"))).exitCode, 0);
+    const RunResult vtk = run("mesh -q " + quote(path("surface.vtk")) + " -o " + quote(path("again2.ply")));
+    EXPECT_EQ(vtk.exitCode, 0) << vtk.err;
+    EXPECT_EQ(vtk.err, "nonbloppy: warning: " + path("surface.vtk") + " is a mesh (its POLYGONS section was not "
+                       "read): its vertices were meshed as particles\n");
+    const RunResult converted = run("convert -q " + quote(path("surface.ply")) + " " + quote(path("v.csv")));
+    EXPECT_EQ(converted.exitCode, 0) << converted.err;
+    EXPECT_EQ(converted.err, "nonbloppy: warning: not read from " + path("surface.ply") + ", so not converted: "
+                             "element 'face'\n");
     // A PLY of particles: nothing to say.
     ASSERT_EQ(run("convert -q " + quote(cube) + " " + quote(path("particles.ply"))).exitCode, 0);
     const RunResult particles = run("mesh -q " + quote(path("particles.ply")) + " -o " + quote(path("p.ply")));

@@ -15,7 +15,6 @@
 
 #include <nonbloppy/BuildSurface.h>
 #include <nonbloppy/Error.h>
-#include <nonbloppy/ReadMesh.h>
 #include <nonbloppy/ReadParticles.h>
 #include <nonbloppy/Timing.h>
 #include <nonbloppy/WriteMesh.h>
@@ -471,6 +470,7 @@ struct FrameOutcome
 {
     nonbloppy::SurfaceResult result;
     nonbloppy::StageTimings timings;
+    std::string faces;  ///< a mesh input's faces not read ("element 'face'"), or ""
 };
 
 /// A frame read and meshed, its outputs not yet written (see writeFrame()).
@@ -480,6 +480,7 @@ struct MeshedFrame
     nonbloppy::SurfaceResult result;
     nonbloppy::StageTimings before;    ///< "read particles"
     nonbloppy::StageTimings after;     ///< "interpolate attributes", then the writes
+    std::string faces;                 ///< what made the input a mesh, or "" (FrameOutcome)
 };
 
 /// Read o.input and build the surface (with its attributes); writes nothing.
@@ -492,6 +493,12 @@ MeshedFrame meshFrameSurface(const MeshOptions& o, ProgressInterrupter& interrup
     }
     if (frame.particles.size() == 0) {
         throw nonbloppy::FileError("no particles in " + o.input);
+    }
+    for (const std::string& skipped : frame.particles.skipped) {
+        // A mesh's faces (PLY) or polygons (legacy VTK), not read: its vertices are meshed.
+        if (skipped == "element 'face'" || skipped == "POLYGONS section" || skipped == "TRIANGLE_STRIPS section") {
+            frame.faces = skipped;
+        }
     }
     // Once per run, and only where the particles' attributes are used.
     if (o.outputs.needParticles() && !frame.particles.skipped.empty() && !once.attributesNotRead.exchange(true)) {
@@ -577,6 +584,7 @@ FrameOutcome writeFrame(const MeshOptions& o, MeshedFrame& frame, ProgressInterr
     cleanup.keep(remover);
 
     FrameOutcome outcome;
+    outcome.faces = frame.faces;
     outcome.timings = frame.before;
     outcome.timings.add(result.timings);
     outcome.timings.add(frame.after);
@@ -680,33 +688,24 @@ void warnIfEmpty(const nonbloppy::SurfaceResult& result, const std::string& outp
               << formatNumber(result.parameters.threshold) << std::endl;
 }
 
-/// Once per run: a PLY input whose header declares faces is a mesh, not particles; its
-/// vertices were meshed as particles (readParticles() reads the vertex element of any PLY).
-/// Only regular PLY files are asked: the header alone tells, while a VTK file would be
-/// decoded again up to its POLYGONS, and a pipe cannot be read twice.
-void warnIfMeshInput(const std::string& input, OnceWarnings& once)
+/// Once per run: an input with faces (PLY) or polygons (legacy VTK) is a mesh, not
+/// particles; its vertices were meshed as particles (the readers read the vertices of any
+/// PLY or VTK file and list what they leave out: @a faces).
+void warnIfMeshInput(const std::string& input, const std::string& faces, OnceWarnings& once)
 {
-    std::error_code ec;
-    if (lowerExtension(input) != ".ply" || !fs::is_regular_file(input, ec) || once.meshInput.load()) return;
-    bool polygons = false;
-    try {
-        polygons = nonbloppy::declaresPolygons(input);
-    } catch (const nonbloppy::Error&) {
-        return;  // gone since it was read: nothing to say about it
-    }
-    if (!polygons || once.meshInput.exchange(true)) return;
-    std::cerr << "nonbloppy: warning: " << input << " is a mesh (its header declares faces): its "
+    if (faces.empty() || once.meshInput.exchange(true)) return;
+    std::cerr << "nonbloppy: warning: " << input << " is a mesh (its " << faces << " was not read): its "
               << "vertices were meshed as particles" << std::endl;
 }
 
 /// The warnings about one meshed frame (@a f: its options, paths included), each printed
 /// once per run.
-void warnAboutFrame(const MeshOptions& f, const nonbloppy::SurfaceResult& result, OnceWarnings& once)
+void warnAboutFrame(const MeshOptions& f, const FrameOutcome& outcome, OnceWarnings& once)
 {
-    warnIfFacesEndInside(f, result.parameters, once);
-    warnIfCoarseFloats(result, once);
-    warnIfEmpty(result, f.output);
-    warnIfMeshInput(f.input, once);
+    warnIfFacesEndInside(f, outcome.result.parameters, once);
+    warnIfCoarseFloats(outcome.result, once);
+    warnIfEmpty(outcome.result, f.output);
+    warnIfMeshInput(f.input, outcome.faces, once);
 }
 
 // ---------------------------------------------------------------------------------------
@@ -919,7 +918,7 @@ int runSequence(const MeshOptions& o)
     const auto writeAndReport = [&](const MeshOptions& f, const BatchJob& job, MeshedFrame& frame,
                                     ProgressInterrupter& interrupter, ResidentSampler* sampler) {
         const FrameOutcome outcome = writeFrame(f, frame, interrupter, remover, once, OnInterrupt::Finish);
-        warnAboutFrame(f, outcome.result, once);
+        warnAboutFrame(f, outcome, once);
         warnIfLengthsMove(job.frame.number, outcome.result.parameters, o.maxStepOpt->count() > 0, once);
 
         FrameReport report;
@@ -1012,7 +1011,7 @@ int runMesh(const MeshOptions& o)
     try {
         const FrameOutcome outcome = meshFrame(o, interrupter, remover, once);
         interrupter.clearLine();
-        warnAboutFrame(o, outcome.result, once);
+        warnAboutFrame(o, outcome, once);
         if (sampler) {
             sampler->stop();
             std::cerr << sampler->report(outcome.timings, outcome.result.particleCount);
