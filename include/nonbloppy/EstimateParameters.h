@@ -156,8 +156,9 @@ struct SurfaceParameters
     std::optional<bool> smoothSurface;
     /// With adaptivity 0 the surface is extracted region by region, about this many density
     /// leaves that the surface touches per region (0: the whole grid at once). The extracted
-    /// surface has the same polygons and vertices whatever the value (only their order changes);
-    /// the value trades cancel latency against speed, since OpenVDB's volumeToMesh cannot
+    /// surface has the same polygons and vertices whatever the value (only their order changes),
+    /// and so has the relaxed one; the smoothing (spacing given) sums over neighbours in that
+    /// order, so its vertices can differ in the last bits (up to about 1e-6 of a unit). The value trades cancel latency against speed, since OpenVDB's volumeToMesh cannot
     /// be stopped inside a region. On the 64x benchmark input (1.56M particles, two
     /// cores, no --vdb, 2026-12-05 at fca7043), extraction wall time / process peak,
     /// medians of 3-5 alternating runs: 1024 leaves 0.61-0.63 s / 313-321 MB (longest

@@ -1083,7 +1083,7 @@ Command setupMeshCommand(CLI::App& parent)
     o.regionLeavesOpt = cmd->add_option("--region-leaves", o.regionLeaves,
         "Density leaves per extraction region: smaller takes less memory and answers Ctrl-C "
         "sooner; 0: the whole grid at once, about 10% faster to extract and uninterruptible; the same surface either way, "
-        "its vertices in another order "
+        "its vertices in another order (with --spacing, whose smoothing sums in that order, to the last bits) "
         "(default: " + std::to_string(nonbloppy::kDefaultRegionLeaves) + ")")->group(kGroupAdvanced);
     o.threadsOpt = cmd->add_option("--threads", o.threads,
         "Worker threads (default: all cores); results do not depend on it")
