@@ -20,13 +20,19 @@ namespace {
 
 const openvdb::Vec3f kCentre(0.31f, -0.17f, 0.05f);
 
-SurfaceMesh singleParticleSurface(double radius, double threshold, double voxelSize)
+/// The density of one particle at kCentre.
+openvdb::FloatGrid::Ptr singleParticleDensity(double radius, double voxelSize)
 {
     const ParticleIndex index = ParticleIndex::build({kCentre}, radius / 2);
     DensitySettings settings;
     settings.effectiveRadius = radius;
     settings.voxelSize = voxelSize;
-    return extractSurface(*rasterizeDensity(index, settings), threshold);
+    return rasterizeDensity(index, settings);
+}
+
+SurfaceMesh singleParticleSurface(double radius, double threshold, double voxelSize)
+{
+    return extractSurface(*singleParticleDensity(radius, voxelSize), threshold);
 }
 
 } // namespace
@@ -63,11 +69,7 @@ TEST(ExtractSurface, PolygonsFaceOutOfTheFluid)
 
 TEST(ExtractSurface, AdaptivityMergesPolygonsAndIsChecked)
 {
-    const ParticleIndex index = ParticleIndex::build({kCentre}, 0.5);
-    DensitySettings settings;
-    settings.effectiveRadius = 1.0;
-    settings.voxelSize = 0.04;
-    const openvdb::FloatGrid::Ptr grid = rasterizeDensity(index, settings);
+    const openvdb::FloatGrid::Ptr grid = singleParticleDensity(1.0, 0.04);
     const SurfaceMesh full = extractSurface(*grid, 1.0, 0.0);
     const SurfaceMesh adaptive = extractSurface(*grid, 1.0, 0.5);
     EXPECT_LT(adaptive.polygonCount(), full.polygonCount());
@@ -108,11 +110,7 @@ TEST(ExtractSurface, AThresholdAtOrBelowTheBackgroundIsRefused)
 {
     // r_0 <= 0 returned an empty mesh without a word (bug hunt), and tileDeepInterior() and
     // offsetSurface() took NaN (the latter made every vertex NaN).
-    const ParticleIndex index = ParticleIndex::build({kCentre}, 0.5);
-    DensitySettings settings;
-    settings.effectiveRadius = 1.0;
-    settings.voxelSize = 0.1;
-    const openvdb::FloatGrid::Ptr grid = rasterizeDensity(index, settings);
+    const openvdb::FloatGrid::Ptr grid = singleParticleDensity(1.0, 0.1);
     for (const double threshold : {0.0, -1.0}) {
         std::ostringstream expected;
         expected << "--threshold must lie above the density grid's background value 0 (its value outside the "
