@@ -141,15 +141,23 @@ void runSurfaceStages(const ParticleIndex& index, bool keepDensity, SurfaceResul
         computeNormals(result.mesh, interrupter);
         checkCancelled(interrupter, "compute normals");
     }
-    // The volume offset moves each vertex along its normal and smoothing moves it again:
-    // slivers between neighbours moved by different amounts turned over, 4% of the
-    // triangles of the dam-break frame at --spacing 0.0467 (bug hunt). Those vertices go
-    // back to where relaxation and its repair left them, as after relaxation.
-    const bool repairCorrections = p.repairFolds && (p.preserveVolume || p.smoothSurface);
-    if (repairCorrections) copyInParallel(result.mesh.points, unrelaxed);  // after the normals' peak
+    // The volume offset moves each vertex along its normal, and the smoothing moves it again:
+    // slivers between neighbours moved by different amounts turned over, 4% of the triangles
+    // of the dam-break frame at --spacing 0.0467 (bug hunt). With fold repair each of the two
+    // is checked against the surface it started from, and the vertices of what it turned
+    // over go back towards it: 0.35% are left. One check against the relaxed surface after
+    // both left 0.03%, but its reverted vertices lost offset and smoothing alike (up to
+    // 0.96 s) and the largest errors of docs/fidelity.md grew up to 2.4 times; this way by
+    // up to 15% (7% with the default options).
+    const auto repairAgainstStart = [&] {
+        if (repairFoldsUnchecked(result.mesh, unrelaxed.data(), kDefaultRepairRounds, interrupter) > 0) {
+            computeNormals(result.mesh, interrupter);
+        }
+    };
     if (p.preserveVolume) {
         // Each particle stands for s³ of fluid; preserveVolume() recomputes the normals.
         StageScope scope(result.timings, interrupter, "correct surface");
+        if (p.repairFolds) copyInParallel(result.mesh.points, unrelaxed);  // past the normals' peak
         const double s = p.spacing;
         VolumeSettings volume;
         volume.targetVolume = double(result.particleCount) * s * s * s;
@@ -158,24 +166,23 @@ void runSurfaceStages(const ParticleIndex& index, bool keepDensity, SurfaceResul
         volume.maxDistance = (p.volumeOffset == VolumeOffset::Convex ? kMaxConvexOffsetOverSpacing
                                                                      : kMaxVolumeOffsetOverSpacing) * s;
         preserveVolumeUnchecked(result.mesh, volume, interrupter);
+        if (p.repairFolds) repairAgainstStart();
         checkCancelled(interrupter, "correct surface");
     }
     if (p.smoothSurface) {
         // After the volume correction: smoothing first would leave the edges it rounds
         // nothing to put their volume back (docs/fidelity.md).
         StageScope scope(result.timings, interrupter, "smooth surface");
+        if (p.repairFolds) copyInParallel(result.mesh.points, unrelaxed);
         SmoothSettings settings;
         settings.spatialWidth = kDefaultSmoothWidthOverSpacing * p.spacing;
         smoothSurfaceUnchecked(result.mesh, settings, interrupter);
         computeNormals(result.mesh, interrupter);
+        if (p.repairFolds) repairAgainstStart();
         checkCancelled(interrupter, "smooth surface");
     }
-    if (repairCorrections) {
-        StageScope scope(result.timings, interrupter, "correct surface");
-        const size_t folded = repairFoldsUnchecked(result.mesh, unrelaxed.data(), kDefaultRepairRounds, interrupter);
-        if (folded > 0) computeNormals(result.mesh, interrupter);
-        if (whenRepaired == UnrelaxedBuffer::Release) VertexBufferT().swap(unrelaxed);
-        checkCancelled(interrupter, "correct surface");
+    if (p.repairFolds && (p.preserveVolume || p.smoothSurface) && whenRepaired == UnrelaxedBuffer::Release) {
+        VertexBufferT().swap(unrelaxed);
     }
 }
 

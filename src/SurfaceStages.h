@@ -76,24 +76,28 @@ void resolveAndIndex(const SurfaceParameters& params, const ResolvedParameters* 
                      std::vector<openvdb::Vec3f>& positions, ParticleIndex& index, SurfaceResult& result,
                      openvdb::util::NullInterrupter* interrupter);
 
-/// What runSurfaceStages() does with the unrelaxed-vertex buffer after fold repair.
+/// What runSurfaceStages() does with the buffer fold repair compares against once each
+/// repair is done.
 enum class UnrelaxedBuffer
 {
-    Release,  ///< free its memory before the normals are computed (lower peak memory)
+    Release,  ///< free its memory after each repair, so that it is not held while the normals
+              ///< are computed (the peak of a frame without the spacing)
     Keep,     ///< keep its capacity for the next frame
 };
 
 /// Run the stages after "index particles" with the parameters in result.parameters, each
 /// announced to @a interrupter (start()/end()) and checked at its end:
 /// rasterize density (metadata holding the parameters), extract surface (into result.mesh's
-/// vectors, which keep their capacity), relax vertices, fold repair, compute normals and the
-/// volume correction, timing each in result.timings. result.density is reset when
+/// vectors, which keep their capacity), relax vertices, fold repair, compute normals, the
+/// volume correction and the smoothing (each followed by a fold repair against the surface
+/// it started from), timing each in result.timings. result.density is reset when
 /// @a keepDensity is false.
 /// @param index        the frame's particle index, cell size kCellOverRadius·r_e
-/// @param unrelaxed    scratch for the vertex positions before relaxation (fold repair),
-///                     a std::vector<openvdb::Vec3s> or a memory_internal::UnwrittenVector
-///                     of them (filled in parallel without a serial memset first)
-/// @param whenRepaired whether @a unrelaxed is freed or kept once fold repair is done
+/// @param unrelaxed    scratch for the vertex positions before each step fold repair checks
+///                     (relaxation, then the volume correction and the smoothing), a
+///                     std::vector<openvdb::Vec3s> or a memory_internal::UnwrittenVector of
+///                     them (filled in parallel without a serial memset first)
+/// @param whenRepaired whether @a unrelaxed is freed or kept after each fold repair
 /// Cost: as buildSurface() minus its first two stages. Thread-safety: reentrant.
 /// @throw ParameterError, CancelledError as buildSurface(); result is then unspecified.
 template<typename VertexBufferT>

@@ -12,8 +12,8 @@
 /// ParticleIndex::build (with r_e given, the index comes first and the estimate searches it:
 /// ParticleIndex::build → resolveParametersIndexed) → rasterizeDensity → extractSurface →
 /// relaxVertices → (Faithful: repairFolds) → computeNormals → (spacing given:
-/// preserveVolume → smoothSurface → computeNormals → (Faithful: repairFolds against the
-/// relaxed surface → computeNormals)).
+/// preserveVolume → smoothSurface → computeNormals; Faithful: each of the two followed by
+/// repairFolds against the surface it started from, and computeNormals).
 
 #ifndef NONBLOPPY_BUILD_SURFACE_H
 #define NONBLOPPY_BUILD_SURFACE_H

@@ -103,7 +103,7 @@ private:
     bool mHaveKeptParameters = false;
     ResolvedParameters mKeptParameters;
     std::vector<openvdb::Vec3f> mPositions;
-    std::vector<openvdb::Vec3s> mUnrelaxed;  ///< vertex positions before relaxation (fold repair)
+    std::vector<openvdb::Vec3s> mUnrelaxed;  ///< scratch: positions before a step fold repair checks
     ParticleIndex mIndex;
     SurfaceResult mResult;
     size_t mFrames = 0;

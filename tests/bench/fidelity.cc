@@ -366,7 +366,10 @@ int main(int argc, char** argv)
        << "spacing is given; without it the smoothing alone leaves box and slab no closer. Cost: it "
        << "costs about as much as the rest of the pipeline when it runs (about 9 exponentials per quad per round).\n"
        << "- **step cap** (RelaxSettings::maxStep, s/2) and **fold repair** (repairFolds()): guards for "
-       << "sparse, splashing particles and large blends; no effect on these shapes (identical rows).\n";
+       << "sparse, splashing particles and large blends. The fold repair also checks the volume correction "
+          "and the smoothing, each against the surface it started from (on the dam-break frame at "
+          "--spacing 0.0467 they turned 4% of the triangles over): on these shapes it changes a truth max "
+          "by 0.02 s at most.\n";
     md << "\nMethods:\n\n";
     for (const Method& method : methods()) md << "- " << method.name << ": " << method.how << "\n";
 
