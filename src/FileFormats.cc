@@ -837,12 +837,6 @@ public:
                 havePoints = true;
             } else if (key == "CELLS" || key == "VERTICES" || key == "LINES" ||
                        key == "POLYGONS" || key == "TRIANGLE_STRIPS") {
-                uint64_t cells = 0;
-                if (words.size() == 3 && parseCount(words[1], cells) && cells > 0) {
-                    if (key == "POLYGONS") mSawPolygons = true;
-                    const bool surface = key == "POLYGONS" || key == "LINES" || key == "TRIANGLE_STRIPS";
-                    if (surface && !(key == "POLYGONS" && mWantPolygons)) mData.skippedSections.push_back(key + " section");
-                }
                 readCells(key, words);
             } else if (key == "CELL_TYPES") {
                 requireWords(words, 2);
@@ -1010,8 +1004,15 @@ private:
         const uint64_t size = count(words[2]);
         const bool keep = mWantPolygons && key == "POLYGONS";
         const std::string section = key + " section";
+        // VTK 5 counts offsets, one more than the cells: "POLYGONS 1 0" holds none (review).
+        const bool offsetsFollow = mInput.peekWord("OFFSETS");
+        if (n > (offsetsFollow ? 1u : 0u)) {
+            if (key == "POLYGONS") mSawPolygons = true;
+            const bool surface = key == "POLYGONS" || key == "LINES" || key == "TRIANGLE_STRIPS";
+            if (surface && !keep) mData.skippedSections.push_back(section);
+        }
 
-        if (mInput.peekWord("OFFSETS")) {
+        if (offsetsFollow) {
             mInput.skipSpace();
             mLine = mInput.line();
             const std::vector<std::string_view> offsetWords = splitWords(mLine);

@@ -347,11 +347,15 @@ public:
             for (size_t other = 0; other < mElements.size(); ++other) {
                 if (other != e && mElements[other].count > 0) mData.skipped.push_back("element '" + mElements[other].name + "'");
             }
-            if (e + 1 == mElements.size()) {
+            // Only where nothing but empty elements follows (MeshLab writes point clouds with
+            // "element face 0"); a list element's size is known only by reading it.
+            bool last = true;
+            for (size_t other = e + 1; other < mElements.size(); ++other) last = last && mElements[other].count == 0;
+            if (last) {
                 mInput.skipSpace();
                 if (!mInput.atEnd()) {
-                    fail(mPath, "PLY data goes on for " + std::to_string(mInput.remaining()) + " bytes after the " +
-                                std::to_string(element.count) + " vertices the header declares");
+                    fail(mPath, "PLY file has " + std::to_string(mInput.remaining()) +
+                                " bytes more than its header declares (element vertex " + std::to_string(element.count) + ")");
                 }
             }
             return std::move(mData);

@@ -308,7 +308,8 @@ writeVtu(const ParticleSet& particles, std::ostream& os)
     os.write(tail.data(), std::streamsize(tail.size()));
 }
 
-/// Shortest text that reads back as the same value of @a type.
+/// Shortest text that reads back as the same value of @a type; a whole float keeps ".0", so
+/// that it reads back as a float.
 void
 appendNumber(std::string& out, const ParticleAttribute& a, size_t n, int c)
 {
@@ -437,7 +438,11 @@ pointDataGridOfFinitePositions(const ParticleSet& particles, double voxelSize)
     openvdb::initialize();
     std::vector<openvdb::Vec3R> positions(particles.positions.begin(), particles.positions.end());
     const openvdb::points::PointAttributeVector<openvdb::Vec3R> wrapper(positions);
-    if (std::isnan(voxelSize)) throw ParameterError("--voxel-size must be finite, got nan");  // it picked one
+    if (std::isnan(voxelSize) || voxelSize == -HUGE_VAL) {  // they picked one, as 0 does
+        std::ostringstream msg;
+        msg << "--voxel-size must be finite, got " << voxelSize;
+        throw ParameterError(msg.str());
+    }
     if (!(voxelSize > 0.0)) {
         voxelSize = positions.size() > 1 ? double(openvdb::points::computeVoxelSize(wrapper, 8)) : 1.0;
     } else {

@@ -101,7 +101,7 @@ TEST(MeshToLevelSet, VerticesAndBandsItCannotHoldAreRefusedBeforeAnyGridIsMade)
         nonbloppy_test::messageOf<ParameterError>([&] { nonbloppy::meshToLevelSet(sail, 0.01); });
     EXPECT_EQ(message.rfind("the level set's narrow band would hold about 3e+10 voxels, about 960 GB at its "
                             "peak, more than the ", 0), 0u) << message;
-    const std::string advice = " GB this process can still take: use a voxel size larger than 0.01 or a half width "
+    const std::string advice = " this process can still take: use a voxel size larger than 0.01 or a half width "
                                "below 3";
     ASSERT_GT(message.size(), advice.size());
     EXPECT_EQ(message.substr(message.size() - advice.size()), advice) << message;

@@ -654,7 +654,7 @@ TEST_F(ReadFormatsTest, PlyDataPastTheDeclaredVerticesIsAnErrorAndOtherElementsA
                                "property float z\nend_header\n";
     const std::string extra = write("extra.ply", header + "0 0 0\n1 1 1\n2 2 2\n");
     EXPECT_EQ(nonbloppy_test::messageOf<FileError>([&] { readParticles(extra); }),
-              "PLY data goes on for 6 bytes after the 2 vertices the header declares (" + extra + ")");
+              "PLY file has 6 bytes more than its header declares (element vertex 2) (" + extra + ")");
     EXPECT_EQ(readParticles(write("ends.ply", header + "0 0 0\n1 1 1\n\n \n")).size(), 2u);
     const float values[6] = {0, 0, 0, 1, 1, 1};
     const std::string binary = "ply\nformat binary_little_endian 1.0\nelement vertex 2\nproperty float x\n"
@@ -662,14 +662,37 @@ TEST_F(ReadFormatsTest, PlyDataPastTheDeclaredVerticesIsAnErrorAndOtherElementsA
                                + std::string(reinterpret_cast<const char*>(values), sizeof(values));
     const std::string junk = write("junk.ply", binary + "JUNK");
     EXPECT_EQ(nonbloppy_test::messageOf<FileError>([&] { readParticles(junk); }),
-              "PLY data goes on for 4 bytes after the 2 vertices the header declares (" + junk + ")");
+              "PLY file has 4 bytes more than its header declares (element vertex 2) (" + junk + ")");
     EXPECT_EQ(readParticles(write("newline.ply", binary + "\n")).size(), 2u);
+    // MeshLab's point clouds declare "element face 0" after the vertices (review).
+    const std::string noFaces = write("nofaces.ply", "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\n"
+        "property float y\nproperty float z\nelement face 0\nproperty list uchar int vertex_indices\nend_header\n"
+        "0 0 0\n1 1 1\n2 2 2\n");
+    EXPECT_EQ(nonbloppy_test::messageOf<FileError>([&] { readParticles(noFaces); }),
+              "PLY file has 6 bytes more than its header declares (element vertex 2) (" + noFaces + ")");
     // A mesh's faces are not read, but named (convert warned of nothing).
     const ParticleSet mesh = readParticles(write("mesh.ply", "ply\nformat ascii 1.0\nelement vertex 3\n"
         "property float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\n"
         "end_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n"));
     EXPECT_EQ(mesh.size(), 3u);
     EXPECT_EQ(mesh.skipped, std::vector<std::string>{"element 'face'"});
+}
+
+TEST_F(ReadFormatsTest, AVtkMeshsPolygonsAreNamedAsNotReadAndAnEmptySectionIsNot)
+{
+    const ParticleSet mesh = readParticles(write("mesh.vtk", "# vtk DataFile Version 3.0\nm\nASCII\nDATASET POLYDATA\n"
+        "POINTS 3 float\n0 0 0 1 0 0 0 1 0\nPOLYGONS 1 4\n3 0 1 2\n"));
+    EXPECT_EQ(mesh.skipped, std::vector<std::string>{"POLYGONS section"});
+    // VTK 5 counts offsets, one more than the polygons: "POLYGONS 1 0" holds none (review).
+    const ParticleSet empty = readParticles(write("empty.vtk", "# vtk DataFile Version 5.1\nm\nASCII\n"
+        "DATASET POLYDATA\nPOINTS 3 float\n0 0 0 1 0 0 0 1 0\nPOLYGONS 1 0\nOFFSETS vtktypeint64\n0\n"
+        "CONNECTIVITY vtktypeint64\n\n"));
+    EXPECT_EQ(empty.size(), 3u);
+    EXPECT_TRUE(empty.skipped.empty());
+    const ParticleSet one = readParticles(write("one.vtk", "# vtk DataFile Version 5.1\nm\nASCII\n"
+        "DATASET POLYDATA\nPOINTS 3 float\n0 0 0 1 0 0 0 1 0\nPOLYGONS 2 3\nOFFSETS vtktypeint64\n0 3\n"
+        "CONNECTIVITY vtktypeint64\n0 1 2\n"));
+    EXPECT_EQ(one.skipped, std::vector<std::string>{"POLYGONS section"});
 }
 
 TEST_F(ReadFormatsTest, TwoRunsOfTheSameBaseGiveOneVectorAndScalars)

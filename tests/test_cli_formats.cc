@@ -400,6 +400,10 @@ TEST_F(CliFormatsTest, AMeshGivenAsParticlesIsSaidToBeOne)
     EXPECT_EQ(vtk.exitCode, 0) << vtk.err;
     EXPECT_EQ(vtk.err, "nonbloppy: warning: " + path("surface.vtk") + " is a mesh (its POLYGONS section was not "
                        "read): its vertices were meshed as particles\n");
+    // Said once, also where the attributes are used (the faces were "not read" as well).
+    const RunResult points = run("mesh -q " + quote(path("surface.ply")) + " -o " + quote(path("again3.ply")) +
+                                 " --vdb " + quote(path("again3.vdb")) + " --vdb-points");
+    EXPECT_EQ(points.err, again.err);
     const RunResult converted = run("convert -q " + quote(path("surface.ply")) + " " + quote(path("v.csv")));
     EXPECT_EQ(converted.exitCode, 0) << converted.err;
     EXPECT_EQ(converted.err, "nonbloppy: warning: not read from " + path("surface.ply") + ", so not converted: "
@@ -806,6 +810,9 @@ TEST_F(CliFormatsTest, APointsGridRefusesVoxelSizesThatWouldLoseThePositions)
               "particle coordinates up to 1e+09 are too far from the origin for a voxel size of 0.001 (32-bit index space)");
     EXPECT_EQ(nonbloppy_test::messageOf<nonbloppy::ParameterError>([&] { nonbloppy::makePointDataGrid(particles, std::nan("")); }),
               "--voxel-size must be finite, got nan");
+    EXPECT_EQ(nonbloppy_test::messageOf<nonbloppy::ParameterError>([&] {
+                  nonbloppy::makePointDataGrid(particles, -std::numeric_limits<double>::infinity());
+              }), "--voxel-size must be finite, got -inf");
     const auto grid = openvdb::gridPtrCast<openvdb::points::PointDataGrid>(nonbloppy::makePointDataGrid(particles, 10.0));
     ASSERT_TRUE(grid);
     EXPECT_EQ(openvdb::points::pointCount(grid->tree()), 3u);

@@ -42,12 +42,13 @@ namespace nonbloppy {
 /// @param reachesSurface  optional; set to whether the relaxed face ends at s/2 (false when
 ///                        the start height had to be limited and the face ends inside)
 /// @param maxStepOverSpacing  the relaxation's cap on one step (RelaxSettings::maxStep) in
-///                        units of s; 0: uncapped. The calibration takes the same capped
+///                        units of s; 0 or +inf: uncapped. The calibration takes the same capped
 ///                        steps as the mesh will: a start 1.4 s out (r_e = 2 s, c = 0.4,
 ///                        t = 2) needs steps longer than the default cap of s/2, and
 ///                        calibrating for uncapped ones left the box's faces 0.09 s off.
 /// @throw ParameterError if @a effectiveRadiusOverSpacing ≤ 0.5 or above
-///        kMaxCalibratedRadiusOverSpacing, c outside [0,1], t < 0 or @a maxStepOverSpacing < 0.
+///        kMaxCalibratedRadiusOverSpacing, c outside [0,1], t < 0 or @a maxStepOverSpacing < 0
+///        or NaN.
 NONBLOPPY_API double calibrateRelaxedThreshold(double effectiveRadiusOverSpacing, double blend,
                                                int iterations, bool* reachesSurface = nullptr,
                                                double maxStepOverSpacing = 0.0);

@@ -158,8 +158,9 @@ struct SurfaceParameters
     /// leaves that the surface touches per region (0: the whole grid at once). The extracted
     /// surface has the same polygons and vertices whatever the value (only their order changes),
     /// and so has the relaxed one; the smoothing (spacing given) sums over neighbours in that
-    /// order, so its vertices can differ in the last bits (up to about 1e-6 of a unit). The value trades cancel latency against speed, since OpenVDB's volumeToMesh cannot
-    /// be stopped inside a region. On the 64x benchmark input (1.56M particles, two
+    /// order, so its vertices can differ in their last bits (a few float steps of their
+    /// coordinates). The value trades cancel latency against speed, since OpenVDB's
+    /// volumeToMesh cannot be stopped inside a region. On the 64x benchmark input (1.56M particles, two
     /// cores, no --vdb, 2026-12-05 at fca7043), extraction wall time / process peak,
     /// medians of 3-5 alternating runs: 1024 leaves 0.61-0.63 s / 313-321 MB (longest
     /// region 34-41 ms when measured at 2b7aabc), 2048 leaves 0.63 s / 319 MB, 4096 leaves

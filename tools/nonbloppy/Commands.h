@@ -59,11 +59,22 @@ Command setupConvertCommand(CLI::App& parent);
 void warnRenamedAttributes(const std::vector<std::string>& original, const std::vector<std::string>& written,
                            const std::string& path);
 
-/// @a particles.skipped as one list: "group 'splash', string attribute 'name'".
-inline std::string joinedSkipped(const nonbloppy::ParticleSet& particles)
+/// Whether @a item of ParticleSet::skipped is what makes a file a mesh: a PLY's faces, a
+/// legacy VTK's polygons or triangle strips, as the readers name them (the CLI tests check
+/// both spellings).
+inline bool isSurfaceSkipped(const std::string& item)
+{
+    return item == "element 'face'" || item == "POLYGONS section" || item == "TRIANGLE_STRIPS section";
+}
+
+/// @a particles.skipped as one list: "group 'splash', string attribute 'name'"; without
+/// the mesh's faces (isSurfaceSkipped()) unless @a withSurfaces.
+inline std::string joinedSkipped(const nonbloppy::ParticleSet& particles, bool withSurfaces = true)
 {
     std::string list;
-    for (const std::string& item : particles.skipped) list += (list.empty() ? "" : ", ") + item;
+    for (const std::string& item : particles.skipped) {
+        if (withSurfaces || !isSurfaceSkipped(item)) list += (list.empty() ? "" : ", ") + item;
+    }
     return list;
 }
 

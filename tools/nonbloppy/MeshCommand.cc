@@ -495,15 +495,13 @@ MeshedFrame meshFrameSurface(const MeshOptions& o, ProgressInterrupter& interrup
         throw nonbloppy::FileError("no particles in " + o.input);
     }
     for (const std::string& skipped : frame.particles.skipped) {
-        // A mesh's faces (PLY) or polygons (legacy VTK), not read: its vertices are meshed.
-        if (skipped == "element 'face'" || skipped == "POLYGONS section" || skipped == "TRIANGLE_STRIPS section") {
-            frame.faces = skipped;
-        }
+        // A mesh's faces, not read: its vertices are meshed (said by warnIfMeshInput()).
+        if (isSurfaceSkipped(skipped)) frame.faces = skipped;
     }
     // Once per run, and only where the particles' attributes are used.
-    if (o.outputs.needParticles() && !frame.particles.skipped.empty() && !once.attributesNotRead.exchange(true)) {
-        std::cerr << "nonbloppy: warning: not read from " << o.input << ": " << joinedSkipped(frame.particles)
-                  << std::endl;
+    const std::string notRead = joinedSkipped(frame.particles, /*withSurfaces=*/false);
+    if (o.outputs.needParticles() && !notRead.empty() && !once.attributesNotRead.exchange(true)) {
+        std::cerr << "nonbloppy: warning: not read from " << o.input << ": " << notRead << std::endl;
     }
     // Before meshing: a misspelt name used to cost the whole frame's work first.
     try {
@@ -1071,7 +1069,7 @@ Command setupMeshCommand(CLI::App& parent)
         "repaired, volume N*s^3 kept and faces smoothed when --spacing is given; paper: the paper's plain method")
         ->check(CLI::IsMember({"faithful", "paper"}))->group(kGroupNumerical);
     o.maxStepOpt = cmd->add_option("--max-step", o.maxStep,
-        "faithful: the farthest one relaxation step moves a vertex; 0: no cap (default: s/2; no "
+        "faithful: the farthest one relaxation step moves a vertex; 0 or inf: no cap (default: s/2; no "
         "cap when --radius, --threshold and --voxel-size are all given without --spacing)")
         ->group(kGroupNumerical);
     o.noSmoothOpt = cmd->add_flag("--no-smooth", o.noSmooth,
