@@ -40,12 +40,7 @@ void requireVerticesInRange(const SurfaceMesh& mesh, double voxelSize, float hal
         }
         largest = std::max({largest, std::abs(p[0]), std::abs(p[1]), std::abs(p[2])});
     }
-    if (double(largest) / voxelSize + double(halfWidth) > openvdb_scale_internal::kMaxIndexCoordinate) {
-        std::ostringstream msg;
-        msg << "mesh coordinates up to " << double(largest) << " are too far from the origin for a voxel size of "
-            << voxelSize << " (32-bit index space)";
-        throw ParameterError(msg.str());
-    }
+    openvdb_scale_internal::requireIndexRange(double(largest), voxelSize, "mesh", "voxel size", double(halfWidth));
 }
 
 /// @throw ParameterError if the narrow band (the surface's area in voxels times 2·halfWidth,
@@ -61,8 +56,9 @@ void requireBandFitsInMemory(double area, double voxelSize, float halfWidth)
         msg.precision(2);
         msg << "the level set's narrow band would hold about " << bandVoxels << " voxels, about "
             << machine_memory_internal::formatBytes(needed) << " at its peak, more than the "
-            << machine_memory_internal::formatBytes(available) << " this process can still take: use a voxel size larger than " << voxelSize << " or a half width below "
-            << halfWidth;
+            << machine_memory_internal::formatBytes(available)
+            << " this process can still take: use a voxel size larger than " << voxelSize
+            << " or a half width below " << halfWidth;
         throw ParameterError(msg.str());
     }
 }

@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: Apache-2.0
 /// @file OpenVdbScale.h
 /// @brief Private: the one check, and the one message, for lengths below the smallest voxel
-///        or cell OpenVDB's linear transforms accept (kMinCellSize), and the largest index
-///        coordinate accepted. Only src/ includes it.
+///        or cell OpenVDB's linear transforms accept (kMinCellSize), and for coordinates past
+///        the largest index coordinate accepted. Only src/ includes it.
 
 #ifndef NONBLOPPY_OPENVDB_SCALE_H
 #define NONBLOPPY_OPENVDB_SCALE_H
@@ -30,6 +30,22 @@ inline void requireOpenVdbScale(double value, double least, const char* name)
         std::ostringstream msg;
         msg << name << " " << value << " is below " << least
             << ", the smallest OpenVDB accepts: give the positions in a smaller unit";
+        throw ParameterError(msg.str());
+    }
+}
+
+/// Throw ParameterError("<what> coordinates up to <largest> are too far from the origin for
+/// a <cellName> of <cellSize> (32-bit index space)") if @a largest (the largest |coordinate|)
+/// over @a cellSize, plus @a marginCells, passes kMaxIndexCoordinate: for the particle index
+/// ("particle", "cell size"), a points grid ("particle", "voxel size") and a mesh's level
+/// set ("mesh", "voxel size", its half width as margin).
+inline void requireIndexRange(double largest, double cellSize, const char* what, const char* cellName,
+                              double marginCells = 0.0)
+{
+    if (largest / cellSize + marginCells > kMaxIndexCoordinate) {
+        std::ostringstream msg;
+        msg << what << " coordinates up to " << largest << " are too far from the origin for a " << cellName
+            << " of " << cellSize << " (32-bit index space)";
         throw ParameterError(msg.str());
     }
 }

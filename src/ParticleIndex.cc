@@ -101,12 +101,7 @@ ParticleIndex ParticleIndex::build(std::vector<openvdb::Vec3f> positions, double
         throw ParameterError(particle_index_internal::nonFinitePositionMessage(scan.firstNonFinite));
     }
     // Index coordinates are 32-bit: refuse positions whose cell number would overflow.
-    if (double(scan.maxAbs()) / cellSize > openvdb_scale_internal::kMaxIndexCoordinate) {
-        std::ostringstream msg;
-        msg << "particle coordinates up to " << double(scan.maxAbs())
-            << " are too far from the origin for a cell size of " << cellSize << " (32-bit index space)";
-        throw ParameterError(msg.str());
-    }
+    openvdb_scale_internal::requireIndexRange(double(scan.maxAbs()), cellSize, "particle", "cell size");
 
     ParticleIndex index;
     Impl& impl = *index.mImpl;

@@ -342,15 +342,16 @@ public:
                 continue;
             }
             readVertices(element);
-            // The elements after it (a mesh's faces) are not read, only named; data after
-            // the last element (more rows than the header counts) was dropped silently.
-            for (size_t other = 0; other < mElements.size(); ++other) {
-                if (other != e && mElements[other].count > 0) mData.skipped.push_back("element '" + mElements[other].name + "'");
-            }
-            // Only where nothing but empty elements follows (MeshLab writes point clouds with
+            // The other elements (a mesh's faces) are not read, only named. Data after the
+            // vertices (more rows than the header counts) was dropped silently: it is checked
+            // where nothing but empty elements follows (MeshLab writes point clouds with
             // "element face 0"); a list element's size is known only by reading it.
             bool last = true;
-            for (size_t other = e + 1; other < mElements.size(); ++other) last = last && mElements[other].count == 0;
+            for (size_t other = 0; other < mElements.size(); ++other) {
+                if (other == e || mElements[other].count == 0) continue;
+                mData.skipped.push_back("element '" + mElements[other].name + "'");
+                last = last && other < e;
+            }
             if (last) {
                 mInput.skipSpace();
                 if (!mInput.atEnd()) {

@@ -420,25 +420,30 @@ namespace {
 
 /// @throw ParameterError("non-finite position of particle N, which a .vdb points grid cannot
 ///        hold" + @a suffix): OpenVDB's point partitioning silently dropped such particles
-///        (the other formats write them as they are). Cost: one parallel pass.
-void requirePlaceablePositions(const ParticleSet& particles, const std::string& suffix)
+///        (the other formats write them as they are). Returns the largest |coordinate|.
+///        Cost: one parallel pass.
+double requirePlaceablePositions(const ParticleSet& particles, const std::string& suffix)
 {
     cancellation_internal::CancelPoll never(nullptr, "write particles");
-    const size_t bad = particle_index_internal::scanPositions(particles.positions, never).firstNonFinite;
-    if (bad < particles.positions.size()) {
-        throw ParameterError(particle_index_internal::nonFinitePositionMessage(bad) +
+    const particle_index_internal::PositionScan scan = particle_index_internal::scanPositions(particles.positions, never);
+    if (scan.firstNonFinite < particles.positions.size()) {
+        throw ParameterError(particle_index_internal::nonFinitePositionMessage(scan.firstNonFinite) +
                              ", which a .vdb points grid cannot hold" + suffix);
     }
+    return double(scan.maxAbs());
 }
 
-/// makePointDataGrid() of positions requirePlaceablePositions() has passed.
+/// makePointDataGrid() of positions requirePlaceablePositions() has passed, @a largest
+/// their largest |coordinate|.
 openvdb::GridBase::Ptr
-pointDataGridOfFinitePositions(const ParticleSet& particles, double voxelSize)
+pointDataGridOfFinitePositions(const ParticleSet& particles, double voxelSize, double largest)
 {
     openvdb::initialize();
     std::vector<openvdb::Vec3R> positions(particles.positions.begin(), particles.positions.end());
     const openvdb::points::PointAttributeVector<openvdb::Vec3R> wrapper(positions);
-    if (std::isnan(voxelSize) || voxelSize == -HUGE_VAL) {  // they picked one, as 0 does
+    // OpenVDB's own message for +inf is an ArithmeticError, not a nonbloppy::Error; NaN and
+    // -inf picked a size, as 0 does.
+    if (!std::isfinite(voxelSize)) {
         std::ostringstream msg;
         msg << "--voxel-size must be finite, got " << voxelSize;
         throw ParameterError(msg.str());
@@ -446,21 +451,10 @@ pointDataGridOfFinitePositions(const ParticleSet& particles, double voxelSize)
     if (!(voxelSize > 0.0)) {
         voxelSize = positions.size() > 1 ? double(openvdb::points::computeVoxelSize(wrapper, 8)) : 1.0;
     } else {
-        // OpenVDB's own message for these is an ArithmeticError, not a nonbloppy::Error.
-        if (!std::isfinite(voxelSize)) throw ParameterError("--voxel-size must be finite, got inf");
         openvdb_scale_internal::requireOpenVdbScale(voxelSize, kMinCellSize, "--voxel-size");
     }
     // Voxel coordinates are 32-bit: past them particles far apart shared voxel -2^31 (bug hunt).
-    double largest = 0.0;
-    for (const openvdb::Vec3R& p : positions) {
-        for (int axis = 0; axis < 3; ++axis) largest = std::max(largest, std::abs(p[axis]));
-    }
-    if (largest / voxelSize > openvdb_scale_internal::kMaxIndexCoordinate) {
-        std::ostringstream msg;
-        msg << "particle coordinates up to " << largest << " are too far from the origin for a voxel size of "
-            << voxelSize << " (32-bit index space)";
-        throw ParameterError(msg.str());
-    }
+    openvdb_scale_internal::requireIndexRange(largest, voxelSize, "particle", "voxel size");
     const auto transform = openvdb::math::Transform::createLinearTransform(voxelSize);
     const auto index = openvdb::tools::createPointIndexGrid<PointIndexGrid>(wrapper, *transform);
     auto grid = openvdb::points::createPointDataGrid<openvdb::points::NullCodec, PointDataGrid>(
@@ -513,8 +507,8 @@ openvdb::GridBase::Ptr
 makePointDataGrid(const ParticleSet& particles, double voxelSize)
 {
     requireSizes(particles, "");
-    requirePlaceablePositions(particles, "");
-    return pointDataGridOfFinitePositions(particles, voxelSize);
+    const double largest = requirePlaceablePositions(particles, "");
+    return pointDataGridOfFinitePositions(particles, voxelSize, largest);
 }
 
 void
@@ -523,13 +517,13 @@ writeParticles(const ParticleSet& particles, const std::string& path, const Part
     const std::string ext = requireParticleOutput(path);
     requireSizes(particles, " (" + path + ")");
     if (ext == ".vdb") {
-        requirePlaceablePositions(particles, " (" + path + ")");
+        const double largest = requirePlaceablePositions(particles, " (" + path + ")");
         try {
             for (const ParticleAttribute& a : particles.attributes) io_internal::requireInt64Values(a, "a .vdb stores");
         } catch (const ParameterError& e) {
             throw ParameterError(e.what() + (" (" + path + ")"));  // named as the other refusals are
         }
-        writeVdb({pointDataGridOfFinitePositions(particles, 0.0)}, path);
+        writeVdb({pointDataGridOfFinitePositions(particles, 0.0, largest)}, path);
         return;
     }
     writeFileAtomically(path, [&](std::ostream& os) {
