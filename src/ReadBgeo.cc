@@ -10,7 +10,8 @@
 ///
 /// everything big-endian. Primitives and the rest that follows the points are ignored.
 /// Newer Houdini `.bgeo` files are JSON-based (binary JSON starts with byte 0x7f, text
-/// JSON with '['); they are reported as unsupported rather than misread.
+/// JSON with '['); they are reported as unsupported rather than misread, with the name
+/// under which Houdini writes the classic layout, `.bhclassic`.
 ///
 /// The file is read through a StreamReader (a bounded buffer, gzip inflated on the fly)
 /// and the points are decoded from it straight into the final arrays. An uncompressed
@@ -107,7 +108,7 @@ parseBgeo(StreamReader& stream, const std::string& path)
 {
     if (stream.ensure(1) && (stream.here()[0] == 0x7f || stream.here()[0] == '[' || stream.here()[0] == '{')) {
         fail(path, "unsupported BGEO version (JSON-based, Houdini 12 or later); "
-                   "only the classic binary BgeoV layout is read");
+                   "only the classic binary BgeoV layout is read: write the cache as .bhclassic");
     }
     if (!stream.ensure(5) || std::memcmp(stream.here(), "BgeoV", 5) != 0) {
         fail(path, "not a BGEO file (no 'BgeoV' magic)");

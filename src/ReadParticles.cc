@@ -524,20 +524,49 @@ readXyzParticles(const std::string& path)
 const char* const kParticleExtensions =
     ".vtk, .vtu, .vtp, .ply, .xyz, .bgeo, .vdb, .csv, .txt or .json";
 
+/// The extension that picks @a path's reader, lower case: lowerExtension(), except that the
+/// names Houdini gives its classic binary geometry pick ".bgeo": `.bhclassic` (what Houdini
+/// 12 and later write it as; their own `.bgeo` is JSON-based) and the gzip-compressed
+/// `.bgeo.gz` and `.bhclassic.gz` (the reader tells gzip from the bytes).
+std::string readerExtension(const std::string& path)
+{
+    using io_internal::lowerExtension;
+    std::string ext = lowerExtension(path);
+    if (ext == ".gz") {
+        const std::string inner = lowerExtension(path.substr(0, path.size() - 3));
+        if (inner == ".bgeo" || inner == ".bhclassic") return ".bgeo";
+    }
+    return ext == ".bhclassic" ? ".bgeo" : ext;
+}
+
+/// What to do with a Houdini geometry file nonbloppy does not read, said after the
+/// unknown-extension error; empty for other names. Houdini's default cache, `.bgeo.sc`, is
+/// JSON-based geometry compressed with Blosc, and `.geo`/`.hclassic` are ASCII.
+std::string houdiniAdvice(const std::string& path)
+{
+    using io_internal::lowerExtension;
+    const std::string ext = lowerExtension(path);
+    const std::string inner = ext == ".sc" || ext == ".gz" ? lowerExtension(path.substr(0, path.size() - ext.size())) : ext;
+    if (inner != ".bgeo" && inner != ".bhclassic" && inner != ".geo" && inner != ".hclassic") return std::string();
+    return std::string(ext == ".sc" ? ": Houdini's Blosc-compressed geometry is not read" : ": Houdini's ASCII geometry is not read")
+           + "; write the cache as .bhclassic (Houdini's classic binary geometry)";
+}
+
 } // namespace
 
 ParticleSet
 readParticles(const std::string& path)
 {
     using namespace io_internal;
-    const std::string ext = lowerExtension(path);
+    const std::string ext = readerExtension(path);
     if (ext.empty()) {
         throw FileError("particle file name has no extension (" + path +
             "); expected " + kParticleExtensions);
     }
     if (!isParticleFile(path)) {
-        throw FileError("unknown particle file extension '" + ext + "' (" + path +
-            "); expected " + kParticleExtensions);
+        const std::string advice = houdiniAdvice(path);
+        throw FileError("unknown particle file extension '" + ext + "' (" + path + ")" +
+            (advice.empty() ? std::string("; expected ") + kParticleExtensions : advice));
     }
 
     ParticleSet particles;
@@ -575,7 +604,7 @@ readParticles(const std::string& path)
 bool
 isParticleFile(const std::string& path)
 {
-    const std::string ext = io_internal::lowerExtension(path);
+    const std::string ext = readerExtension(path);
     return ext == ".vtk" || ext == ".ply" || ext == ".xyz" || ext == ".bgeo" || ext == ".vtu"
         || ext == ".vtp" || ext == ".csv" || ext == ".txt" || ext == ".json" || ext == ".vdb";
 }

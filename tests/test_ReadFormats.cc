@@ -156,6 +156,35 @@ TEST_F(ReadFormatsTest, BgeoUncompressedReadsTheSame)
     expectSameParticles(readParticles(plain), readParticles(gz));
 }
 
+// Houdini 12 and later write the classic layout as .bhclassic (their .bgeo is JSON-based),
+// and gzip it under .gz; .bgeo.sc (Blosc, Houdini's default cache) and ASCII .geo are not
+// read, and the message says which name to write instead.
+TEST_F(ReadFormatsTest, BgeoUnderHoudiniClassicNames)
+{
+    const std::string gz = dataPath("dam_break_frame_9_6859_particles.bgeo");
+    const ParticleSet expected = readParticles(gz);
+    const std::string bytes = readBytes(gz);
+    for (const char* name : {"frame.bhclassic", "frame.bgeo.gz", "frame.BHCLASSIC.GZ", "frame.0009.bhclassic.gz"}) {
+        const std::string path = write(name, bytes);
+        EXPECT_TRUE(nonbloppy::isParticleFile(path)) << name;
+        expectSameParticles(readParticles(path), expected);
+    }
+    const std::string plain = write("plain.bhclassic", gunzipBytes(bytes));
+    expectSameParticles(readParticles(plain), expected);
+
+    const std::string blosc = write("frame.bgeo.sc", bytes);
+    EXPECT_FALSE(nonbloppy::isParticleFile(blosc));
+    EXPECT_EQ(fileErrorOf(blosc), "unknown particle file extension '.sc' (" + blosc + "): Houdini's Blosc-compressed "
+                                  "geometry is not read; write the cache as .bhclassic (Houdini's classic binary geometry)");
+    const std::string ascii = write("frame.geo", "PGEOMETRY V5\n");
+    EXPECT_EQ(fileErrorOf(ascii), "unknown particle file extension '.geo' (" + ascii + "): Houdini's ASCII geometry "
+                                  "is not read; write the cache as .bhclassic (Houdini's classic binary geometry)");
+    const std::string tarball = write("frame.tar.gz", bytes);
+    EXPECT_FALSE(nonbloppy::isParticleFile(tarball));
+    EXPECT_EQ(fileErrorOf(tarball), "unknown particle file extension '.gz' (" + tarball + "); expected .vtk, .vtu, "
+                                    ".vtp, .ply, .xyz, .bgeo, .vdb, .csv, .txt or .json");
+}
+
 TEST_F(ReadFormatsTest, BgeoTruncatedCorruptAndUnsupported)
 {
     const std::string raw = gunzipBytes(readBytes(dataPath("dam_break_frame_9_6859_particles.bgeo")));
@@ -183,10 +212,10 @@ TEST_F(ReadFormatsTest, BgeoTruncatedCorruptAndUnsupported)
     EXPECT_EQ(fileErrorOf(version6), "unsupported BGEO version (6) (" + version6 + ")");
     const std::string json = write("json.bgeo", "[\"fileversion\",\"19.0.383\",\"hasindex\",false]");
     EXPECT_EQ(fileErrorOf(json), "unsupported BGEO version (JSON-based, Houdini 12 or later); only "
-                                 "the classic binary BgeoV layout is read (" + json + ")");
+                                 "the classic binary BgeoV layout is read: write the cache as .bhclassic (" + json + ")");
     const std::string binaryJson = write("bjson.bgeo", std::string("\x7fNSJb", 5) + "\x01");
-    EXPECT_EQ(fileErrorOf(binaryJson), "unsupported BGEO version (JSON-based, Houdini 12 or later); "
-                                       "only the classic binary BgeoV layout is read (" + binaryJson + ")");
+    EXPECT_EQ(fileErrorOf(binaryJson), "unsupported BGEO version (JSON-based, Houdini 12 or later); only the "
+                                       "classic binary BgeoV layout is read: write the cache as .bhclassic (" + binaryJson + ")");
     const std::string other = write("other.bgeo", "hello world");
     EXPECT_EQ(fileErrorOf(other), "not a BGEO file (no 'BgeoV' magic) (" + other + ")");
 }

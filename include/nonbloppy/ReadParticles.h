@@ -19,7 +19,10 @@
 /// - `.xyz`  raw little-endian float32 triples, no header.
 /// - `.bgeo` Houdini classic binary geometry (`BgeoV` version 5, as Partio and SPlisHSPlasH
 ///           write it), gzip-compressed or not; float, int, vector and index point
-///           attributes. JSON-based `.bgeo` (Houdini 12+) is rejected as unsupported.
+///           attributes. Also under the names Houdini 12 and later write that layout as,
+///           `.bhclassic`, and gzipped, `.bgeo.gz` and `.bhclassic.gz`. Their own `.bgeo`
+///           is JSON-based and rejected as unsupported, as are `.bgeo.sc` (Blosc) and the
+///           ASCII `.geo`; the messages name `.bhclassic` instead.
 /// - `.vtu`, `.vtp`  VTK XML UnstructuredGrid / PolyData: ascii, inline base64 and appended
 ///           (raw or base64) arrays, zlib-compressed or not, UInt32/UInt64 headers, either
 ///           byte order, Float32/Float64 points; every PointData array in its type.
@@ -72,7 +75,8 @@ namespace nonbloppy {
 /// Thread-safe: yes (no shared state).
 NONBLOPPY_API ParticleSet readParticles(const std::string& path);
 
-/// True if @a path has an extension readParticles() understands.
+/// True if @a path has an extension readParticles() understands (`.bhclassic`, `.bgeo.gz`
+/// and `.bhclassic.gz` included).
 NONBLOPPY_API bool isParticleFile(const std::string& path);
 
 } // namespace nonbloppy

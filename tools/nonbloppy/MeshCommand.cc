@@ -1038,7 +1038,7 @@ Command setupMeshCommand(CLI::App& parent)
         "so that a flat block of fluid gets its surface s/2 outside the outer particles.");
 
     cmd->add_option("IN", o.input,
-        "Particle file (.vtk, .vtu, .ply, .bgeo, .vdb, .csv, .xyz: binary float32 triples, ...), or a sequence: fluid_{}.vtk, fluid_####.vtk, "
+        "Particle file (.vtk, .vtu, .ply, classic .bgeo or .bhclassic, .vdb, .csv, .xyz: binary float32 triples, ...), or a sequence: fluid_{}.vtk, fluid_####.vtk, "
         "fluid_%04d.vtk")
         ->required()->group(kGroupInputOutput);
     cmd->add_option("-o,--output", o.output,
