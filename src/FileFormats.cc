@@ -818,7 +818,8 @@ public:
 
     /// Whether parse() reached a POLYGONS section header declaring at least one polygon
     /// (true even if the section's data then failed to decode).
-    bool sawPolygons() const { return mSawPolygons; }
+    /// Whether the file declares polygons (an empty mesh included) so far.
+    bool sawPolygons() const { return mSawPolygons || (mSawEmptyPolygons && mPointCount == 0); }
 
     VtkData parse()
     {
@@ -991,6 +992,7 @@ private:
         mReader->requireRoom(3 * n, type, "POINTS section");
         static_assert(sizeof(openvdb::Vec3f) == 12, "Vec3f must be three packed floats");
         mData.points.resize(size_t(n));
+        mPointCount = n;
         mReader->readFloats(size_t(3 * n), type, "POINTS section",
             reinterpret_cast<float*>(mData.points.data()));
     }
@@ -1006,6 +1008,9 @@ private:
         const std::string section = key + " section";
         // VTK 5 counts offsets, one more than the cells: "POLYGONS 1 0" holds none (review).
         const bool offsetsFollow = mInput.peekWord("OFFSETS");
+        // A POLYGONS section of no polygon declares an empty mesh when there are no points
+        // either (as writeMesh() writes one); next to particles it says nothing.
+        if (key == "POLYGONS") mSawEmptyPolygons = true;
         if (n > (offsetsFollow ? 1u : 0u)) {
             if (key == "POLYGONS") mSawPolygons = true;
             const bool surface = key == "POLYGONS" || key == "LINES" || key == "TRIANGLE_STRIPS";
@@ -1150,6 +1155,8 @@ private:
     uint64_t mTupleCount = 0;
     VtkData mData;
     bool mSawPolygons = false;
+    bool mSawEmptyPolygons = false;  ///< a POLYGONS section, maybe of no polygon
+    uint64_t mPointCount = 0;        ///< of the POINTS section (parse() moves mData out)
 };
 
 } // namespace
@@ -1454,10 +1461,16 @@ public:
     bool declaresFaces()
     {
         readHeader();
+        bool faceElement = false;
+        uint64_t vertices = 0;
         for (const PlyElement& element : mElements) {
             if (element.name == "face" && element.count > 0) return true;
+            if (element.name == "face") faceElement = true;
+            if (element.name == "vertex") vertices = element.count;
         }
-        return false;
+        // An empty face element with vertices is a point cloud (MeshLab writes them so);
+        // without vertices, an empty mesh (as writeMesh() writes one).
+        return faceElement && vertices == 0;
     }
 };
 

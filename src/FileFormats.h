@@ -341,7 +341,8 @@ VtkData parseVtk(const char* data, size_t size, const std::string& path, bool wa
 VtkData parseVtk(ByteInput& input, const std::string& path, bool wantPolygons);
 
 /// Whether a legacy VTK file has a POLYGONS section header declaring at least one polygon,
-/// however broken the file is after it (false when it breaks before).
+/// however broken the file is after it (false when it breaks before), or one of no polygon
+/// in a file without points (an empty mesh).
 bool vtkDeclaresPolygons(const char* data, size_t size, const std::string& path);
 
 /// What parsePly() found in a PLY file.
@@ -396,8 +397,9 @@ protected:
 /// the face element's vertex_indices (or vertex_index) list when @a wantFaces.
 PlyData parsePly(const char* data, size_t size, const std::string& path, bool wantFaces);
 
-/// Whether a PLY header declares a face element of at least one face (false when the
-/// header cannot be read); reads the header only.
+/// Whether a PLY header declares a face element of at least one face, or any face element
+/// and no vertices (an empty mesh; false when the header cannot be read); reads the header
+/// only.
 bool plyDeclaresFaces(const char* data, size_t size, const std::string& path);
 
 /// The values of a 1- or 3-component array as floats (for positions and normals).

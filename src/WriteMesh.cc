@@ -308,6 +308,14 @@ writeObj(const SurfaceMesh& mesh, const PolygonView& polygons, std::ostream& os)
     out.flush();
 }
 
+/// Whether the PLY and VTK writers declare normals: when the mesh has them, and when it has
+/// no vertices, so that a sequence's empty frames (before the fluid arrives, say) declare
+/// the columns its other frames have (a pipeline's meshes have normals).
+bool declaresNormals(const SurfaceMesh& mesh)
+{
+    return !mesh.normals.empty() || mesh.points.empty();
+}
+
 /// The names the writer of extension @a ext (lower case, with the dot) gives the mesh's
 /// attributes, one per attribute in order: in the particle writers' alphabet, distinct from
 /// one another and from the format's own columns (PLY: x, y, z and, with normals, nx, ny,
@@ -318,7 +326,7 @@ attributeNamesFor(const SurfaceMesh& mesh, const std::string& ext)
     using namespace attribute_names_internal;
     std::vector<NamedAttribute> attributes;
     for (const MeshAttribute& a : mesh.attributes) attributes.emplace_back(a.name, a.components);
-    const bool withNormals = !mesh.normals.empty();
+    const bool withNormals = declaresNormals(mesh);
     if (ext == ".ply") {
         return uniqueNames(attributes, headerWord, plyColumns, [withNormals](const std::string& column) {
             return column == "x" || column == "y" || column == "z"
@@ -345,7 +353,7 @@ writePly(const SurfaceMesh& mesh, const PolygonView& polygons, const std::string
          std::ostream& os)
 {
     requireInt32(mesh.points.size(), "vertices", path);
-    const bool withNormals = !mesh.normals.empty();
+    const bool withNormals = declaresNormals(mesh);
     ChunkWriter out(os);
     out.text("ply\nformat binary_little_endian 1.0\ncomment written by nonbloppy\n");
     out.text("element vertex " + std::to_string(mesh.points.size()) + "\n");
@@ -395,10 +403,11 @@ writeVtk(const SurfaceMesh& mesh, const PolygonView& polygons, const std::string
         std::to_string(polygons.polygonCount() + polygons.cornerCount()) + "\n");
     writePolygonRecords</*BigEndian=*/true, int32_t>(out, polygons);
     out.text("\n");
-    if (!mesh.normals.empty() || !mesh.attributes.empty()) {
+    const bool withNormals = declaresNormals(mesh);
+    if (withNormals || !mesh.attributes.empty()) {
         out.text("POINT_DATA " + std::to_string(mesh.points.size()) + "\n");
     }
-    if (!mesh.normals.empty()) {
+    if (withNormals) {
         out.text("NORMALS normals float\n");
         writeRecords(out, mesh.normals.size(), 12, [&](size_t i, char* at) { putVec3(at, mesh.normals[i]); });
         out.text("\n");

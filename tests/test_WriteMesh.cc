@@ -842,6 +842,18 @@ TEST_F(WriteMeshTest, MeshFilesDeclareTheirPolygonsHoweverBrokenTheRestIs)
                                     "property float z\nelement face 0\nproperty list uchar int vertex_indices\n"
                                     "end_header\n0 0 0\n");
     EXPECT_FALSE(declaresPolygons(path("noFaces.ply")));
+    // An empty mesh is a mesh (and an empty VTK particle file is not).
+    for (const char* ext : {".ply", ".vtk"}) {
+        const std::string empty = path(std::string("empty") + ext);
+        writeMesh(SurfaceMesh(), empty);
+        EXPECT_TRUE(declaresPolygons(empty)) << ext;
+        EXPECT_EQ(readMesh(empty).points.size(), 0u) << ext;
+    }
+    writeBytes(path("noPoints.vtk"), "# vtk DataFile Version 3.0\nx\nASCII\nDATASET POLYDATA\nPOINTS 0 float\n");
+    EXPECT_FALSE(declaresPolygons(path("noPoints.vtk")));
+    writeBytes(path("emptyCells.vtk"), "# vtk DataFile Version 3.0\nx\nASCII\nDATASET POLYDATA\nPOINTS 1 float\n0 0 0\n"
+                                       "POLYGONS 0 0\n");
+    EXPECT_FALSE(declaresPolygons(path("emptyCells.vtk")));
     EXPECT_EQ(messageOf<FileError>([&] { declaresPolygons(path("missing.ply")); }).rfind("cannot open ", 0), 0u);
     // A missing OBJ file was declared a mesh.
     EXPECT_EQ(messageOf<FileError>([&] { declaresPolygons(path("missing.obj")); }),

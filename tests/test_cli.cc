@@ -615,6 +615,16 @@ TEST_F(CliTest, EmptyMeshIsWrittenWithAWarning)
     EXPECT_EQ(r.err, "nonbloppy: warning: " + out("empty.obj")
                          + " is empty: the density of the 2366 particles nowhere reaches --threshold 1e+30\n");
     EXPECT_TRUE(fs::exists(out("empty.obj")));
+    // PLY and VTK declare the normals a non-empty mesh has, and inspect calls them meshes.
+    for (const std::string name : {"empty.ply", "empty.vtk"}) {
+        ASSERT_EQ(run("mesh " + quote(kCube) + " -q -o " + quote(out(name)) + " --threshold 1e30").exitCode, 0);
+        const std::string bytes = readText(out(name));
+        EXPECT_NE(bytes.find(name == "empty.ply" ? "property float nx\n" : "NORMALS normals float\n"), std::string::npos)
+            << bytes;
+        const RunResult inspect = run("inspect " + quote(out(name)));
+        EXPECT_EQ(inspect.exitCode, 0) << inspect.err;
+        EXPECT_EQ(inspect.out.rfind(out(name) + ": mesh\n  vertices         0\n", 0), 0u) << inspect.out;
+    }
     const RunResult normal = run("mesh " + quote(kCube) + " -q -o " + quote(out("cube.obj")));
     EXPECT_EQ(normal.err, "");
 }

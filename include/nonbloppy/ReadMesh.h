@@ -27,7 +27,8 @@ NONBLOPPY_API SurfaceMesh readMesh(const std::string& path);
 
 /// Whether @a path is a mesh by its own declaration, however broken its data: an OBJ file,
 /// a PLY file whose header declares at least one face, or a legacy VTK file with a
-/// POLYGONS section header of at least one polygon. PLY and VTK hold particles too; this
+/// POLYGONS section header of at least one polygon; also an empty mesh as writeMesh()
+/// writes one (no vertices, and an empty face element or POLYGONS section). PLY and VTK hold particles too; this
 /// tells a broken mesh (for readMesh() to report) from a particle file, which a failing
 /// readMesh() cannot.
 /// @throw FileError if the file cannot be opened. Cost: PLY reads the header, VTK decodes

@@ -34,7 +34,9 @@ struct MeshWriteSettings
 /// failed or interrupted write never leaves a partial file.
 /// Output is byte-identical for identical meshes: OBJ coordinates use the shortest decimal
 /// text that reads back as the same float (std::to_chars), and nothing depends on time.
-/// Normals are written only when mesh.normals is non-empty.
+/// Normals are written only when mesh.normals is non-empty; PLY and VTK also declare them
+/// (with no values) for a mesh without vertices, so that the empty frames of a sequence
+/// declare the columns its other frames have.
 /// Per-vertex attributes (mesh.attributes, see interpolateAttributes()) are written as PLY
 /// float vertex properties ("density"; a 3-vector "velocity" as velocity_x, velocity_y,
 /// velocity_z) and as VTK POINT_DATA (VECTORS for 3 components, SCALARS for 1, 2 or 4, a
