@@ -299,14 +299,16 @@ double cancellation_internal::calibrateRelaxedThreshold(double effectiveRadiusOv
     // relaxations (large c·t) stop there and end inside (preserveVolume() can finish).
     constexpr double kScanStep = 0.05, kMaxStart = 1.5;
     const double limit = std::min(kMaxStart, 0.75 * ratio);
+    // The limit itself is tried too: the scan gave up on reaching it untried, and c = 0.5,
+    // t = 2, r_e = 2 s, which relaxes a start at 1.5 to 0.5009, fell back for that (bug hunt).
     double low = 0.5, high = 0.5;
     while (relaxedHeight(ratio, blend, maxStep, iterations, high, poll) < 0.5) {
-        low = high;
-        high += kScanStep;
         if (high >= limit) {
             if (reachesSurface) *reachesSurface = false;
             return cancellation_internal::requireCalibratedThreshold(planeDensity(ratio, limit, poll), ratio);
         }
+        low = high;
+        high = std::min(high + kScanStep, limit);
     }
     for (int step = 0; step < 24; ++step) {
         const double middle = 0.5 * (low + high);

@@ -181,6 +181,30 @@ TEST(Fidelity, RelaxedThresholdEndsAFlatFaceHalfASpacingOutside)
     EXPECT_NEAR(meanHeight, spacing / 2, 0.03 * spacing);
 }
 
+TEST(Fidelity, RelaxationThatReachesFromTheStartLimitIsCalibrated)
+{
+    // c = 0.5, t = 2 relaxes a face that starts at the limit, 1.5 s out, to just past s/2:
+    // the scan gave up before trying the limit itself, warned that the faces end inside and
+    // fell back to starting there (bug hunt). The face of a slab lands at s/2.
+    const double spacing = 0.1;
+    const auto slab = detail::lattice(spacing, 16, [](int i, int j, int k) {
+        return std::abs(i) <= 15 && std::abs(j) <= 15 && k <= 0 && k >= -7;
+    }, 0.0, 1);
+    SurfaceParameters params;
+    params.blend = 0.5;
+    params.iterations = 2;
+    const SurfaceResult result = buildSurface(slab, params);
+    EXPECT_TRUE(result.parameters.thresholdReachesSurface);
+    const auto [meanHeight, count] = nonbloppy_test::meanTopHeight(result.mesh.points);
+    ASSERT_GT(count, 50);
+    EXPECT_NEAR(meanHeight, spacing / 2, 0.03 * spacing);
+    bool reaches = false;
+    calibrateRelaxedThreshold(2.0, 0.5, 2, &reaches, kDefaultMaxStepOverSpacing);
+    EXPECT_TRUE(reaches);
+    calibrateRelaxedThreshold(2.0, 0.5, 3, &reaches, kDefaultMaxStepOverSpacing);  // beyond reach
+    EXPECT_FALSE(reaches);
+}
+
 TEST(Fidelity, RelaxedThresholdIsTheBlobThresholdWithoutRelaxation)
 {
     EXPECT_EQ(calibrateRelaxedThreshold(2.0, 0.3, 0), calibrateThreshold(2.0));
