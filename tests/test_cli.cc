@@ -691,6 +691,16 @@ TEST_F(CliTest, AFailedVdbWriteLeavesTheEarlierMeshInPlace)
     EXPECT_EQ(r.err, "nonbloppy: cannot write /proc/nonbloppy.vdb: No such file or directory\n");
     EXPECT_EQ(readText(mesh), before);
     EXPECT_EQ(listDir(out("")), std::vector<std::string>{"keep.obj"});  // no link to the old file left
+    // An output name too long for the link's usual name beside it (bug hunt: the link
+    // failed, and the old mesh was lost).
+    const std::string longName = std::string(250, 'm') + ".obj";
+    fs::rename(mesh, out(longName));
+    const RunResult again = run("mesh " + quote(kCube) + " -q -c 0.1 -o " + quote(out(longName)) +
+                                " --vdb /proc/nonbloppy.vdb");
+    EXPECT_EQ(again.exitCode, 1);
+    EXPECT_EQ(readText(out(longName)), before);
+    EXPECT_EQ(listDir(out("")), std::vector<std::string>{longName});
+    fs::rename(out(longName), mesh);
     // A first run that fails the same way leaves nothing.
     fs::remove(mesh);
     EXPECT_EQ(run("mesh " + quote(kCube) + " -q -o " + quote(mesh) + " --vdb /proc/nonbloppy.vdb").exitCode, 1);

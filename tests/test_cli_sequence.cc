@@ -441,6 +441,24 @@ TEST_F(CliSequenceTest, ARunWithoutFramesReplacesAnEarlierLog)
     const std::string frame1 = in("fluid_0001.vtk"), before = readText(frame1);
     EXPECT_EQ(run(base + " --frames 5 --log " + quote(frame1)).exitCode, 1);
     EXPECT_EQ(readText(frame1), before);
+    // Nor when the frames exist but the outputs are refused before the first one (bug hunt:
+    // the earlier log was left): a missing directory, an output that is an input.
+    writeText(log, "{\"summary\": true, \"frames_done\": 1}\n");
+    const std::string missing = "mesh " + quote(in("fluid_{}.vtk")) + " -o " + quote(out("nodir/m_{}.obj"));
+    const RunResult refused = run(missing + " --log " + quote(log));
+    EXPECT_EQ(refused.exitCode, 1);
+    EXPECT_EQ(refused.err, "nonbloppy: cannot write " + out("nodir/m_0001.obj") + ": No such file or directory\n");
+    EXPECT_NE(readText(log).find("\"frames_done\": 0, \"error\": \"cannot write " + out("nodir/m_0001.obj")),
+              std::string::npos) << readText(log);
+    writeText(log, "{\"summary\": true, \"frames_done\": 1}\n");
+    const RunResult clash = run("mesh " + quote(in("fluid_{}.vtk")) + " -o " + quote(in("fluid_{}.vtk")) + " --log " + quote(log));
+    EXPECT_EQ(clash.exitCode, 2);
+    EXPECT_NE(readText(log).find("\"frames_done\": 0"), std::string::npos) << readText(log);
+    // ... but not over an output: its rename would replace the log, and the run is refused.
+    const std::string mesh1 = out("m_0001.obj");
+    writeText(mesh1, "earlier mesh\n");
+    EXPECT_EQ(run(base + " --log " + quote(mesh1)).exitCode, 2);
+    EXPECT_EQ(readText(mesh1), "earlier mesh\n");
 }
 
 TEST_F(CliSequenceTest, EveryCountIsOfTheFramesAskedFor)

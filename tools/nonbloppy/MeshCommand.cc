@@ -829,12 +829,14 @@ void requireOutputsApart(const FramePattern& input, const std::vector<Frame>& se
     }
 }
 
-/// For a run that ends before its first frame for want of frames (none of them on disk, two
-/// files for one frame): replace the --log with one summary line naming the error, so that a
-/// log an earlier run left there is not read as this run's. Left alone when the log names an
-/// input of the sequence (or the directory cannot be read to tell); a log that cannot be
-/// written is not reported over @a error.
-void logEarlyFailure(const MeshOptions& o, const FramePattern& input, const std::string& error)
+/// For a run that ends before its first frame (no frames on disk, two files for one frame,
+/// an output that cannot be written or would clash with an input): replace the --log with
+/// one summary line naming the error, so that a log an earlier run left there is not read as
+/// this run's. Left alone when the log names an input of the sequence or one of @a jobs'
+/// outputs (or the directory cannot be read to tell); a log that cannot be written is not
+/// reported over @a error.
+void logEarlyFailure(const MeshOptions& o, const FramePattern& input, const std::string& error,
+                     const std::vector<BatchJob>& jobs = {})
 {
     if (o.logPath.empty()) return;
     try {
@@ -842,6 +844,11 @@ void logEarlyFailure(const MeshOptions& o, const FramePattern& input, const std:
         for (const Frame& frame : findFrames(input)) {
             if (fileIdentity(frame.input) == log) return;
             if (!frame.otherInput.empty() && fileIdentity(frame.otherInput) == log) return;
+        }
+        for (const BatchJob& job : jobs) {
+            for (const std::string& output : job.outputs) {
+                if (fileIdentity(output) == log) return;
+            }
         }
     } catch (const std::exception&) {
         return;
@@ -888,9 +895,15 @@ int runSequence(const MeshOptions& o)
         if (!f.vdbPath.empty()) job.outputs.push_back(f.vdbPath);
         jobs.push_back(std::move(job));
     }
-    // Output extensions and directories, before any work.
-    validatePaths(optionsForFrame(o, plan.frames.front()));
-    requireOutputsApart(input, plan.onDisk, jobs, o.logPath);
+    // Output extensions and directories, before any work. Refused here, the run replaces its
+    // log too (bug hunt: an earlier run's summary was left, reading as this one's).
+    try {
+        validatePaths(optionsForFrame(o, plan.frames.front()));
+        requireOutputsApart(input, plan.onDisk, jobs, o.logPath);
+    } catch (const nonbloppy::Error& e) {
+        logEarlyFailure(o, input, e.what(), jobs);
+        throw;
+    }
 
     std::unique_ptr<tbb::global_control> threadLimit;
     if (o.threadsOpt->count() > 0) {

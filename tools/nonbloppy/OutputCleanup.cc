@@ -6,6 +6,7 @@
 
 #include "BackgroundRemover.h"
 
+#include <cerrno>
 #include <cstdio>
 #include <filesystem>
 #include <system_error>
@@ -34,6 +35,31 @@ std::string writtenFile(const std::string& path)
     return target.string();
 }
 
+/// Link @a target to a new name beside it and return that name ("" if no link could be
+/// made): `target.nonbloppy-old-<pid>`, or `.nonbloppy-old-<pid>` in the same directory
+/// where that name would be longer than the directory allows (an output name of about 235
+/// bytes or more), with -2, -3, ... appended while the name is taken (by a killed run of
+/// the same pid: containers reuse them). Both cases lost the old file on a failure: the
+/// link() failed, and the undo then only removed the new file (bug hunt).
+std::string linkBeside(const std::string& target)
+{
+    const size_t slash = target.rfind('/');
+    const std::string directory = slash == std::string::npos ? std::string() : target.substr(0, slash + 1);
+    const std::string suffix = "nonbloppy-old-" + std::to_string(::getpid());
+    const long maxName = ::pathconf(directory.empty() ? "." : directory.c_str(), _PC_NAME_MAX);
+    const size_t limit = maxName > 0 ? size_t(maxName) : 255;
+    constexpr size_t kCounterRoom = 4;  // "-100"
+    const size_t nameLength = target.size() - directory.size();
+    const std::string stem = nameLength + 1 + suffix.size() + kCounterRoom <= limit ? target + "." + suffix
+                                                                                     : directory + "." + suffix;
+    for (int attempt = 1; attempt <= 100; ++attempt) {
+        const std::string name = attempt == 1 ? stem : stem + "-" + std::to_string(attempt);
+        if (::link(target.c_str(), name.c_str()) == 0) return name;
+        if (errno != EEXIST) break;
+    }
+    return std::string();
+}
+
 } // namespace
 
 void OutputCleanup::willWrite(const std::string& path)
@@ -42,10 +68,7 @@ void OutputCleanup::willWrite(const std::string& path)
     // file that did not exist yet and leave the new file behind.
     Output output{writtenFile(path), "", false};
     struct stat existing{};
-    if (::stat(output.target.c_str(), &existing) == 0) {
-        const std::string backup = output.target + ".nonbloppy-old-" + std::to_string(::getpid());
-        if (::link(output.target.c_str(), backup.c_str()) == 0) output.backup = backup;
-    }
+    if (::stat(output.target.c_str(), &existing) == 0) output.backup = linkBeside(output.target);
     mOutputs.push_back(output);
 }
 
