@@ -713,6 +713,17 @@ TEST_F(CliTest, AFailedVdbWriteLeavesTheEarlierMeshInPlace)
     EXPECT_TRUE(fs::is_symlink(fs::symlink_status(out("link.obj"))));
 }
 
+TEST_F(CliTest, AnOutputLinkedIntoAMissingDirectoryIsRefusedBeforeTheWork)
+{
+    // The check looked at the link's own directory; the writers follow the link, and the run
+    // failed only after meshing (bug hunt).
+    fs::create_symlink(out("nodir/x.vdb"), out("v.vdb"));
+    const RunResult r = run("mesh " + quote(kCube) + " -v -o " + quote(out("m.obj")) + " --vdb " + quote(out("v.vdb")));
+    EXPECT_EQ(r.exitCode, 1);
+    EXPECT_EQ(r.err, "nonbloppy: cannot write " + out("v.vdb") + ": No such file or directory\n");
+    EXPECT_EQ(listDir(out("")), std::vector<std::string>{"v.vdb"});
+}
+
 TEST_F(CliTest, ASuccessfulRunOverEarlierOutputsLeavesOnlyTheNewOnes)
 {
     // The replaced files lose their last link on a thread of their own (BackgroundRemover):

@@ -775,6 +775,24 @@ TEST_F(CliFormatsTest, ParticlesFarFromTheOriginAreWarnedOfTheirFloatStep)
     // At the origin, no warning.
     EXPECT_EQ(run("mesh " + quote(kData + "/cube_2366_particles.vtk") + " -q -o " + quote(mesh) + " --spacing 0.05").err,
               "");
+
+    // Particles in one plane, whose bounding box OpenVDB calls empty, went unwarned; so did
+    // any run without a spacing (r_e, r_0 and h given), now measured against h/8 (bug hunt).
+    nonbloppy::ParticleSet sheet;
+    for (int i = 0; i < 400; ++i) sheet.positions.emplace_back(1.0e5f + 0.05f * float(i % 20), 0.05f * float(i / 20), 1.0e5f);
+    nonbloppy::writeParticles(sheet, path("sheet.ply"));
+    const RunResult flat = run("mesh " + quote(path("sheet.ply")) + " -q -o " + quote(mesh) + " --spacing 0.05");
+    EXPECT_EQ(flat.exitCode, 0) << flat.err;
+    EXPECT_EQ(flat.err, "nonbloppy: warning: the particles reach 100001 from the origin, where float positions step by "
+                        "0.0078125, more than 1/16 of the spacing 0.05: the surface is quantized there; move the "
+                        "particles nearer the origin\n");
+    const RunResult noSpacing = run("mesh " + quote(far) + " -q -o " + quote(mesh) +
+                                    " --radius 0.1 --voxel-size 0.025 --threshold 3");
+    EXPECT_EQ(noSpacing.exitCode, 0) << noSpacing.err;
+    EXPECT_EQ(noSpacing.err, "nonbloppy: warning: the particles reach " + shown.str() +
+                                 " from the origin, where float positions step by 0.0078125, more than 1/8 of the "
+                                 "voxel size 0.025: the surface is quantized there; move the particles nearer the "
+                                 "origin\n");
 }
 
 TEST_F(CliFormatsTest, AttributesOfTheWrongShapeAreNamedAndNothingIsWritten)

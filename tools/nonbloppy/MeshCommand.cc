@@ -269,7 +269,9 @@ void requireWritableDirectory(const std::string& path)
     if (fs::exists(existing) && !fs::is_regular_file(existing)) {
         throw nonbloppy::FileError("cannot write " + path + ": not a regular file");
     }
-    fs::path dir = fs::path(path).parent_path();
+    // The directory of the file written: a link into a missing directory passed, and the
+    // run failed only after the work (bug hunt).
+    fs::path dir = fs::path(writtenFile(path)).parent_path();
     if (dir.empty()) dir = ".";
     std::error_code ec;
     const fs::file_status status = fs::status(dir, ec);
@@ -659,20 +661,25 @@ void warnIfFacesEndInside(const MeshOptions& o, const nonbloppy::ResolvedParamet
 /// collapse to points and vanish from the mesh. Warned when the step at the particles'
 /// farthest coordinate exceeds 1/16 of the spacing (from 8192 units out for s = 0.01). The
 /// particles, not the mesh: a part of the fluid that is lost leaves no vertex to tell.
+/// Without a spacing (r_e, r_0 and h all given) the voxel size stands for s/2, its default.
 void warnIfCoarseFloats(const nonbloppy::SurfaceResult& result, OnceWarnings& once)
 {
+    // Not BBoxd::empty(), which is true for particles in one plane (min == max on an axis):
+    // a flat sheet or a single particle went unwarned (bug hunt).
     const openvdb::BBoxd& bounds = result.particleBounds;
-    if (bounds.empty() || once.coarseFloats.load()) return;
+    if (result.particleCount == 0 || once.coarseFloats.load()) return;
     double farthest = 0.0;
     for (int k = 0; k < 3; ++k) farthest = std::max({farthest, std::abs(bounds.min()[k]), std::abs(bounds.max()[k])});
     const float atFarthest = float(farthest);  // exact: the bounds are float positions
     const double step = double(std::nextafter(atFarthest, std::numeric_limits<float>::infinity())) - farthest;
-    const double spacing = result.parameters.spacing;
-    if (!(spacing > 0.0) || !(step > spacing / 16.0) || once.coarseFloats.exchange(true)) return;
+    const double spacing = result.parameters.spacing, voxelSize = result.parameters.voxelSize;
+    const bool bySpacing = spacing > 0.0;
+    const double limit = bySpacing ? spacing / 16.0 : voxelSize / 8.0;
+    if (!(limit > 0.0) || !(step > limit) || once.coarseFloats.exchange(true)) return;
     std::cerr << "nonbloppy: warning: the particles reach " << formatNumber(farthest)
-              << " from the origin, where float positions step by " << formatNumber(step)
-              << ", more than 1/16 of the spacing " << formatNumber(spacing)
-              << ": the surface is quantized there" << (step >= spacing / 2.0 ? ", and droplets may vanish" : "")
+              << " from the origin, where float positions step by " << formatNumber(step) << ", more than "
+              << (bySpacing ? "1/16 of the spacing " + formatNumber(spacing) : "1/8 of the voxel size " + formatNumber(voxelSize))
+              << ": the surface is quantized there" << (step >= 8.0 * limit ? ", and droplets may vanish" : "")
               << "; move the particles nearer the origin" << std::endl;
 }
 
@@ -682,7 +689,7 @@ void warnIfEmpty(const nonbloppy::SurfaceResult& result, const std::string& outp
 {
     if (result.particleCount == 0 || !result.mesh.points.empty()) return;
     std::cerr << "nonbloppy: warning: " << output << " is empty: the density of the "
-              << result.particleCount << " particles nowhere reaches --threshold "
+              << result.particleCount << (result.particleCount == 1 ? " particle" : " particles") << " nowhere reaches --threshold "
               << formatNumber(result.parameters.threshold) << std::endl;
 }
 

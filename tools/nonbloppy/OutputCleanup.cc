@@ -16,11 +16,6 @@
 
 namespace nonbloppy_tool {
 
-namespace {
-
-/// The file a writer writes for @a path: symbolic links followed, also to a target that does
-/// not exist yet, as the library's writers (and a shell's '>') follow them. A loop of links
-/// stops at the 40th, where the writer fails anyway.
 std::string writtenFile(const std::string& path)
 {
     namespace fs = std::filesystem;
@@ -34,6 +29,8 @@ std::string writtenFile(const std::string& path)
     }
     return target.string();
 }
+
+namespace {
 
 /// Link @a target to a new name beside it and return that name ("" if no link could be
 /// made): `target.nonbloppy-old-<pid>`, or `.nonbloppy-old-<pid>` in the same directory

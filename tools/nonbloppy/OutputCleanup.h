@@ -12,6 +12,11 @@ namespace nonbloppy_tool {
 
 class BackgroundRemover;
 
+/// The file a writer writes for @a path: symbolic links followed, also to a target that does
+/// not exist yet, as the library's writers (and a shell's '>') follow them. A loop of links
+/// stops at the 40th, where the writer fails anyway.
+std::string writtenFile(const std::string& path);
+
 /// The outputs of one frame (or one conversion), put back as they were unless it succeeds.
 /// Each output is written atomically, but the mesh is in place before the .vdb is written:
 /// when that failed, removing the new mesh used to leave neither it nor the mesh an earlier
