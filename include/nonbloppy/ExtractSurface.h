@@ -26,7 +26,8 @@ namespace nonbloppy {
 /// volumeToMesh takes no interrupter, and stopping it through its TBB context is unsafe
 /// (its serial steps then size arrays from uninitialised counts: measured, up to 1.4·10⁹
 /// points allocated and zeroed). buildSurface() and SurfaceReconstructor therefore mesh
-/// their own density grids slab by slab, asking the interrupter in between; the result has
+/// their own density grids region by region (about SurfaceParameters::regionLeaves leaves
+/// each), asking the interrupter in between; the result has
 /// the same vertices and polygons as this function's, in another order.
 /// Thread-safety: reentrant; the grid is only read.
 /// @throw ParameterError if adaptivity lies outside [0,1], threshold is not finite or not

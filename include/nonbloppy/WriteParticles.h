@@ -36,8 +36,8 @@ struct ParticleWriteSettings
 ///           points, vertex cells, attributes in their types.
 /// - `.xyz`  raw little-endian float32 triples (attributes cannot be stored: dropped).
 /// - `.csv`  header "x,y,z,<name>" (multi-component: "<name>:0,<name>:1,...", as ParaView),
-///           shortest round-trip decimal text (whole floats as "300.0", so that they read
-///           back as floats, not integers).
+///           shortest round-trip decimal text (whole float attribute values as "300.0", so
+///           that they read back as floats, not integers; positions are always floats).
 /// - `.vdb`  one PointDataGrid named "points" (see makePointDataGrid()).
 /// Attribute names are written in the format's alphabet (spaces, commas, quotes, <, >, &
 /// and non-ASCII bytes become '_'; for `.vdb` all but letters, digits, '_', '|' and ':'),

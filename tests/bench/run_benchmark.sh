@@ -86,7 +86,7 @@ say "Input: \`tests/data/dam_break_frame_23_24389_particles.vtk\` tiled by \`non
 say "nonbloppy: \`mesh IN -o OUT.ply ${nb_args[*]}\`; vdb_tool: \`-points2ls voxel=0.025 radius=2 width=3 -ls2mesh adapt=0\`."
 say "Median of $runs runs each, in rounds over the inputs, the two tools alternating."
 say ""
-say "| input | particles | tool | wall s | CPU s | peak RSS MB | particles/s | wall ratio | RSS ratio |"
+say "| input | particles | tool | wall s | CPU s | peak RSS MiB | particles/s | wall ratio | RSS ratio |"
 say "| --- | --- | --- | --- | --- | --- | --- | --- | --- |"
 
 declare -A nb_wall nb_cpu pair_ratios
@@ -262,7 +262,7 @@ rm -f "$out"/sequence/out_*.ply
 say ""
 say "Sequences: $seq_frames frames of the 64x input in one call (\`mesh 'in_{}.ply' -o 'out_{}.ply' --frames 1-$seq_frames\`), median of $scan_runs runs, against $seq_frames single-frame runs (the 64x rows above):"
 say ""
-say "| $seq_frames frames of 64x | wall s | per frame s | peak RSS MB | per frame / one-frame run | per frame / vdb_tool run |"
+say "| $seq_frames frames of 64x | wall s | per frame s | peak RSS MiB | per frame / one-frame run | per frame / vdb_tool run |"
 say "| --- | --- | --- | --- | --- | --- |"
 vt64=$(median 1 "$out/vt_64")
 sequence_row() {  # sequence_row LABEL WALL RSS_KB

@@ -92,7 +92,7 @@ Command setupConvertCommand(CLI::App& parent)
     auto options = std::make_shared<ConvertOptions>();
     CLI::App* cmd = parent.add_subcommand(
         "convert", "Convert a particle file to another format, keeping its attributes");
-    cmd->footer("Reads .vtk, .vtu, .vtp, .ply, .xyz, .bgeo, .vdb (points), .csv, .txt, .json;\n"
+    cmd->footer("Reads .vtk, .vtu, .vtp, .ply, .xyz, .bgeo (also .bhclassic), .vdb (points), .csv, .txt, .json;\n"
                 "writes .ply, .vtk, .vtu, .xyz (positions only), .csv, .vdb (PointDataGrid).\n"
                 ".xyz is raw binary: little-endian float32 x y z triples (write text tables as .csv).");
     cmd->add_option("IN", options->input, "Particle file to read")->required()->group(kGroupInputOutput);

@@ -588,6 +588,8 @@ Command setupInspectCommand(CLI::App& parent)
 
     CLI::App* cmd = parent.add_subcommand(
         "inspect", "Describe a .vdb grid file, a mesh (.obj, .ply, .vtk) or a particle file");
+    cmd->footer("A .ply or .vtk file that declares faces is described as a mesh, other .ply and .vtk files\n"
+                "as particles; every particle format mesh reads is described.");
     cmd->add_option("FILE", options->path, "File to describe")
         ->required()->group(kGroupInputOutput);
     cmd->add_flag("--json", options->json, "Print one JSON object instead of text")

@@ -1077,7 +1077,7 @@ Command setupMeshCommand(CLI::App& parent)
     o.radiusOpt = cmd->add_option("--radius", o.radius,
         "Effective (kernel) radius r_e (default: 2 s)")->group(kGroupNumerical);
     o.thresholdOpt = cmd->add_option("--threshold", o.threshold,
-        "Density iso-value r_0 (default: calibrated from r_e/s)")->group(kGroupNumerical);
+        "Density iso-value r_0 (default: calibrated from r_e/s, c, t and --max-step; paper: from r_e/s)")->group(kGroupNumerical);
     o.voxelSizeOpt = cmd->add_option("--voxel-size", o.voxelSize,
         "Voxel size h of the density grid (default: s/2)")->group(kGroupNumerical);
     o.blendOpt = cmd->add_option("-c,--blend", o.blend,

@@ -183,6 +183,7 @@ int run(int argc, char** argv)
     std::string helpTopic;
     CLI::App* help = app.add_subcommand("help", "Print the options of COMMAND, or this list");
     help->add_option("COMMAND", helpTopic, "mesh, inspect or convert");
+    help->footer("");  // not the list's "Run 'nonbloppy help COMMAND' ...", which points back here
     commands.push_back({help, [&]() {
         if (helpTopic.empty()) {
             // Not app.help(): CLI11 hands that to the selected subcommand, "help" itself.
