@@ -461,6 +461,35 @@ TEST_F(CliSequenceTest, ARunWithoutFramesReplacesAnEarlierLog)
     EXPECT_EQ(readText(mesh1), "earlier mesh\n");
 }
 
+TEST_F(CliSequenceTest, OnATerminalWarningsEraseTheBarAndVerboseRunsDrawNone)
+{
+    // A warning (stderr) ran on after the bar (stdout) on the same terminal, and so did -v's
+    // progress lines (bug hunt). script(1) gives the run a terminal for both.
+    if (std::system("command -v script >/dev/null 2>&1") != 0) GTEST_SKIP() << "no script(1)";
+    makeFrames({kFree, kCube, kFree});
+    const std::string transcript = out("terminal.txt");
+    const auto onTerminal = [&](const std::string& options) {
+        const std::string command = quote(kCli) + " mesh " + quote(in("fluid_{}.vtk")) + " -o " +
+                                    quote(out("m_{}.obj")) + options;
+        const std::string shell = "script -qec " + quote(command) + " /dev/null >" + quote(transcript) + " 2>&1 </dev/null";
+        EXPECT_EQ(std::system(shell.c_str()), 0) << shell;
+        return readText(transcript);
+    };
+    const std::string barred = onTerminal("");
+    EXPECT_NE(barred.find("] 3/3 frames"), std::string::npos) << barred;
+    size_t warnings = 0;
+    for (size_t at = barred.find("nonbloppy: warning: "); at != std::string::npos;
+         at = barred.find("nonbloppy: warning: ", at + 1), ++warnings) {
+        ASSERT_GE(at, 4u);
+        EXPECT_EQ(barred.substr(at - 4, 4), "\r\033[K") << barred;
+    }
+    EXPECT_EQ(warnings, 1u) << barred;  // the spacing estimate moves
+    const std::string verbose = onTerminal(" -v");
+    EXPECT_EQ(verbose.find("] 1/3 frames"), std::string::npos) << verbose;
+    EXPECT_NE(verbose.find("frame 3 (3/3): "), std::string::npos) << verbose;
+    EXPECT_NE(verbose.find("[progress] frame 2: extract surface done"), std::string::npos) << verbose;
+}
+
 TEST_F(CliSequenceTest, EveryCountIsOfTheFramesAskedFor)
 {
     // stdout said "5 frames", the failure "2 of 3 frames failed" and the log "frames": 3.

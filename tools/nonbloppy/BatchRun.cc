@@ -60,7 +60,7 @@ class BatchState
 public:
     BatchState(const std::vector<BatchJob>& jobs, const BatchSettings& settings)
         : mJobs(jobs), mSettings(settings), mStatus(jobs.size(), Status::Pending),
-          mTerminal(::isatty(STDOUT_FILENO) == 1), mStart(Clock::now())
+          mTerminal(::isatty(STDOUT_FILENO) == 1 && !settings.verbose), mStart(Clock::now())
     {
         if (!settings.logPath.empty()) {
             mLog = std::fopen(settings.logPath.c_str(), "w");

@@ -53,6 +53,9 @@ struct BatchSettings
     bool skipExisting = false;  ///< skip a frame whose outputs all exist
     bool keepGoing = false;     ///< go on after a failed frame
     bool quiet = false;         ///< print nothing but errors
+    /// A line per frame instead of the bar on a terminal: -v's progress lines (stderr) ran on
+    /// after the bar's (stdout).
+    bool verbose = false;
     std::string logPath;        ///< --log: JSON lines, "" for none
     std::string inputPattern, outputPattern;
     std::vector<int> missing;   ///< requested frames not on disk (listed once, skipped)

@@ -460,11 +460,20 @@ struct OnceWarnings
     std::atomic<bool> meshInput{false};
     std::atomic<bool> attributesNotRead{false};
     OutputWarnings outputs;  ///< those of --attributes, --vdb-surface and --vdb-points
+    /// Printed before each warning: "\r\033[K" while a sequence's progress bar may stand on
+    /// the terminal, which erases it (a warning ran on after the bar's last line).
+    std::string linePrefix;
     /// The first frame meshed and its parameters, which warnIfLengthsMove() compares the
     /// later frames with.
     std::mutex firstFrameMutex;
     std::optional<std::pair<int, nonbloppy::ResolvedParameters>> firstFrame;
 };
+
+/// Start a warning line on stderr (after OnceWarnings::linePrefix).
+std::ostream& warning(const OnceWarnings& once)
+{
+    return std::cerr << once.linePrefix << "nonbloppy: warning: ";
+}
 
 /// What meshing one frame produced: the library's result and every stage's seconds
 /// (the tool's own "read particles", "write mesh", "write vdb" included).
@@ -503,7 +512,7 @@ MeshedFrame meshFrameSurface(const MeshOptions& o, ProgressInterrupter& interrup
     // Once per run, and only where the particles' attributes are used.
     const std::string notRead = joinedSkipped(frame.particles, /*withSurfaces=*/false);
     if (o.outputs.needParticles() && !notRead.empty() && !once.attributesNotRead.exchange(true)) {
-        std::cerr << "nonbloppy: warning: not read from " << o.input << ": " << notRead << std::endl;
+        warning(once) << "not read from " << o.input << ": " << notRead << std::endl;
     }
     // Before meshing: a misspelt name used to cost the whole frame's work first.
     try {
@@ -639,7 +648,7 @@ void warnIfLengthsMove(int frame, const nonbloppy::ResolvedParameters& p, bool m
     if (p.method == nonbloppy::Method::Faithful && !maxStepGiven) {
         pin += " --max-step " + formatNumber(first.second.maxStep);
     }
-    std::cerr << "nonbloppy: warning: the spacing estimate moves between frames (" << formatNumber(reference)
+    warning(once) << "the spacing estimate moves between frames (" << formatNumber(reference)
               << " in frame " << first.first << ", " << formatNumber(p.spacing) << " in frame " << frame
               << ") and the lengths derived from it move too; to mesh every frame alike, give frame "
               << first.first << "'s:" << pin << std::endl;
@@ -649,7 +658,7 @@ void warnIfLengthsMove(int frame, const nonbloppy::ResolvedParameters& p, bool m
 void warnIfFacesEndInside(const MeshOptions& o, const nonbloppy::ResolvedParameters& p, OnceWarnings& once)
 {
     if (p.thresholdReachesSurface || once.facesEndInside.exchange(true)) return;
-    std::cerr << "nonbloppy: warning: --blend " << formatNumber(o.blend) << " --iterations " << o.iterations
+    warning(once) << "--blend " << formatNumber(o.blend) << " --iterations " << o.iterations
               << " relax too strongly for --threshold to be calibrated: flat faces end inside the "
                  "particles; lower --blend or --iterations"
               << (p.spacingGiven ? "" : ", or give --spacing to correct the volume") << std::endl;
@@ -676,7 +685,7 @@ void warnIfCoarseFloats(const nonbloppy::SurfaceResult& result, OnceWarnings& on
     const bool bySpacing = spacing > 0.0;
     const double limit = bySpacing ? spacing / 16.0 : voxelSize / 8.0;
     if (!(limit > 0.0) || !(step > limit) || once.coarseFloats.exchange(true)) return;
-    std::cerr << "nonbloppy: warning: the particles reach " << formatNumber(farthest)
+    warning(once) << "the particles reach " << formatNumber(farthest)
               << " from the origin, where float positions step by " << formatNumber(step) << ", more than "
               << (bySpacing ? "1/16 of the spacing " + formatNumber(spacing) : "1/8 of the voxel size " + formatNumber(voxelSize))
               << ": the surface is quantized there" << (step >= 8.0 * limit ? ", and droplets may vanish" : "")
@@ -685,10 +694,10 @@ void warnIfCoarseFloats(const nonbloppy::SurfaceResult& result, OnceWarnings& on
 
 /// An empty mesh from particles is written (a frame of spray may have none), but said: an
 /// out-of-scale --threshold (1e308) gave 0 vertices and exit 0 without a word.
-void warnIfEmpty(const nonbloppy::SurfaceResult& result, const std::string& output)
+void warnIfEmpty(const nonbloppy::SurfaceResult& result, const std::string& output, const OnceWarnings& once)
 {
     if (result.particleCount == 0 || !result.mesh.points.empty()) return;
-    std::cerr << "nonbloppy: warning: " << output << " is empty: the density of the "
+    warning(once) << output << " is empty: the density of the "
               << result.particleCount << (result.particleCount == 1 ? " particle" : " particles") << " nowhere reaches --threshold "
               << formatNumber(result.parameters.threshold) << std::endl;
 }
@@ -699,7 +708,7 @@ void warnIfEmpty(const nonbloppy::SurfaceResult& result, const std::string& outp
 void warnIfMeshInput(const std::string& input, const std::string& faces, OnceWarnings& once)
 {
     if (faces.empty() || once.meshInput.exchange(true)) return;
-    std::cerr << "nonbloppy: warning: " << input << " is a mesh (its " << faces << " was not read): its "
+    warning(once) << input << " is a mesh (its " << faces << " was not read): its "
               << "vertices were meshed as particles" << std::endl;
 }
 
@@ -709,7 +718,7 @@ void warnAboutFrame(const MeshOptions& f, const FrameOutcome& outcome, OnceWarni
 {
     warnIfFacesEndInside(f, outcome.result.parameters, once);
     warnIfCoarseFloats(outcome.result, once);
-    warnIfEmpty(outcome.result, f.output);
+    warnIfEmpty(outcome.result, f.output, once);
     warnIfMeshInput(f.input, outcome.faces, once);
 }
 
@@ -924,6 +933,7 @@ int runSequence(const MeshOptions& o)
     settings.skipExisting = o.skipExisting;
     settings.keepGoing = o.keepGoing;
     settings.quiet = o.quiet;
+    settings.verbose = o.verbose;
     settings.logPath = o.logPath;
     settings.inputPattern = o.input;
     settings.outputPattern = o.output;
@@ -931,6 +941,10 @@ int runSequence(const MeshOptions& o)
 
     std::mutex verboseMutex;
     OnceWarnings once;
+    // The bar (stdout) and the warnings (stderr) on one terminal: each warning erases the bar
+    // first, and the next frame draws it again.
+    const bool barShown = !o.quiet && !o.verbose && ::isatty(STDOUT_FILENO) == 1;
+    if (barShown && ::isatty(STDERR_FILENO) == 1) once.linePrefix = "\r\033[K";
     BackgroundRemover remover;  // replaced outputs are freed while the next frames run
     // Writes a meshed frame, warns, and reports it; the frame's memory goes on return.
     const auto writeAndReport = [&](const MeshOptions& f, const BatchJob& job, MeshedFrame& frame,
