@@ -10,6 +10,7 @@
 #include <nonbloppy/ComputeNormals.h>
 
 #include "Cancellation.h"
+#include "NumberText.h"
 #include "ParameterChecks.h"
 #include "PolygonIndices.h"
 #include "SurfaceStages.h"
@@ -281,7 +282,7 @@ double cancellation_internal::calibrateRelaxedThreshold(double effectiveRadiusOv
     const double ratio = effectiveRadiusOverSpacing;
     if (!(blend >= 0.0 && blend <= 1.0)) {
         std::ostringstream msg;
-        msg << "--blend must lie in [0,1], got " << blend;
+        msg << "--blend must lie in [0,1], got " << number_text_internal::numberBeside(blend, blend < 0.0 ? 0.0 : 1.0);
         throw ParameterError(msg.str());
     }
     if (iterations < 0) {

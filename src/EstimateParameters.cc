@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "Cancellation.h"
+#include "NumberText.h"
 #include "OpenVdbScale.h"
 #include "ParameterChecks.h"
 #include "ParticleIndexImpl.h"
@@ -27,9 +28,7 @@ using surface_stages_internal::LengthNames;
 
 std::string formatNumber(double value)
 {
-    std::ostringstream out;
-    out << value;
-    return out.str();
+    return number_text_internal::sixDigits(value);
 }
 
 /// Run @a perSample(i, forNeighbours) in parallel for every sampled slot i (sorted order,
@@ -326,7 +325,8 @@ namespace {
 void requireVoxelWithinRadius(double effectiveRadius, double voxelSize, const LengthNames& names = {})
 {
     if (voxelSize > effectiveRadius) {
-        throw ParameterError(names.voxelSize + " " + formatNumber(voxelSize) + " is too large for " + names.radius +
+        throw ParameterError(names.voxelSize + " " + number_text_internal::numberBeside(voxelSize, effectiveRadius) +
+                             " is too large for " + names.radius +
                              " " + formatNumber(effectiveRadius) + ": at least one voxel per radius");
     }
 }
@@ -395,13 +395,15 @@ void checkParameters(const SurfaceParameters& params)
     requirePositive(params.threshold, "--threshold");
     requirePositive(params.voxelSize, "--voxel-size");
     if (!(params.blend >= 0.0 && params.blend <= 1.0)) {
-        throw ParameterError("--blend must lie in [0,1], got " + formatNumber(params.blend));
+        throw ParameterError("--blend must lie in [0,1], got " +
+                             number_text_internal::numberBeside(params.blend, params.blend < 0.0 ? 0.0 : 1.0));
     }
     if (params.iterations < 0) {
         throw ParameterError("--iterations must be >= 0, got " + std::to_string(params.iterations));
     }
     if (!(params.adaptivity >= 0.0 && params.adaptivity <= 1.0)) {
-        throw ParameterError("--adaptivity must lie in [0,1], got " + formatNumber(params.adaptivity));
+        throw ParameterError("--adaptivity must lie in [0,1], got " +
+                             number_text_internal::numberBeside(params.adaptivity, params.adaptivity < 0.0 ? 0.0 : 1.0));
     }
     // An out-of-range enumerator (a cast integer, memory from another build) ran as neither
     // variant: the Paper mesh without its threshold calibration.
@@ -418,7 +420,7 @@ void checkParameters(const SurfaceParameters& params)
     if (params.threshold && !(*params.threshold <= double(std::numeric_limits<float>::max()) &&
                               float(*params.threshold) > 0.0f)) {
         throw ParameterError("--threshold must be a positive number within float's range (the density grid's values), got " +
-                             formatNumber(*params.threshold));
+                             number_text_internal::numberBeside(*params.threshold, double(std::numeric_limits<float>::max())));
     }
     // Lengths that a given spacing alone sets (r_e = 2 s, h = s/2) meet the same limits
     // whatever the particles: checked now and said of --spacing. "--voxel-size 5e-07 is

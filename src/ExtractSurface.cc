@@ -13,6 +13,7 @@
 #include <nonbloppy/ExtractSurface.h>
 
 #include "Cancellation.h"
+#include "NumberText.h"
 #include "SurfaceStages.h"
 
 #include <openvdb/tools/VolumeToMesh.h>
@@ -56,12 +57,13 @@ void checkExtractParameters(double threshold, double adaptivity, double backgrou
     if (!(threshold > background)) {
         std::ostringstream msg;
         msg << "--threshold must lie above the density grid's background value " << background
-            << " (its value outside the fluid), got " << threshold;
+            << " (its value outside the fluid), got " << number_text_internal::numberBeside(threshold, background);
         throw ParameterError(msg.str());
     }
     if (!(adaptivity >= 0.0 && adaptivity <= 1.0)) {
         std::ostringstream msg;
-        msg << "--adaptivity must lie in [0,1], got " << adaptivity;
+        msg << "--adaptivity must lie in [0,1], got "
+            << number_text_internal::numberBeside(adaptivity, adaptivity < 0.0 ? 0.0 : 1.0);
         throw ParameterError(msg.str());
     }
 }

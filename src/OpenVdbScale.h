@@ -9,6 +9,8 @@
 
 #include <nonbloppy/Error.h>
 
+#include "NumberText.h"
+
 #include <sstream>
 
 namespace nonbloppy {
@@ -28,7 +30,7 @@ inline void requireOpenVdbScale(double value, double least, const char* name)
 {
     if (value < least) {
         std::ostringstream msg;
-        msg << name << " " << value << " is below " << least
+        msg << name << " " << number_text_internal::numberBeside(value, least) << " is below " << least
             << ", the smallest OpenVDB accepts: give the positions in a smaller unit";
         throw ParameterError(msg.str());
     }

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "Cancellation.h"
 #include "InstructionSet.h"
+#include "NumberText.h"
 #include "ParameterChecks.h"
 #include "ParticleIndexImpl.h"
 #include "UnwrittenVector.h"
@@ -480,7 +481,8 @@ void instruction_set_internal::relaxVertices(SurfaceMesh& mesh, const ParticleIn
     std::ostringstream msg;
     parameter_checks_internal::requirePositive(settings.effectiveRadius, "--radius");
     if (!(settings.blend >= 0.0 && settings.blend <= 1.0)) {
-        msg << "--blend must lie in [0,1], got " << settings.blend;
+        msg << "--blend must lie in [0,1], got "
+            << number_text_internal::numberBeside(settings.blend, settings.blend < 0.0 ? 0.0 : 1.0);
         throw ParameterError(msg.str());
     }
     if (settings.iterations < 0) {

@@ -259,6 +259,27 @@ TEST(EstimateParameters, ResolveReportsWhatWasGivenAndChecksRanges)
     bad = SurfaceParameters();
     bad.blend = 1.5;
     expectMessage(bad, "--blend must lie in [0,1], got 1.5");
+    // A value that six digits would print as the limit it broke is printed exactly (bug hunt:
+    // "--blend must lie in [0,1], got 1").
+    bad.blend = 1.0000001;
+    expectMessage(bad, "--blend must lie in [0,1], got 1.0000001");
+    bad = SurfaceParameters();
+    bad.adaptivity = -1e-9;
+    expectMessage(bad, "--adaptivity must lie in [0,1], got -1e-09");
+    bad.adaptivity = 1.0000001;
+    expectMessage(bad, "--adaptivity must lie in [0,1], got 1.0000001");
+    bad = SurfaceParameters();
+    bad.threshold = 3.4028236e38;
+    expectMessage(bad, "--threshold must be a positive number within float's range (the density grid's values), "
+                       "got 3.4028236e+38");
+    bad = SurfaceParameters();
+    bad.effectiveRadius = 0.1;
+    bad.voxelSize = 0.1000001;
+    expectMessage(bad, "--voxel-size 0.1000001 is too large for --radius 0.1: at least one voxel per radius");
+    bad = SurfaceParameters();
+    bad.spacing = 0.0000299999;
+    expectMessage(bad, "--spacing 2.99999e-05: the voxel size 0.5 s = 1.499995e-05 is below 1.5e-05, the smallest "
+                       "OpenVDB accepts: give the positions in a smaller unit");
     bad = SurfaceParameters();
     bad.iterations = -1;
     expectMessage(bad, "--iterations must be >= 0, got -1");
