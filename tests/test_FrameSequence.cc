@@ -279,6 +279,14 @@ TEST_F(FindFramesTest, PlaceholdersInDirectoriesArePartOfTheirNames)
     EXPECT_FALSE(nonbloppy_tool::placeholderInDirectory("take_2/fluid_{}.vtk"));
     EXPECT_FALSE(nonbloppy_tool::placeholderInDirectory("fluid_#.vtk"));
 
+    // A frame's path keeps the directory as typed: "take#2//f_{}.vtk" named frame 7
+    // ".../take#2/f_7.vtk" in a sequence, recorded so in its .vdb, and as typed alone.
+    const FramePattern doubled = parseFramePattern(mDir + "/take#2//f_{}.vtk", "IN");
+    ASSERT_EQ(nonbloppy_tool::findFrames(doubled).size(), 1u);
+    EXPECT_EQ(nonbloppy_tool::findFrames(doubled)[0].input, mDir + "/take#2//f_7.vtk");
+    EXPECT_EQ(doubled.directoryPrefix(), mDir + "/take#2//");
+    EXPECT_EQ(parseFramePattern("f_{}.vtk", "IN").directoryPrefix(), "");
+
     const FramePattern missing = parseFramePattern(mDir + "/nowhere/f_{}.vtk", "IN");
     EXPECT_EQ(errorOf([&] { nonbloppy_tool::findFrames(missing); }),
               "cannot read directory " + mDir + "/nowhere: No such file or directory");

@@ -162,6 +162,13 @@ std::string FramePattern::directory() const
     return fs::path(mPrefix + "0").parent_path().string();
 }
 
+std::string FramePattern::directoryPrefix() const
+{
+    const std::string& text = mKind == Kind::None ? mText : mPrefix;
+    const size_t slash = text.rfind('/');
+    return slash == std::string::npos ? std::string() : text.substr(0, slash + 1);
+}
+
 std::optional<std::string> FramePattern::matchDigits(const std::string& fileName) const
 {
     if (mKind == Kind::None) return std::nullopt;
@@ -308,7 +315,7 @@ std::vector<Frame> findFrames(const FramePattern& input, std::string& pastLarges
             // (Digits padded otherwise than the pattern's are simply another name.)
             const std::optional<std::string> other = input.matchDigits(name);
             if (other && !parseNumber(*other) && !entry.is_directory(statError)) {
-                const std::string path = (dir.empty() ? fs::path(name) : fs::path(dir) / name).string();
+                const std::string path = input.directoryPrefix() + name;
                 if (pastLargest.empty() || path < pastLargest) pastLargest = path;
             }
             continue;
@@ -317,7 +324,7 @@ std::vector<Frame> findFrames(const FramePattern& input, std::string& pastLarges
         Frame frame;
         frame.number = *parseNumber(*digits);
         frame.digits = *digits;
-        frame.input = (dir.empty() ? fs::path(name) : fs::path(dir) / name).string();
+        frame.input = input.directoryPrefix() + name;
         const auto [at, inserted] = byNumber.emplace(frame.number, frame);
         if (!inserted) {
             // Directory order is arbitrary: keep the names sorted, so the message is stable.

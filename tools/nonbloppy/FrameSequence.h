@@ -65,6 +65,10 @@ public:
 
     /// The directory part of the pattern ("" for the current directory).
     std::string directory() const;
+    /// The pattern's text before the file name, as typed ("sim//", "" for the current
+    /// directory): the frames' paths start with it, so that a frame is named alike in a
+    /// sequence and alone ("sim//f_{}.vtk" gave "sim/f_1.vtk", recorded in its .vdb).
+    std::string directoryPrefix() const;
 
 private:
     friend FramePattern parseFramePattern(const std::string& text, const std::string& what);
