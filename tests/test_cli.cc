@@ -613,7 +613,8 @@ TEST_F(CliTest, EmptyMeshIsWrittenWithAWarning)
     const RunResult r = run("mesh " + quote(kCube) + " -q -o " + quote(out("empty.obj")) + " --threshold 1e30");
     EXPECT_EQ(r.exitCode, 0);
     EXPECT_EQ(r.err, "nonbloppy: warning: " + out("empty.obj")
-                         + " is empty: the density of the 2366 particles nowhere reaches --threshold 1e+30\n");
+                         + " is empty: the density of the 2366 particles, sampled at --voxel-size 0.0249191, "
+                           "nowhere reaches --threshold 1e+30\n");
     EXPECT_TRUE(fs::exists(out("empty.obj")));
     // PLY and VTK declare the normals a non-empty mesh has, and inspect calls them meshes.
     for (const std::string name : {"empty.ply", "empty.vtk"}) {

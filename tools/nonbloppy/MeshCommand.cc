@@ -693,13 +693,16 @@ void warnIfCoarseFloats(const nonbloppy::SurfaceResult& result, OnceWarnings& on
 }
 
 /// An empty mesh from particles is written (a frame of spray may have none), but said: an
-/// out-of-scale --threshold (1e308) gave 0 vertices and exit 0 without a word.
+/// out-of-scale --threshold (1e308) gave 0 vertices and exit 0 without a word. The density
+/// is named as sampled: it reaches any threshold at a particle's centre, but a lone particle
+/// between voxel centres can leave every sample below it (bug hunt).
 void warnIfEmpty(const nonbloppy::SurfaceResult& result, const std::string& output, const OnceWarnings& once)
 {
     if (result.particleCount == 0 || !result.mesh.points.empty()) return;
-    warning(once) << output << " is empty: the density of the "
-              << result.particleCount << (result.particleCount == 1 ? " particle" : " particles") << " nowhere reaches --threshold "
-              << formatNumber(result.parameters.threshold) << std::endl;
+    warning(once) << output << " is empty: the density of the " << result.particleCount
+                  << (result.particleCount == 1 ? " particle" : " particles") << ", sampled at --voxel-size "
+                  << formatNumber(result.parameters.voxelSize) << ", nowhere reaches --threshold "
+                  << formatNumber(result.parameters.threshold) << std::endl;
 }
 
 /// Once per run: an input with faces (PLY) or polygons (legacy VTK) is a mesh, not
