@@ -630,6 +630,23 @@ TEST_F(CliTest, EmptyMeshIsWrittenWithAWarning)
     EXPECT_EQ(normal.err, "");
 }
 
+TEST_F(CliTest, VerticesWithoutANormalAreSaid)
+{
+    // -c 1 moves every vertex onto its particles' mean: the isolated droplets of this frame
+    // collapse to points, whose vertices got (0,0,0) normals without a word (bug hunt).
+    const std::string free = kData + "/free_particles_125_particles.vtk";
+    const RunResult r = run("mesh " + quote(free) + " -q -o " + quote(out("c1.obj")) + " -c 1 --method paper");
+    EXPECT_EQ(r.exitCode, 0);
+    const std::string mesh = readText(out("c1.obj"));
+    size_t zero = 0;
+    for (size_t at = mesh.find("\nvn 0 0 0\n"); at != std::string::npos; at = mesh.find("\nvn 0 0 0\n", at + 1)) ++zero;
+    ASSERT_GT(zero, 0u);
+    EXPECT_EQ(r.err, "nonbloppy: warning: " + std::to_string(zero) + " of the 1032 vertices of " + out("c1.obj") +
+                         " have no normal (the faces around them have no area): -c 1 collapses droplets onto their "
+                         "particles; lower --blend\n");
+    EXPECT_EQ(run("mesh " + quote(free) + " -q -o " + quote(out("c3.obj")) + " -c 0.3 --method paper").err, "");
+}
+
 TEST_F(CliTest, UsageErrorsAreOneLine)
 {
     for (const std::string& args : {std::string(""), std::string("mesh"),

@@ -459,6 +459,7 @@ struct OnceWarnings
     std::atomic<bool> lengthsMoved{false};
     std::atomic<bool> meshInput{false};
     std::atomic<bool> attributesNotRead{false};
+    std::atomic<bool> normalsMissing{false};
     OutputWarnings outputs;  ///< those of --attributes, --vdb-surface and --vdb-points
     /// Printed before each warning: "\r\033[K" while a sequence's progress bar may stand on
     /// the terminal, which erases it (a warning ran on after the bar's last line).
@@ -715,6 +716,22 @@ void warnIfMeshInput(const std::string& input, const std::string& faces, OnceWar
               << "vertices were meshed as particles" << std::endl;
 }
 
+/// Once per run: vertices without a normal ((0,0,0), computeNormals()) shade black or not at
+/// all, and nothing said why: -c 1 moves every vertex onto its particles' weighted mean,
+/// which collapses a droplet to a point (bug hunt: 32 of the 1,032 vertices of the bundled
+/// free-particle frame with --method paper).
+void warnIfNormalsMissing(const nonbloppy::SurfaceResult& result, const std::string& output, OnceWarnings& once)
+{
+    const std::vector<openvdb::Vec3s>& normals = result.mesh.normals;
+    const size_t missing = size_t(std::count(normals.begin(), normals.end(), openvdb::Vec3s(0.0f)));
+    if (missing == 0 || once.normalsMissing.exchange(true)) return;
+    warning(once) << missing << " of the " << normals.size() << " vertices of " << output
+                  << " have no normal (the faces around them have no area)"
+                  << (result.parameters.blend == 1.0 ? ": -c 1 collapses droplets onto their particles; lower --blend"
+                                                     : "")
+                  << std::endl;
+}
+
 /// The warnings about one meshed frame (@a f: its options, paths included), each printed
 /// once per run.
 void warnAboutFrame(const MeshOptions& f, const FrameOutcome& outcome, OnceWarnings& once)
@@ -722,6 +739,7 @@ void warnAboutFrame(const MeshOptions& f, const FrameOutcome& outcome, OnceWarni
     warnIfFacesEndInside(f, outcome.result.parameters, once);
     warnIfCoarseFloats(outcome.result, once);
     warnIfEmpty(outcome.result, f.output, once);
+    warnIfNormalsMissing(outcome.result, f.output, once);
     warnIfMeshInput(f.input, outcome.faces, once);
 }
 
