@@ -79,8 +79,8 @@ bool directIoSuitable(const std::string& path);
 /// kDirectIoMinBytes and directIoSuitable(), the file is written with O_DIRECT, in 4 MiB
 /// blocks from two aligned buffers (a writer thread writes one while @a writeContents fills
 /// the other), past the page cache; the last partial block goes through the page cache. A mesh is written once and read by another program, so caching it only
-/// costs: on the benchmark machine a new 119 MB file took 0.6–0.8 s through the page cache
-/// and 0.11 s direct. If the file system rejects a direct write, the rest is written
+/// costs: on the benchmark machine a new 119 MB mesh took 0.09–0.11 s direct and 0.08–0.78 s
+/// through the page cache, whose flush then ran on into the next run. If the file system rejects a direct write, the rest is written
 /// buffered. The bytes are the same either way.
 /// @return true if direct I/O was used.
 /// @throw FileError naming @a path if the file cannot be created, written or renamed, or if

@@ -22,8 +22,9 @@ struct MeshWriteSettings
     /// Write files of 1 MiB or more with direct I/O (O_DIRECT, past the page cache) on
     /// local ext4, XFS or Btrfs disks; other file systems, and false, use the page cache.
     /// The bytes are the same. A mesh is written once and read by another program, so
-    /// caching it only costs: on the benchmark machine a new 119 MB mesh took 0.6–0.8 s
-    /// through the page cache and 0.11 s direct.
+    /// caching it only costs: on the benchmark machine the 119 MB mesh of the 64x input took
+    /// 0.09–0.11 s direct and 0.08–0.78 s through the page cache, whose flush then ran on
+    /// into the next run (write stage, alternating pairs, 2026-12-05).
     bool directIo = true;
 };
 
