@@ -325,9 +325,9 @@ namespace {
 void requireVoxelWithinRadius(double effectiveRadius, double voxelSize, const LengthNames& names = {})
 {
     if (voxelSize > effectiveRadius) {
-        throw ParameterError(names.voxelSize + " " + number_text_internal::numberBeside(voxelSize, effectiveRadius) +
-                             " is too large for " + names.radius +
-                             " " + formatNumber(effectiveRadius) + ": at least one voxel per radius");
+        const auto [voxelText, radiusText] = number_text_internal::numbersApart(voxelSize, effectiveRadius);
+        throw ParameterError(names.voxelSize + " " + voxelText + " is too large for " + names.radius + " " +
+                             radiusText + ": at least one voxel per radius");
     }
 }
 

@@ -816,9 +816,9 @@ public:
     VtkParser(ByteInput& input, const std::string& path, bool wantPolygons)
         : mInput(input), mPath(path), mWantPolygons(wantPolygons) {}
 
-    /// Whether parse() reached a POLYGONS section header declaring at least one polygon
-    /// (true even if the section's data then failed to decode).
-    /// Whether the file declares polygons (an empty mesh included) so far.
+    /// Whether parse() reached a POLYGONS section header declaring at least one polygon (true
+    /// even if the section's data then failed to decode), or one of no polygon in a file
+    /// whose POINTS section holds none (an empty mesh).
     bool sawPolygons() const { return mSawPolygons || (mSawEmptyPolygons && mPointCount == 0); }
 
     VtkData parse()

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <sstream>
 #include <string>
+#include <utility>
 
 namespace nonbloppy {
 namespace number_text_internal {
@@ -32,6 +33,13 @@ inline std::string numberBeside(double value, double limit)
     char digits[32];
     const auto result = std::to_chars(digits, digits + sizeof(digits), value);
     return std::string(digits, result.ptr);
+}
+
+/// Two numbers an error compares, both printed: numberBeside() each against the other, so
+/// that 0.09999997 and 0.09999996 do not read "0.09999997 is too large for 0.1" (review).
+inline std::pair<std::string, std::string> numbersApart(double a, double b)
+{
+    return {numberBeside(a, b), numberBeside(b, a)};
 }
 
 } // namespace number_text_internal

@@ -108,7 +108,7 @@ parseBgeo(StreamReader& stream, const std::string& path)
 {
     if (stream.ensure(1) && (stream.here()[0] == 0x7f || stream.here()[0] == '[' || stream.here()[0] == '{')) {
         fail(path, "unsupported BGEO version (JSON-based, Houdini 12 or later); "
-                   "only the classic binary BgeoV layout is read: write the cache as .bhclassic");
+                   "only the classic binary BgeoV layout is read: export it from Houdini as .bhclassic");
     }
     if (!stream.ensure(5) || std::memcmp(stream.here(), "BgeoV", 5) != 0) {
         fail(path, "not a BGEO file (no 'BgeoV' magic)");

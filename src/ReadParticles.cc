@@ -524,10 +524,11 @@ readXyzParticles(const std::string& path)
 const char* const kParticleExtensions =
     ".vtk, .vtu, .vtp, .ply, .xyz, .bgeo, .vdb, .csv, .txt or .json";
 
-/// The extension that picks @a path's reader, lower case: lowerExtension(), except that the
-/// names Houdini gives its classic binary geometry pick ".bgeo": `.bhclassic` (what Houdini
-/// 12 and later write it as; their own `.bgeo` is JSON-based) and the gzip-compressed
-/// `.bgeo.gz` and `.bhclassic.gz` (the reader tells gzip from the bytes).
+/// The extension that picks @a path's reader, lower case: lowerExtension(), except that
+/// ".bgeo" is also picked by `.bhclassic` (Houdini 12 and later write the classic layout
+/// under that name; their own `.bgeo` is JSON-based) and by the gzipped `.bgeo.gz` and
+/// `.bhclassic.gz` (the reader tells gzip from the bytes, and refuses JSON inside, as a
+/// `.bgeo.gz` from Houdini 12 or later holds).
 std::string readerExtension(const std::string& path)
 {
     using io_internal::lowerExtension;
@@ -549,7 +550,7 @@ std::string houdiniAdvice(const std::string& path)
     const std::string inner = ext == ".sc" || ext == ".gz" ? lowerExtension(path.substr(0, path.size() - ext.size())) : ext;
     if (inner != ".bgeo" && inner != ".bhclassic" && inner != ".geo" && inner != ".hclassic") return std::string();
     return std::string(ext == ".sc" ? ": Houdini's Blosc-compressed geometry is not read" : ": Houdini's ASCII geometry is not read")
-           + "; write the cache as .bhclassic (Houdini's classic binary geometry)";
+           + "; export it from Houdini as .bhclassic (classic binary geometry; renaming does not convert it)";
 }
 
 } // namespace

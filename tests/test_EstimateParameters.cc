@@ -276,6 +276,9 @@ TEST(EstimateParameters, ResolveReportsWhatWasGivenAndChecksRanges)
     bad.effectiveRadius = 0.1;
     bad.voxelSize = 0.1000001;
     expectMessage(bad, "--voxel-size 0.1000001 is too large for --radius 0.1: at least one voxel per radius");
+    bad.effectiveRadius = 0.09999996;  // both print as 0.1 with six digits
+    bad.voxelSize = 0.09999997;
+    expectMessage(bad, "--voxel-size 0.09999997 is too large for --radius 0.09999996: at least one voxel per radius");
     bad = SurfaceParameters();
     bad.spacing = 0.0000299999;
     expectMessage(bad, "--spacing 2.99999e-05: the voxel size 0.5 s = 1.499995e-05 is below 1.5e-05, the smallest "

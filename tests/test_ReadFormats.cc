@@ -175,10 +175,12 @@ TEST_F(ReadFormatsTest, BgeoUnderHoudiniClassicNames)
     const std::string blosc = write("frame.bgeo.sc", bytes);
     EXPECT_FALSE(nonbloppy::isParticleFile(blosc));
     EXPECT_EQ(fileErrorOf(blosc), "unknown particle file extension '.sc' (" + blosc + "): Houdini's Blosc-compressed "
-                                  "geometry is not read; write the cache as .bhclassic (Houdini's classic binary geometry)");
+                                  "geometry is not read; export it from Houdini as .bhclassic (classic binary geometry; "
+                                  "renaming does not convert it)");
     const std::string ascii = write("frame.geo", "PGEOMETRY V5\n");
     EXPECT_EQ(fileErrorOf(ascii), "unknown particle file extension '.geo' (" + ascii + "): Houdini's ASCII geometry "
-                                  "is not read; write the cache as .bhclassic (Houdini's classic binary geometry)");
+                                  "is not read; export it from Houdini as .bhclassic (classic binary geometry; renaming does "
+                                  "not convert it)");
     const std::string tarball = write("frame.tar.gz", bytes);
     EXPECT_FALSE(nonbloppy::isParticleFile(tarball));
     EXPECT_EQ(fileErrorOf(tarball), "unknown particle file extension '.gz' (" + tarball + "); expected .vtk, .vtu, "
@@ -212,10 +214,10 @@ TEST_F(ReadFormatsTest, BgeoTruncatedCorruptAndUnsupported)
     EXPECT_EQ(fileErrorOf(version6), "unsupported BGEO version (6) (" + version6 + ")");
     const std::string json = write("json.bgeo", "[\"fileversion\",\"19.0.383\",\"hasindex\",false]");
     EXPECT_EQ(fileErrorOf(json), "unsupported BGEO version (JSON-based, Houdini 12 or later); only "
-                                 "the classic binary BgeoV layout is read: write the cache as .bhclassic (" + json + ")");
+                                 "the classic binary BgeoV layout is read: export it from Houdini as .bhclassic (" + json + ")");
     const std::string binaryJson = write("bjson.bgeo", std::string("\x7fNSJb", 5) + "\x01");
     EXPECT_EQ(fileErrorOf(binaryJson), "unsupported BGEO version (JSON-based, Houdini 12 or later); only the "
-                                       "classic binary BgeoV layout is read: write the cache as .bhclassic (" + binaryJson + ")");
+                                       "classic binary BgeoV layout is read: export it from Houdini as .bhclassic (" + binaryJson + ")");
     const std::string other = write("other.bgeo", "hello world");
     EXPECT_EQ(fileErrorOf(other), "not a BGEO file (no 'BgeoV' magic) (" + other + ")");
 }

@@ -625,6 +625,7 @@ TEST_F(CliTest, EmptyMeshIsWrittenWithAWarning)
         const RunResult inspect = run("inspect " + quote(out(name)));
         EXPECT_EQ(inspect.exitCode, 0) << inspect.err;
         EXPECT_EQ(inspect.out.rfind(out(name) + ": mesh\n  vertices         0\n", 0), 0u) << inspect.out;
+        EXPECT_NE(inspect.out.find("\n  attributes       none\n"), std::string::npos) << inspect.out;
     }
     const RunResult normal = run("mesh " + quote(kCube) + " -q -o " + quote(out("cube.obj")));
     EXPECT_EQ(normal.err, "");

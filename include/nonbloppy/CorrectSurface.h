@@ -31,8 +31,9 @@ namespace nonbloppy {
 /// fluid's volume is about N·s³. With t = 0 or c = 0 it equals calibrateThreshold().
 /// The start height is limited to min(1.5 s, 0.75 r_e): relaxations so strong that they
 /// would need to start farther out (uncapped, c = 0.5, t = 2 would start 1.9 s out and
-/// merge fluid bodies 4 s apart; with the default cap of s/2, about 1.5 s out) get the
-/// threshold of that limit and end inside the true surface.
+/// merge fluid bodies 4 s apart; with the default cap of s/2 it starts just within reach,
+/// while c = 0.4, t = 3 does not) get the threshold of that limit and end inside the true
+/// surface.
 /// The result depends only on r_e/s, c, t and the cap. Cost: about 10⁵ kernel evaluations
 /// (2 ms at r_e = 2.1 s), growing as (r_e/s)³ and with t, up to the step where a sample
 /// vertex stops moving.

@@ -19,10 +19,10 @@
 /// - `.xyz`  raw little-endian float32 triples, no header.
 /// - `.bgeo` Houdini classic binary geometry (`BgeoV` version 5, as Partio and SPlisHSPlasH
 ///           write it), gzip-compressed or not; float, int, vector and index point
-///           attributes. Also under the names Houdini 12 and later write that layout as,
-///           `.bhclassic`, and gzipped, `.bgeo.gz` and `.bhclassic.gz`. Their own `.bgeo`
-///           is JSON-based and rejected as unsupported, as are `.bgeo.sc` (Blosc) and the
-///           ASCII `.geo`; the messages name `.bhclassic` instead.
+///           attributes. Also under `.bhclassic`, the name Houdini 12 and later write that
+///           layout under, and gzipped as `.bgeo.gz` or `.bhclassic.gz`. Houdini's own
+///           `.bgeo` (and `.bgeo.gz`) is JSON-based and rejected as unsupported, as are
+///           `.bgeo.sc` (Blosc) and the ASCII `.geo`; the messages name `.bhclassic` instead.
 /// - `.vtu`, `.vtp`  VTK XML UnstructuredGrid / PolyData: ascii, inline base64 and appended
 ///           (raw or base64) arrays, zlib-compressed or not, UInt32/UInt64 headers, either
 ///           byte order, Float32/Float64 points; every PointData array in its type.

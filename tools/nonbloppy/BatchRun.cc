@@ -150,6 +150,15 @@ public:
     /// True if a progress bar is drawn (stdout is a terminal, not --quiet).
     bool showsBar() const { return mTerminal && !mSettings.quiet; }
 
+    /// Print @a line (a whole warning) on stderr, the bar erased first: the next progress or
+    /// tick draws it again.
+    void printLine(const std::string& line)
+    {
+        std::lock_guard<std::mutex> lock(mMutex);
+        clearBar();
+        std::cerr << line << std::flush;
+    }
+
     /// Redraw the bar, so elapsed time and ETA move during long frames.
     void tick()
     {
@@ -461,6 +470,15 @@ int runBatch(const std::vector<BatchJob>& jobs, const BatchSettings& settings,
                   << (settings.missing.size() == 1 ? "" : "s") << " skipped: "
                   << formatFrameList(settings.missing) << " (" << settings.inputPattern << ")"
                   << std::endl;
+    }
+
+    // The frames' warnings go past the bar while it shows (a warning ran on after its line).
+    struct RouteWarnings {
+        WarningPrinter* printer;
+        ~RouteWarnings() { if (printer) printer->route(nullptr); }
+    } routeWarnings{state.showsBar() ? settings.warnings : nullptr};
+    if (routeWarnings.printer) {
+        routeWarnings.printer->route([&state](const std::string& line) { state.printLine(line); });
     }
 
     std::atomic<bool> finished{false};

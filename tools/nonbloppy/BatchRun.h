@@ -47,6 +47,8 @@ struct FrameReport
     std::vector<std::pair<std::string, double>> parameters;  ///< resolved values, by name
 };
 
+class WarningPrinter;
+
 struct BatchSettings
 {
     int frameJobs = 1;          ///< frames meshed at once (each uses the shared TBB arena)
@@ -59,6 +61,8 @@ struct BatchSettings
     std::string logPath;        ///< --log: JSON lines, "" for none
     std::string inputPattern, outputPattern;
     std::vector<int> missing;   ///< requested frames not on disk (listed once, skipped)
+    /// The frames' warnings: while the bar shows, runBatch() routes them past it.
+    WarningPrinter* warnings = nullptr;
 };
 
 /// Meshes one frame and returns the step that writes its outputs and reports it: run at once

@@ -22,6 +22,8 @@
 #include <cstdio>
 #include <filesystem>
 #include <functional>
+#include <iostream>
+#include <mutex>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -52,12 +54,63 @@ Command setupInspectCommand(CLI::App& parent);
 /// Declare `nonbloppy convert` on @a parent.
 Command setupConvertCommand(CLI::App& parent);
 
+/// Where a command's warnings go: stderr, a whole line at a time. While a sequence's progress
+/// bar stands on the terminal, runBatch() routes them past it (route()): the bar is erased,
+/// under the bar's own lock, before each line, so that neither runs into the other.
+/// Thread-safe.
+class WarningPrinter
+{
+public:
+    /// Print "nonbloppy: warning: " + @a text as one line.
+    void warn(const std::string& text) const
+    {
+        const std::string line = "nonbloppy: warning: " + text + "\n";
+        std::lock_guard<std::mutex> lock(mMutex);
+        if (mRoute) {
+            mRoute(line);
+        } else {
+            std::cerr << line << std::flush;
+        }
+    }
+    /// Hand every line to @a print from now on; an empty function restores stderr.
+    void route(std::function<void(const std::string&)> print)
+    {
+        std::lock_guard<std::mutex> lock(mMutex);
+        mRoute = std::move(print);
+    }
+
+private:
+    mutable std::mutex mMutex;
+    std::function<void(const std::string&)> mRoute;
+};
+
+/// Builds one warning and hands it to a WarningPrinter when it goes out of scope:
+/// `WarningLine(printer) << "the particles reach " << far;`.
+class WarningLine
+{
+public:
+    explicit WarningLine(const WarningPrinter& printer) : mPrinter(printer) {}
+    ~WarningLine() { mPrinter.warn(mText.str()); }
+    WarningLine(const WarningLine&) = delete;
+    WarningLine& operator=(const WarningLine&) = delete;
+    template<typename T>
+    WarningLine& operator<<(const T& value)
+    {
+        mText << value;
+        return *this;
+    }
+
+private:
+    const WarningPrinter& mPrinter;
+    std::ostringstream mText;
+};
+
 /// Warn on stderr, one line per attribute, where a writer renamed one for @a path's format
 /// (@a original[i] written as @a written[i]; an empty written name is an attribute dropped,
 /// which the caller reports itself): "nonbloppy: warning: attribute 'a b' is written to
 /// out.ply as 'a_b_2'". Defined in main.cc.
 void warnRenamedAttributes(const std::vector<std::string>& original, const std::vector<std::string>& written,
-                           const std::string& path);
+                           const std::string& path, const WarningPrinter& printer);
 
 /// Whether @a item of ParticleSet::skipped is what makes a file a mesh: a PLY's faces, a
 /// legacy VTK's polygons or triangle strips, as the readers name them (the CLI tests check
@@ -88,7 +141,7 @@ inline std::string counted(size_t count, const std::string& noun)
 /// as doubles, rounded (nonbloppy::roundedAttributes() tells which): "nonbloppy: warning:
 /// attribute 'id' holds integers past 2^53, which out.ply stores as doubles, rounded (PLY has
 /// no 64-bit integers); write .vtk to keep them exact". Defined in main.cc.
-void warnRounded(const std::string& name, const std::string& path);
+void warnRounded(const std::string& name, const std::string& path, const WarningPrinter& printer);
 
 /// @throw UsageError("<@a name> needs a file name, got ''") if @a path is empty, say a shell
 ///        variable left unset: "cannot open : No such file or directory" named nothing, and

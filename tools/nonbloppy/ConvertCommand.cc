@@ -48,25 +48,24 @@ int runConvert(const ConvertOptions& o)
     // IN is read, before anything is written, or once OUT is written, which is then undone.
     // It used to kill the process, leaving the writer's temporary file beside OUT.
     SignalHandlerScope signals;
+    const WarningPrinter printer;
     const nonbloppy::ParticleSet particles = nonbloppy::readParticles(o.input);
     throwIfInterrupted();
     if (!particles.skipped.empty()) {
-        std::cerr << "nonbloppy: warning: not read from " << o.input << ", so not converted: " << joinedSkipped(particles)
-                  << std::endl;
+        WarningLine(printer) << "not read from " << o.input << ", so not converted: " << joinedSkipped(particles);
     }
     const bool positionsOnly = lowerExtension(o.output) == ".xyz";
     if (positionsOnly && !particles.attributes.empty()) {
         std::string names;
         for (const auto& a : particles.attributes) names += (names.empty() ? "" : ", ") + a.name;
-        std::cerr << "nonbloppy: warning: .xyz holds positions only; attributes dropped: " << names
-                  << std::endl;
+        WarningLine(printer) << ".xyz holds positions only; attributes dropped: " << names;
     }
     if (!positionsOnly) {
         std::vector<std::string> original;
         for (const auto& a : particles.attributes) original.push_back(a.name);
-        warnRenamedAttributes(original, nonbloppy::writtenAttributeNames(particles, o.output), o.output);
+        warnRenamedAttributes(original, nonbloppy::writtenAttributeNames(particles, o.output), o.output, printer);
     }
-    for (const std::string& name : nonbloppy::roundedAttributes(particles, o.output)) warnRounded(name, o.output);
+    for (const std::string& name : nonbloppy::roundedAttributes(particles, o.output)) warnRounded(name, o.output, printer);
     nonbloppy::ParticleWriteSettings settings;
     settings.directIo = !o.noDirectIo;
     BackgroundRemover remover;

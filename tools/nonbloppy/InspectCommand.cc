@@ -245,7 +245,8 @@ std::optional<std::vector<nonbloppy::ParticleAttribute>> meshVertexAttributes(co
     } catch (const nonbloppy::Error&) {
         return std::nullopt;
     }
-    if (!mesh.normals.empty()) {
+    // An empty mesh declares normals too (writeMesh()), with none to read back.
+    if (!mesh.normals.empty() || mesh.points.empty()) {
         // PLY normals are the properties nx, ny, nz; a VTK file's are the array readMesh()
         // took for them, whatever its name (a NORMALS section, or an array called normals or
         // Normals): the first of three components that holds the same values.
@@ -574,6 +575,8 @@ int runInspect(const std::string& path, bool json)
     if (nonbloppy::isParticleFile(path)) {
         return inspectParticles(path, nonbloppy::readParticles(path), json);
     }
+    // Houdini's own caches: readParticles() refuses them saying which name to export instead.
+    if (ext == ".sc" || ext == ".gz" || ext == ".geo" || ext == ".hclassic") nonbloppy::readParticles(path);
     throw nonbloppy::FileError("unknown file extension '" + ext + "' (" + path
                                + "); expected .vdb, .obj, .ply, .vtk, .vtu, .vtp, .xyz, .bgeo, "
                                  ".csv, .txt or .json");
@@ -589,7 +592,7 @@ Command setupInspectCommand(CLI::App& parent)
     CLI::App* cmd = parent.add_subcommand(
         "inspect", "Describe a .vdb grid file, a mesh (.obj, .ply, .vtk) or a particle file");
     cmd->footer("A .ply or .vtk file that declares faces is described as a mesh, other .ply and .vtk files\n"
-                "as particles; every particle format mesh reads is described.");
+                "as particles; every particle format `nonbloppy mesh` reads is described.");
     cmd->add_option("FILE", options->path, "File to describe")
         ->required()->group(kGroupInputOutput);
     cmd->add_flag("--json", options->json, "Print one JSON object instead of text")

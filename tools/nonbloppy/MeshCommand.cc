@@ -461,19 +461,16 @@ struct OnceWarnings
     std::atomic<bool> attributesNotRead{false};
     std::atomic<bool> normalsMissing{false};
     OutputWarnings outputs;  ///< those of --attributes, --vdb-surface and --vdb-points
-    /// Printed before each warning: "\r\033[K" while a sequence's progress bar may stand on
-    /// the terminal, which erases it (a warning ran on after the bar's last line).
-    std::string linePrefix;
     /// The first frame meshed and its parameters, which warnIfLengthsMove() compares the
     /// later frames with.
     std::mutex firstFrameMutex;
     std::optional<std::pair<int, nonbloppy::ResolvedParameters>> firstFrame;
 };
 
-/// Start a warning line on stderr (after OnceWarnings::linePrefix).
-std::ostream& warning(const OnceWarnings& once)
+/// A warning line of this run, printed when the statement ends (see WarningPrinter).
+WarningLine warning(const OnceWarnings& once)
 {
-    return std::cerr << once.linePrefix << "nonbloppy: warning: ";
+    return WarningLine(once.outputs.printer);
 }
 
 /// What meshing one frame produced: the library's result and every stage's seconds
@@ -513,7 +510,7 @@ MeshedFrame meshFrameSurface(const MeshOptions& o, ProgressInterrupter& interrup
     // Once per run, and only where the particles' attributes are used.
     const std::string notRead = joinedSkipped(frame.particles, /*withSurfaces=*/false);
     if (o.outputs.needParticles() && !notRead.empty() && !once.attributesNotRead.exchange(true)) {
-        warning(once) << "not read from " << o.input << ": " << notRead << std::endl;
+        warning(once) << "not read from " << o.input << ": " << notRead;
     }
     // Before meshing: a misspelt name used to cost the whole frame's work first.
     try {
@@ -652,7 +649,7 @@ void warnIfLengthsMove(int frame, const nonbloppy::ResolvedParameters& p, bool m
     warning(once) << "the spacing estimate moves between frames (" << formatNumber(reference)
               << " in frame " << first.first << ", " << formatNumber(p.spacing) << " in frame " << frame
               << ") and the lengths derived from it move too; to mesh every frame alike, give frame "
-              << first.first << "'s:" << pin << std::endl;
+              << first.first << "'s:" << pin;
 }
 
 /// Once per run: relaxation too strong for the calibrated r_0 shrinks every flat face.
@@ -662,7 +659,7 @@ void warnIfFacesEndInside(const MeshOptions& o, const nonbloppy::ResolvedParamet
     warning(once) << "--blend " << formatNumber(o.blend) << " --iterations " << o.iterations
               << " relax too strongly for --threshold to be calibrated: flat faces end inside the "
                  "particles; lower --blend or --iterations"
-              << (p.spacingGiven ? "" : ", or give --spacing to correct the volume") << std::endl;
+              << (p.spacingGiven ? "" : ", or give --spacing to correct the volume");
 }
 
 /// Once per run: positions are floats, whose step grows with the distance from the origin;
@@ -690,7 +687,7 @@ void warnIfCoarseFloats(const nonbloppy::SurfaceResult& result, OnceWarnings& on
               << " from the origin, where float positions step by " << formatNumber(step) << ", more than "
               << (bySpacing ? "1/16 of the spacing " + formatNumber(spacing) : "1/8 of the voxel size " + formatNumber(voxelSize))
               << ": the surface is quantized there" << (step >= 8.0 * limit ? ", and droplets may vanish" : "")
-              << "; move the particles nearer the origin" << std::endl;
+              << "; move the particles nearer the origin";
 }
 
 /// An empty mesh from particles is written (a frame of spray may have none), but said: an
@@ -703,7 +700,7 @@ void warnIfEmpty(const nonbloppy::SurfaceResult& result, const std::string& outp
     warning(once) << output << " is empty: the density of the " << result.particleCount
                   << (result.particleCount == 1 ? " particle" : " particles") << ", sampled at --voxel-size "
                   << formatNumber(result.parameters.voxelSize) << ", nowhere reaches --threshold "
-                  << formatNumber(result.parameters.threshold) << std::endl;
+                  << formatNumber(result.parameters.threshold);
 }
 
 /// Once per run: an input with faces (PLY) or polygons (legacy VTK) is a mesh, not
@@ -713,7 +710,7 @@ void warnIfMeshInput(const std::string& input, const std::string& faces, OnceWar
 {
     if (faces.empty() || once.meshInput.exchange(true)) return;
     warning(once) << input << " is a mesh (its " << faces << " was not read): its "
-              << "vertices were meshed as particles" << std::endl;
+              << "vertices were meshed as particles";
 }
 
 /// Once per run: vertices without a normal ((0,0,0), computeNormals()) shade black or not at
@@ -728,8 +725,7 @@ void warnIfNormalsMissing(const nonbloppy::SurfaceResult& result, const std::str
     warning(once) << missing << " of the " << normals.size() << " vertices of " << output
                   << " have no normal (the faces around them have no area)"
                   << (result.parameters.blend == 1.0 ? ": -c 1 collapses droplets onto their particles; lower --blend"
-                                                     : "")
-                  << std::endl;
+                                                     : "");
 }
 
 /// The warnings about one meshed frame (@a f: its options, paths included), each printed
@@ -819,6 +815,18 @@ std::string fileIdentity(const std::string& path)
     return "path:" + (ec ? path : normal.string());
 }
 
+/// The frame number the input pattern @a input would read @a path as, if any: its file name
+/// matches the pattern and it lies in the pattern's directory (whose fileIdentity() is
+/// @a inputDirectory).
+std::optional<int> frameReadAs(const FramePattern& input, const std::string& inputDirectory, const std::string& path)
+{
+    const fs::path asPath(path);
+    const std::string directory = asPath.parent_path().empty() ? "." : asPath.parent_path().string();
+    const std::optional<std::string> digits = input.matchFileName(asPath.filename().string());
+    if (!digits || fileIdentity(directory) != inputDirectory) return std::nullopt;
+    return std::stoi(*digits);
+}
+
 /// Refuse, before any frame is meshed, an output of one frame that is an input of the
 /// sequence (@a sequence: every frame on disk, requested or not; 'x{}.vtk' -o 'x1{}.vtk':
 /// frame 1's mesh x11.vtk would replace frame 11's particles, then be read as them), and a
@@ -839,9 +847,14 @@ void requireOutputsApart(const FramePattern& input, const std::vector<Frame>& se
     }
     const std::string log = logPath.empty() ? std::string() : fileIdentity(logPath);
     if (!log.empty()) {
-        if (const auto input = inputs.find(log); input != inputs.end()) {
+        if (const auto found = inputs.find(log); found != inputs.end()) {
             throw UsageError("cannot write " + logPath + ": --log names the input of frame " +
-                             std::to_string(input->second));
+                             std::to_string(found->second));
+        }
+        // Not there yet, but read as a frame by the next run (review).
+        if (const std::optional<int> frame = frameReadAs(input, inputDirectory, logPath)) {
+            throw UsageError("cannot write " + logPath + ": " + input.text() + " would read it as frame " +
+                             std::to_string(*frame));
         }
     }
     for (const BatchJob& job : jobs) {
@@ -851,12 +864,9 @@ void requireOutputsApart(const FramePattern& input, const std::vector<Frame>& se
                 throw UsageError("cannot write " + output + ": it is the input of frame " +
                                  std::to_string(found->second));
             }
-            const fs::path outputPath(output);
-            const std::string outputDirectory = outputPath.parent_path().empty() ? "." : outputPath.parent_path().string();
-            if (const auto digits = input.matchFileName(outputPath.filename().string());
-                digits && fileIdentity(outputDirectory) == inputDirectory) {
+            if (const std::optional<int> frame = frameReadAs(input, inputDirectory, output)) {
                 throw UsageError("cannot write " + output + ": " + input.text() + " would read it as frame " +
-                                 std::to_string(std::stoi(*digits)));
+                                 std::to_string(*frame));
             }
             if (identity == log) {
                 throw UsageError("cannot write " + logPath + ": --log names an output of frame " +
@@ -887,6 +897,7 @@ void logEarlyFailure(const MeshOptions& o, const FramePattern& input, const std:
                 if (fileIdentity(output) == log) return;
             }
         }
+        if (frameReadAs(input, fileIdentity(input.directory().empty() ? "." : input.directory()), o.logPath)) return;
     } catch (const std::exception&) {
         return;
     }
@@ -962,10 +973,7 @@ int runSequence(const MeshOptions& o)
 
     std::mutex verboseMutex;
     OnceWarnings once;
-    // The bar (stdout) and the warnings (stderr) on one terminal: each warning erases the bar
-    // first, and the next frame draws it again.
-    const bool barShown = !o.quiet && !o.verbose && ::isatty(STDOUT_FILENO) == 1;
-    if (barShown && ::isatty(STDERR_FILENO) == 1) once.linePrefix = "\r\033[K";
+    settings.warnings = &once.outputs.printer;
     BackgroundRemover remover;  // replaced outputs are freed while the next frames run
     // Writes a meshed frame, warns, and reports it; the frame's memory goes on return.
     const auto writeAndReport = [&](const MeshOptions& f, const BatchJob& job, MeshedFrame& frame,

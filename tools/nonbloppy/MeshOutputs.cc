@@ -77,17 +77,16 @@ void addSurfaceAttributes(nonbloppy::SurfaceResult& result, const nonbloppy::Par
                                      result.parameters.effectiveRadius, interrupter);
     const std::string ext = lowerExtension(meshPath);
     if (ext == ".obj" && !result.mesh.attributes.empty() && !once.objDropsAttributes.exchange(true)) {
-        std::cerr << "nonbloppy: warning: OBJ cannot store vertex attributes; write .ply or .vtk "
-                     "to keep --attributes" << std::endl;
+        once.printer.warn("OBJ cannot store vertex attributes; write .ply or .vtk to keep --attributes");
     }
     if (!once.meshRounds) {  // the scan is for the first frame that needs it
         const std::vector<std::string> rounded = nonbloppy::roundedAttributes(result.mesh, meshPath);
-        if (!rounded.empty() && !once.meshRounds.exchange(true)) warnRounded(rounded[0], meshPath);
+        if (!rounded.empty() && !once.meshRounds.exchange(true)) warnRounded(rounded[0], meshPath, once.printer);
     }
     if (ext != ".obj" && !result.mesh.attributes.empty() && !once.meshRenames.exchange(true)) {
         std::vector<std::string> original;
         for (const auto& a : result.mesh.attributes) original.push_back(a.name);
-        warnRenamedAttributes(original, nonbloppy::writtenAttributeNames(result.mesh, meshPath), meshPath);
+        warnRenamedAttributes(original, nonbloppy::writtenAttributeNames(result.mesh, meshPath), meshPath, once.printer);
     }
 }
 
@@ -103,11 +102,11 @@ void appendVdbGrids(openvdb::GridCPtrVec& grids, const nonbloppy::SurfaceResult&
         if (!particles.attributes.empty() && !once.vdbRenames.exchange(true)) {  // as convert says it
             std::vector<std::string> original;
             for (const auto& a : particles.attributes) original.push_back(a.name);
-            warnRenamedAttributes(original, nonbloppy::writtenAttributeNames(particles, vdbPath), vdbPath);
+            warnRenamedAttributes(original, nonbloppy::writtenAttributeNames(particles, vdbPath), vdbPath, once.printer);
         }
         if (!once.vdbRounds) {
             const std::vector<std::string> rounded = nonbloppy::roundedAttributes(particles, vdbPath);
-            if (!rounded.empty() && !once.vdbRounds.exchange(true)) warnRounded(rounded[0], vdbPath);
+            if (!rounded.empty() && !once.vdbRounds.exchange(true)) warnRounded(rounded[0], vdbPath, once.printer);
         }
     }
 }

@@ -8,6 +8,8 @@
 #ifndef NONBLOPPY_TOOL_MESH_OUTPUTS_H
 #define NONBLOPPY_TOOL_MESH_OUTPUTS_H
 
+#include "Commands.h"
+
 #include <CLI/CLI.hpp>
 
 #include <nonbloppy/BuildSurface.h>
@@ -35,6 +37,7 @@ struct MeshOutputOptions
 /// frames of a sequence carry the same attributes). One per run of the mesh command.
 struct OutputWarnings
 {
+    WarningPrinter printer;  ///< where every warning of the run goes (see runBatch())
     std::atomic<bool> objDropsAttributes{false};
     std::atomic<bool> meshRounds{false};
     std::atomic<bool> meshRenames{false};

@@ -52,21 +52,21 @@ std::string shownName(std::string name)
 } // namespace
 
 void warnRenamedAttributes(const std::vector<std::string>& original, const std::vector<std::string>& written,
-                           const std::string& path)
+                           const std::string& path, const WarningPrinter& printer)
 {
     for (size_t i = 0; i < original.size() && i < written.size(); ++i) {
         if (written[i].empty() || written[i] == original[i]) continue;
-        std::cerr << "nonbloppy: warning: attribute '" << shownName(original[i]) << "' is written to " << path
-                  << " as '" << written[i] << "'" << std::endl;
+        WarningLine(printer) << "attribute '" << shownName(original[i]) << "' is written to " << path << " as '"
+                             << written[i] << "'";
     }
 }
 
-void warnRounded(const std::string& name, const std::string& path)
+void warnRounded(const std::string& name, const std::string& path, const WarningPrinter& printer)
 {
     const char* why = lowerExtension(path) == ".vdb" ? "OpenVDB has no 64-bit integer vectors"
                                                      : "PLY has no 64-bit integers";
-    std::cerr << "nonbloppy: warning: attribute '" << shownName(name) << "' holds integers past 2^53, which " << path
-              << " stores as doubles, rounded (" << why << "); write .vtk to keep them exact" << std::endl;
+    WarningLine(printer) << "attribute '" << shownName(name) << "' holds integers past 2^53, which " << path
+                         << " stores as doubles, rounded (" << why << "); write .vtk to keep them exact";
 }
 
 } // namespace nonbloppy_tool
