@@ -1344,6 +1344,18 @@ private:
         mPiece.valid = true;
         mPiece.count = count;
         mPiece.positionOffset = mParticles.positions.size();
+        // A PolyData's polygons, lines and strips are not read: listed, as the legacy VTK
+        // reader lists its sections (bug hunt: a .vtp mesh was converted without a word).
+        if (mType == "PolyData") {
+            for (const char* cells : {"Polys", "Lines", "Strips"}) {
+                const std::string text = xmlAttribute(attributes, ("NumberOf" + std::string(cells)).c_str(), "0");
+                const std::string item = std::string(cells) + " section";
+                if (text != "0" && !text.empty() &&
+                    std::find(mParticles.skipped.begin(), mParticles.skipped.end(), item) == mParticles.skipped.end()) {
+                    mParticles.skipped.push_back(item);
+                }
+            }
+        }
     }
 
     /// The piece's first Points DataArray (NumberOfPoints > 0).
@@ -1376,7 +1388,7 @@ private:
             fail(mPath, "unsupported type '" + printable(typeName) + "' of " + what);
         }
         const int components = xmlIntAttribute(attributes, "NumberOfComponents", 1);
-        if (components < 1 || components > 64) fail(mPath, "bad NumberOfComponents of " + what);
+        if (components < 1 || components > 4096) fail(mPath, "bad NumberOfComponents of " + what);
         const size_t index = mPiece.attributeIndex++;
         int target = int(index);
         std::string mismatch;

@@ -101,7 +101,16 @@ namesForExtension(const ParticleSet& particles, const std::string& ext)
     for (const ParticleAttribute& a : particles.attributes) attributes.emplace_back(a.name, a.components);
     using attribute_names_internal::uniqueNames;
     if (ext == ".ply") return uniqueNames(attributes, headerWord, plyColumns, isPositionName);
-    if (ext == ".vtk" || ext == ".vtu") return uniqueNames(attributes, headerWord, wholeColumn, isPositionName);
+    if (ext == ".vtk") {
+        // A FIELD array line "metadata ..." reads as the METADATA block keyword (any case):
+        // the file came back unreadable (bug hunt).
+        return uniqueNames(attributes, headerWord, wholeColumn, [](const std::string& column) {
+            std::string upper = column;
+            for (char& c : upper) c = char(std::toupper(static_cast<unsigned char>(c)));
+            return isPositionName(column) || upper == "METADATA";
+        });
+    }
+    if (ext == ".vtu") return uniqueNames(attributes, headerWord, wholeColumn, isPositionName);
     if (ext == ".csv") return uniqueNames(attributes, headerWord, csvColumns, isCsvPositionName);
     if (ext == ".vdb") return uniqueNames(attributes, vdbWord, vdbColumns, isPositionName);
     return std::vector<std::string>(particles.attributes.size());
@@ -449,7 +458,10 @@ pointDataGridOfFinitePositions(const ParticleSet& particles, double voxelSize, d
         throw ParameterError(msg.str());
     }
     if (!(voxelSize > 0.0)) {
-        voxelSize = positions.size() > 1 ? double(openvdb::points::computeVoxelSize(wrapper, 8)) : 1.0;
+        // One particle has no spacing to size voxels by: 1, or coarser where it lies too far
+        // out for 32-bit voxel coordinates at 1 (one particle 5e9 out was refused).
+        voxelSize = positions.size() > 1 ? double(openvdb::points::computeVoxelSize(wrapper, 8))
+                                         : std::max(1.0, 2.0 * largest / openvdb_scale_internal::kMaxIndexCoordinate);
     } else {
         openvdb_scale_internal::requireOpenVdbScale(voxelSize, kMinCellSize, "--voxel-size");
     }
@@ -518,12 +530,14 @@ writeParticles(const ParticleSet& particles, const std::string& path, const Part
     requireSizes(particles, " (" + path + ")");
     if (ext == ".vdb") {
         const double largest = requirePlaceablePositions(particles, " (" + path + ")");
+        openvdb::GridBase::Ptr grid;
         try {
             for (const ParticleAttribute& a : particles.attributes) io_internal::requireInt64Values(a, "a .vdb stores");
+            grid = pointDataGridOfFinitePositions(particles, 0.0, largest);
         } catch (const ParameterError& e) {
             throw ParameterError(e.what() + (" (" + path + ")"));  // named as the other refusals are
         }
-        writeVdb({pointDataGridOfFinitePositions(particles, 0.0, largest)}, path);
+        writeVdb({grid}, path);
         return;
     }
     writeFileAtomically(path, [&](std::ostream& os) {

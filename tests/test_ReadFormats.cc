@@ -887,6 +887,52 @@ TEST_F(ReadFormatsTest, ComponentsPastTheThirdRoundTripThroughEveryFormat)
     }
 }
 
+TEST_F(ReadFormatsTest, WhatTheWritersWriteTheirReadersRead)
+{
+    // Bug hunt: an attribute named "metadata" made a .vtk FIELD line that reads as VTK's
+    // METADATA block; 65 components made a .vtu the reader refused (it allowed 64, legacy
+    // VTK 4096); one particle 5e9 out got a .vdb voxel of 1, past 32-bit voxel coordinates.
+    ParticleSet particles;
+    particles.positions = {openvdb::Vec3f(0.0f), openvdb::Vec3f(1.0f, 2.0f, 3.0f)};
+    particles.attributes.push_back(ParticleAttribute::of("Metadata", 1, std::vector<float>{1.5f, 2.5f}));
+    std::vector<float> wide(2 * 65);
+    for (size_t k = 0; k < wide.size(); ++k) wide[k] = float(k);
+    particles.attributes.push_back(ParticleAttribute::of("wide", 65, wide));
+    const std::string vtk = path("md.vtk");
+    nonbloppy::writeParticles(particles, vtk);
+    EXPECT_EQ(nonbloppy::writtenAttributeNames(particles, vtk)[0], "Metadata_2");
+    const ParticleSet fromVtk = readParticles(vtk);
+    ASSERT_EQ(fromVtk.attributes.size(), 2u);
+    EXPECT_EQ(fromVtk.attributes[0].name, "Metadata_2");
+    EXPECT_EQ(fromVtk.attributes[0].asDouble(1), 2.5);
+    const std::string vtu = path("wide.vtu");
+    nonbloppy::writeParticles(particles, vtu);
+    const ParticleSet fromVtu = readParticles(vtu);
+    ASSERT_EQ(fromVtu.attributes.size(), 2u);
+    EXPECT_EQ(fromVtu.attributes[1].components, 65);
+    EXPECT_EQ(fromVtu.attributes[1].asDouble(1, 64), 129.0);
+
+    // A .vtp's polygons are listed as not read, as a legacy VTK's are (bug hunt).
+    const std::string vtp = write("tri.vtp",
+        "<?xml version=\"1.0\"?>\n<VTKFile type=\"PolyData\" version=\"1.0\" byte_order=\"LittleEndian\">\n<PolyData>\n"
+        "<Piece NumberOfPoints=\"3\" NumberOfVerts=\"0\" NumberOfLines=\"0\" NumberOfStrips=\"0\" NumberOfPolys=\"1\">\n"
+        "<Points><DataArray type=\"Float32\" NumberOfComponents=\"3\" format=\"ascii\">0 0 0 1 0 0 0 1 0</DataArray></Points>\n"
+        "<Polys><DataArray type=\"Int32\" Name=\"connectivity\" format=\"ascii\">0 1 2</DataArray>\n"
+        "<DataArray type=\"Int32\" Name=\"offsets\" format=\"ascii\">3</DataArray></Polys>\n"
+        "</Piece>\n</PolyData>\n</VTKFile>\n");
+    const ParticleSet triangle = readParticles(vtp);
+    EXPECT_EQ(triangle.size(), 3u);
+    EXPECT_EQ(triangle.skipped, std::vector<std::string>{"Polys section"});
+
+    ParticleSet far;
+    far.positions = {openvdb::Vec3f(5.0e9f, 0.0f, 0.0f)};
+    const std::string vdb = path("far.vdb");
+    nonbloppy::writeParticles(far, vdb);
+    const ParticleSet back = readParticles(vdb);
+    ASSERT_EQ(back.size(), 1u);
+    EXPECT_NEAR(back.positions[0][0], 5.0e9f, 5.0e9f * 1e-6f);
+}
+
 TEST_F(ReadFormatsTest, VdbWithoutPointsIsAClearError)
 {
     openvdb::initialize();

@@ -135,7 +135,8 @@ struct NONBLOPPY_API ParticleSet
     /// "group 'splash'", "string attribute 'name'" (.vdb), "string array 'label'" (VTU,
     /// VTP), "unnamed column 1" (CSV: pandas' and R's row numbers), "list property 'ids'"
     /// or "element 'face'" (PLY: an element other than the vertices, e.g. a mesh's faces),
-    /// "POLYGONS section" (legacy VTK: also LINES and TRIANGLE_STRIPS),
+    /// "POLYGONS section" (legacy VTK: also LINES and TRIANGLE_STRIPS), "Polys section"
+    /// (VTP: also Lines and Strips),
     /// so that a caller can tell its user what a conversion leaves behind.
     std::vector<std::string> skipped;
 

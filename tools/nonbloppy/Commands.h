@@ -113,11 +113,13 @@ void warnRenamedAttributes(const std::vector<std::string>& original, const std::
                            const std::string& path, const WarningPrinter& printer);
 
 /// Whether @a item of ParticleSet::skipped is what makes a file a mesh: a PLY's faces, a
-/// legacy VTK's polygons or triangle strips, as the readers name them (the CLI tests check
+/// legacy VTK's polygons or triangle strips, a VTK PolyData's Polys or Strips, as the
+/// readers name them (the CLI tests check
 /// both spellings).
 inline bool isSurfaceSkipped(const std::string& item)
 {
-    return item == "element 'face'" || item == "POLYGONS section" || item == "TRIANGLE_STRIPS section";
+    return item == "element 'face'" || item == "POLYGONS section" || item == "TRIANGLE_STRIPS section" ||
+           item == "Polys section" || item == "Strips section";
 }
 
 /// @a particles.skipped as one list: "group 'splash', string attribute 'name'"; without
