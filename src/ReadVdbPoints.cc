@@ -1215,6 +1215,7 @@ public:
 
         openvdb::GridPtrVec grids;
         NamedGridMap namedGrids;
+        bool pointsRead = false;  // the first PointDataGrid, the only one read
         for (uint32_t i = 0; i < gridCount; ++i) {
             check.seek(position());
             check.gridDescriptor(version);
@@ -1226,9 +1227,10 @@ public:
             }
             openvdb::GridBase::Ptr grid = openvdb::GridBase::createGrid(descriptor.gridType());
             const bool pointDataGrid = descriptor.gridType() == PointDataGrid::gridType();
-            // Other grids are not needed: where the file says where they end, skip them
-            // unread (only their names and types are kept, for the error message).
-            if (!pointDataGrid && check.hasGridOffsets() && descriptor.getEndPos() > 0
+            // Other grids are not needed, nor point grids after the first: where the file says
+            // where they end, skip them unread (only their names and types are kept, for the
+            // error message and ParticleSet::skipped).
+            if ((!pointDataGrid || pointsRead) && check.hasGridOffsets() && descriptor.getEndPos() > 0
                 && uint64_t(descriptor.getEndPos()) >= check.pos()
                 && uint64_t(descriptor.getEndPos()) <= size) {
                 grid->setName(descriptor.gridName());
@@ -1244,7 +1246,10 @@ public:
             grids.push_back(grid);
             namedGrids[descriptor.uniqueName()] = grid;
             connectInstance(descriptor, namedGrids);
-            if (openvdb::gridConstPtrCast<PointDataGrid>(grid)) break;
+            if (openvdb::gridConstPtrCast<PointDataGrid>(grid)) {
+                pointsRead = true;
+                if (!check.hasGridOffsets()) break;  // the rest could only be found by reading it
+            }
         }
         return grids;
     }
@@ -1322,9 +1327,17 @@ readVdbPoints(const VdbSource& source, const std::string& path)
     openvdb::GridPtrVec grids;
     try {
         grids = CheckedVdbStream().read(source, path);
-        for (const openvdb::GridBase::Ptr& grid : grids) {
-            if (const auto points = openvdb::gridConstPtrCast<PointDataGrid>(grid)) {
-                return convertGrid(*points, path);
+        for (size_t g = 0; g < grids.size(); ++g) {
+            if (const auto points = openvdb::gridConstPtrCast<PointDataGrid>(grids[g])) {
+                ParticleSet particles = convertGrid(*points, path);
+                // Only the first is read; the others are said (bug hunt: a second grid's
+                // particles were left out of a mesh without a word).
+                for (size_t other = g + 1; other < grids.size(); ++other) {
+                    if (openvdb::gridConstPtrCast<PointDataGrid>(grids[other])) {
+                        particles.skipped.push_back("point grid '" + printable(grids[other]->getName()) + "'");
+                    }
+                }
+                return particles;
             }
         }
     } catch (const Error&) {

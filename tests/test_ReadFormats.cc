@@ -10,6 +10,7 @@
 #include <nonbloppy/Error.h>
 #include <nonbloppy/ReadParticles.h>
 #include <nonbloppy/WriteParticles.h>
+#include <nonbloppy/WriteVdb.h>
 
 #include <openvdb/openvdb.h>
 
@@ -931,6 +932,23 @@ TEST_F(ReadFormatsTest, WhatTheWritersWriteTheirReadersRead)
     const ParticleSet back = readParticles(vdb);
     ASSERT_EQ(back.size(), 1u);
     EXPECT_NEAR(back.positions[0][0], 5.0e9f, 5.0e9f * 1e-6f);
+}
+
+TEST_F(ReadFormatsTest, AVdbsPointGridsAfterTheFirstAreListedAsNotRead)
+{
+    // Only the first PointDataGrid is read; a second one's particles were left out of the
+    // mesh without a word (bug hunt).
+    ParticleSet a, b;
+    a.positions = {openvdb::Vec3f(0.0f), openvdb::Vec3f(1.0f, 0.0f, 0.0f)};
+    b.positions = {openvdb::Vec3f(5.0f), openvdb::Vec3f(6.0f), openvdb::Vec3f(7.0f)};
+    openvdb::GridBase::Ptr first = nonbloppy::makePointDataGrid(a), second = nonbloppy::makePointDataGrid(b);
+    first->setName("A");
+    second->setName("B");
+    const std::string vdb = path("two.vdb");
+    nonbloppy::writeVdb({first, second}, vdb);
+    const ParticleSet read = readParticles(vdb);
+    EXPECT_EQ(read.size(), 2u);
+    EXPECT_EQ(read.skipped, std::vector<std::string>{"point grid 'B'"});
 }
 
 TEST_F(ReadFormatsTest, VdbWithoutPointsIsAClearError)

@@ -136,7 +136,8 @@ struct NONBLOPPY_API ParticleSet
     /// VTP), "unnamed column 1" (CSV: pandas' and R's row numbers), "list property 'ids'"
     /// or "element 'face'" (PLY: an element other than the vertices, e.g. a mesh's faces),
     /// "POLYGONS section" (legacy VTK: also LINES and TRIANGLE_STRIPS), "Polys section"
-    /// (VTP: also Lines and Strips),
+    /// (VTP: also Lines and Strips), "point grid 'B'" (.vdb: the point grids after the first,
+    /// which alone is read),
     /// so that a caller can tell its user what a conversion leaves behind.
     std::vector<std::string> skipped;
 

@@ -507,9 +507,11 @@ MeshedFrame meshFrameSurface(const MeshOptions& o, ProgressInterrupter& interrup
         // A mesh's faces, not read: its vertices are meshed (said by warnIfMeshInput()).
         if (isSurfaceSkipped(skipped)) frame.faces = skipped;
     }
-    // Once per run, and only where the particles' attributes are used.
+    // Once per run, and only where the particles' attributes are used; particles left out
+    // (a .vdb's other point grids) whatever the outputs.
     const std::string notRead = joinedSkipped(frame.particles, /*withSurfaces=*/false);
-    if (o.outputs.needParticles() && !notRead.empty() && !once.attributesNotRead.exchange(true)) {
+    const bool particlesLeft = notRead.find("point grid '") != std::string::npos;
+    if ((o.outputs.needParticles() || particlesLeft) && !notRead.empty() && !once.attributesNotRead.exchange(true)) {
         warning(once) << "not read from " << o.input << ": " << notRead;
     }
     // Before meshing: a misspelt name used to cost the whole frame's work first.
