@@ -10,7 +10,6 @@
 #include <nonbloppy/ComputeNormals.h>
 
 #include "Cancellation.h"
-#include "NumberText.h"
 #include "ParameterChecks.h"
 #include "PolygonIndices.h"
 #include "SurfaceStages.h"
@@ -280,11 +279,7 @@ double cancellation_internal::calibrateRelaxedThreshold(double effectiveRadiusOv
 {
     if (reachesSurface) *reachesSurface = true;
     const double ratio = effectiveRadiusOverSpacing;
-    if (!(blend >= 0.0 && blend <= 1.0)) {
-        std::ostringstream msg;
-        msg << "--blend must lie in [0,1], got " << number_text_internal::numberBeside(blend, blend < 0.0 ? 0.0 : 1.0);
-        throw ParameterError(msg.str());
-    }
+    parameter_checks_internal::requireUnitInterval(blend, "--blend");
     if (iterations < 0) {
         throw ParameterError("--iterations must be >= 0, got " + std::to_string(iterations));
     }

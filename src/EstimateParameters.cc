@@ -394,17 +394,11 @@ void checkParameters(const SurfaceParameters& params)
     requirePositive(params.effectiveRadius, "--radius");
     requirePositive(params.threshold, "--threshold");
     requirePositive(params.voxelSize, "--voxel-size");
-    if (!(params.blend >= 0.0 && params.blend <= 1.0)) {
-        throw ParameterError("--blend must lie in [0,1], got " +
-                             number_text_internal::numberBeside(params.blend, params.blend < 0.0 ? 0.0 : 1.0));
-    }
+    parameter_checks_internal::requireUnitInterval(params.blend, "--blend");
     if (params.iterations < 0) {
         throw ParameterError("--iterations must be >= 0, got " + std::to_string(params.iterations));
     }
-    if (!(params.adaptivity >= 0.0 && params.adaptivity <= 1.0)) {
-        throw ParameterError("--adaptivity must lie in [0,1], got " +
-                             number_text_internal::numberBeside(params.adaptivity, params.adaptivity < 0.0 ? 0.0 : 1.0));
-    }
+    parameter_checks_internal::requireUnitInterval(params.adaptivity, "--adaptivity");
     // An out-of-range enumerator (a cast integer, memory from another build) ran as neither
     // variant: the Paper mesh without its threshold calibration.
     if (params.method != Method::Paper && params.method != Method::Faithful) {

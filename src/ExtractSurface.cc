@@ -14,6 +14,7 @@
 
 #include "Cancellation.h"
 #include "NumberText.h"
+#include "ParameterChecks.h"
 #include "SurfaceStages.h"
 
 #include <openvdb/tools/VolumeToMesh.h>
@@ -60,12 +61,7 @@ void checkExtractParameters(double threshold, double adaptivity, double backgrou
             << " (its value outside the fluid), got " << number_text_internal::numberBeside(threshold, background);
         throw ParameterError(msg.str());
     }
-    if (!(adaptivity >= 0.0 && adaptivity <= 1.0)) {
-        std::ostringstream msg;
-        msg << "--adaptivity must lie in [0,1], got "
-            << number_text_internal::numberBeside(adaptivity, adaptivity < 0.0 ? 0.0 : 1.0);
-        throw ParameterError(msg.str());
-    }
+    parameter_checks_internal::requireUnitInterval(adaptivity, "--adaptivity");
 }
 
 /// @throw ParameterError if @a density is classed as a level set: there the inside holds the

@@ -7,6 +7,8 @@
 #include <nonbloppy/CorrectSurface.h>
 #include <nonbloppy/Error.h>
 
+#include "NumberText.h"
+
 #include <cmath>
 #include <sstream>
 #include <string>
@@ -24,6 +26,16 @@ inline void requirePositive(double value, const std::string& name)
     std::ostringstream msg;
     msg << name << (std::isfinite(value) ? " must be > 0, got " : " must be finite, got ") << value;
     throw ParameterError(msg.str());
+}
+
+/// @throw ParameterError("<name> must lie in [0,1], got <value>") unless 0 <= @a value <= 1
+/// (NaN refused): for --blend and --adaptivity, the value printed exactly where six digits
+/// would show the limit (numberBeside()).
+inline void requireUnitInterval(double value, const char* name)
+{
+    if (value >= 0.0 && value <= 1.0) return;
+    throw ParameterError(std::string(name) + " must lie in [0,1], got " +
+                         number_text_internal::numberBeside(value, value < 0.0 ? 0.0 : 1.0));
 }
 
 /// @throw ParameterError("volume offset must be Uniform or Convex, got 7") for a value that

@@ -1,7 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "Cancellation.h"
 #include "InstructionSet.h"
-#include "NumberText.h"
 #include "ParameterChecks.h"
 #include "ParticleIndexImpl.h"
 #include "UnwrittenVector.h"
@@ -480,11 +479,7 @@ void instruction_set_internal::relaxVertices(SurfaceMesh& mesh, const ParticleIn
 {
     std::ostringstream msg;
     parameter_checks_internal::requirePositive(settings.effectiveRadius, "--radius");
-    if (!(settings.blend >= 0.0 && settings.blend <= 1.0)) {
-        msg << "--blend must lie in [0,1], got "
-            << number_text_internal::numberBeside(settings.blend, settings.blend < 0.0 ? 0.0 : 1.0);
-        throw ParameterError(msg.str());
-    }
+    parameter_checks_internal::requireUnitInterval(settings.blend, "--blend");
     if (settings.iterations < 0) {
         msg << "--iterations must be >= 0, got " << settings.iterations;
         throw ParameterError(msg.str());
