@@ -223,10 +223,13 @@ parseTable(StreamReader& in, const std::string& path)
 
     // Values go straight into the attribute arrays: as int64 while every value of the
     // attribute is a whole number that fits (parsed as such, so an id past 2^53 stays
-    // exact), then as float64 from the first that is not, the int64s before it converted.
+    // exact); as uint64 once one passes int64 if none was negative (the bytes of the values
+    // before are the same: a CSV of uint64 ids came back rounded, bug hunt); then as float64
+    // from the first that fits neither, the integers before it converted.
     ParticleSet particles;
     particles.attributes.resize(names.size());
-    std::vector<bool> integral(names.size(), true);
+    std::vector<ScalarType> kinds(names.size(), ScalarType::Int64);
+    std::vector<bool> negative(names.size(), false);
     const uint64_t dataStart = in.pos();
     std::string_view line;
     while (nextLine(line)) {
@@ -240,10 +243,20 @@ parseTable(StreamReader& in, const std::string& path)
             const std::string_view field = trimmed(fields[i]);
             const int attribute = columns[i].attribute;
             if (attribute == kUnnamed) continue;
-            int64_t whole;
-            if (attribute >= 0 && integral[size_t(attribute)] && io_internal::parseWhole(field, whole)) {
-                appendBytes(particles.attributes[size_t(attribute)].bytes, whole);
-                continue;
+            if (attribute >= 0 && kinds[size_t(attribute)] != ScalarType::Float64) {
+                const size_t a = size_t(attribute);
+                int64_t whole;
+                uint64_t large;
+                if (kinds[a] == ScalarType::Int64 && io_internal::parseWhole(field, whole)) {
+                    negative[a] = negative[a] || whole < 0;
+                    appendBytes(particles.attributes[a].bytes, whole);
+                    continue;
+                }
+                if (!negative[a] && io_internal::parseWhole(field, large)) {
+                    kinds[a] = ScalarType::UInt64;
+                    appendBytes(particles.attributes[a].bytes, large);
+                    continue;
+                }
             }
             double value;
             if (!parseDoubleField(field, value)) {
@@ -254,13 +267,17 @@ parseTable(StreamReader& in, const std::string& path)
                 continue;
             }
             std::vector<unsigned char>& bytes = particles.attributes[size_t(attribute)].bytes;
-            if (integral[size_t(attribute)]) {
-                integral[size_t(attribute)] = false;
+            ScalarType& kind = kinds[size_t(attribute)];
+            if (kind != ScalarType::Float64) {
                 for (size_t at = 0; at < bytes.size(); at += 8) {
-                    std::memcpy(&whole, bytes.data() + at, 8);
-                    const double converted = double(whole);
+                    int64_t signedValue;
+                    uint64_t unsignedValue;
+                    std::memcpy(&signedValue, bytes.data() + at, 8);
+                    std::memcpy(&unsignedValue, bytes.data() + at, 8);
+                    const double converted = kind == ScalarType::Int64 ? double(signedValue) : double(unsignedValue);
                     std::memcpy(bytes.data() + at, &converted, 8);
                 }
+                kind = ScalarType::Float64;
             }
             appendBytes(bytes, value);
         }
@@ -280,7 +297,7 @@ parseTable(StreamReader& in, const std::string& path)
         ParticleAttribute& attribute = particles.attributes[a];
         attribute.name = names[a];
         attribute.components = componentCounts[a];
-        attribute.type = integral[a] ? ScalarType::Int64 : ScalarType::Float64;
+        attribute.type = kinds[a];
     }
     return particles;
 }

@@ -483,11 +483,12 @@ TEST_F(ReadFormatsTest, CsvIntegersAreExactPast2To53)
 {
     // Whole numbers were parsed as doubles and a column was int64 only below 9e15: the id
     // 9007199254740993 (2^53 + 1) came back as ...992, a neighbour's. Now parsed as int64;
-    // a column turns float64 at its first value that is not a whole number (or past int64).
+    // uint64 past int64 where no value is negative (a uint64 id past 2^63 came back
+    // rounded, bug hunt); a column turns float64 at its first value that fits neither.
     const std::string file = write("ids.csv",
-        "x,y,z,id,mixed,beyond\n"
-        "0,0,0,9007199254740993,9007199254740993,9223372036854775807\n"
-        "1,0,0,-9223372036854775808,2.5,9223372036854775808\n");
+        "x,y,z,id,mixed,beyond,signed,unsigned\n"
+        "0,0,0,9007199254740993,9007199254740993,9223372036854775807,-1,18446744073709551615\n"
+        "1,0,0,-9223372036854775808,2.5,18446744073709551614,9223372036854775808,-1\n");
     const ParticleSet particles = readParticles(file);
     ASSERT_EQ(particles.size(), 2u);
     const ParticleAttribute& id = attribute(particles, "id");
@@ -501,8 +502,19 @@ TEST_F(ReadFormatsTest, CsvIntegersAreExactPast2To53)
     EXPECT_EQ(mixed.asDouble(0), 9007199254740992.0);  // the nearest double
     EXPECT_EQ(mixed.asDouble(1), 2.5);
     const ParticleAttribute& beyond = attribute(particles, "beyond");
-    EXPECT_EQ(beyond.type, ScalarType::Float64);
-    EXPECT_EQ(beyond.asDouble(1), 9223372036854775808.0);
+    ASSERT_EQ(beyond.type, ScalarType::UInt64);
+    uint64_t large[2];
+    std::memcpy(large, beyond.bytes.data(), sizeof(large));
+    EXPECT_EQ(large[0], 9223372036854775807u);
+    EXPECT_EQ(large[1], 18446744073709551614u);
+    const ParticleAttribute& signedThenLarge = attribute(particles, "signed");
+    EXPECT_EQ(signedThenLarge.type, ScalarType::Float64);
+    EXPECT_EQ(signedThenLarge.asDouble(0), -1.0);
+    EXPECT_EQ(signedThenLarge.asDouble(1), 9223372036854775808.0);
+    const ParticleAttribute& largeThenNegative = attribute(particles, "unsigned");
+    EXPECT_EQ(largeThenNegative.type, ScalarType::Float64);
+    EXPECT_EQ(largeThenNegative.asDouble(0), 18446744073709551615.0);
+    EXPECT_EQ(largeThenNegative.asDouble(1), -1.0);
 }
 
 TEST_F(ReadFormatsTest, CsvWithAByteOrderMarkAsExcelWritesIt)

@@ -39,8 +39,8 @@
 ///           called `name`; a lone `name_x` keeps its name; `name_0` is a scalar),
 ///           separated by ',', ';', tabs or spaces, names and values optionally quoted;
 ///           a column without a name (pandas' and R's row numbers) is left out and listed in
-///           ParticleSet::skipped; attributes are int64 if every value is an integer, else
-///           float64.
+///           ParticleSet::skipped; attributes are int64 if every value is an integer that
+///           fits, uint64 if none is negative and some pass int64, else float64.
 /// - `.json` `[[x, y, z], ...]` (positions only).
 /// A file with zero particles is read without complaint (the pipeline rejects it later).
 /// Cost: one pass over the file. `.vtk`, `.ply`, `.xyz`, `.bgeo` (gzip inflated in chunks),
