@@ -524,6 +524,13 @@ readXyzParticles(const std::string& path)
 const char* const kParticleExtensions =
     ".vtk, .vtu, .vtp, .ply, .xyz, .bgeo, .vdb, .csv, .txt or .json";
 
+/// The extension before @a ext, the lower-case extension @a path ends with ("x.bgeo.gz",
+/// ".gz": ".bgeo"); "" if there is none.
+std::string innerExtension(const std::string& path, const std::string& ext)
+{
+    return io_internal::lowerExtension(path.substr(0, path.size() - ext.size()));
+}
+
 /// The extension that picks @a path's reader, lower case: lowerExtension(), except that
 /// ".bgeo" is also picked by `.bhclassic` (Houdini 12 and later write the classic layout
 /// under that name; their own `.bgeo` is JSON-based) and by the gzipped `.bgeo.gz` and
@@ -531,10 +538,9 @@ const char* const kParticleExtensions =
 /// `.bgeo.gz` from Houdini 12 or later holds).
 std::string readerExtension(const std::string& path)
 {
-    using io_internal::lowerExtension;
-    std::string ext = lowerExtension(path);
+    const std::string ext = io_internal::lowerExtension(path);
     if (ext == ".gz") {
-        const std::string inner = lowerExtension(path.substr(0, path.size() - 3));
+        const std::string inner = innerExtension(path, ext);
         if (inner == ".bgeo" || inner == ".bhclassic") return ".bgeo";
     }
     return ext == ".bhclassic" ? ".bgeo" : ext;
@@ -545,9 +551,8 @@ std::string readerExtension(const std::string& path)
 /// JSON-based geometry compressed with Blosc, and `.geo`/`.hclassic` are ASCII.
 std::string houdiniAdvice(const std::string& path)
 {
-    using io_internal::lowerExtension;
-    const std::string ext = lowerExtension(path);
-    const std::string inner = ext == ".sc" || ext == ".gz" ? lowerExtension(path.substr(0, path.size() - ext.size())) : ext;
+    const std::string ext = io_internal::lowerExtension(path);
+    const std::string inner = ext == ".sc" || ext == ".gz" ? innerExtension(path, ext) : ext;
     if (inner != ".bgeo" && inner != ".bhclassic" && inner != ".geo" && inner != ".hclassic") return std::string();
     return std::string(ext == ".sc" ? ": Houdini's Blosc-compressed geometry is not read" : ": Houdini's ASCII geometry is not read")
            + "; export it from Houdini as .bhclassic (classic binary geometry; renaming does not convert it)";

@@ -105,9 +105,7 @@ namesForExtension(const ParticleSet& particles, const std::string& ext)
         // A FIELD array line "metadata ..." reads as the METADATA block keyword (any case):
         // the file came back unreadable (bug hunt).
         return uniqueNames(attributes, headerWord, wholeColumn, [](const std::string& column) {
-            std::string upper = column;
-            for (char& c : upper) c = char(std::toupper(static_cast<unsigned char>(c)));
-            return isPositionName(column) || upper == "METADATA";
+            return isPositionName(column) || io_internal::iequals(column, "METADATA");
         });
     }
     if (ext == ".vtu") return uniqueNames(attributes, headerWord, wholeColumn, isPositionName);

@@ -114,12 +114,18 @@ void warnRenamedAttributes(const std::vector<std::string>& original, const std::
 
 /// Whether @a item of ParticleSet::skipped is what makes a file a mesh: a PLY's faces, a
 /// legacy VTK's polygons or triangle strips, a VTK PolyData's Polys or Strips, as the
-/// readers name them (the CLI tests check
-/// both spellings).
+/// readers name them (the CLI tests check both spellings).
 inline bool isSurfaceSkipped(const std::string& item)
 {
     return item == "element 'face'" || item == "POLYGONS section" || item == "TRIANGLE_STRIPS section" ||
            item == "Polys section" || item == "Strips section";
+}
+
+/// Whether @a item of ParticleSet::skipped holds particles left out: a .vdb's point grid
+/// after the first ("point grid 'B'"), which alone is read.
+inline bool isPointGridSkipped(const std::string& item)
+{
+    return item.rfind("point grid '", 0) == 0;
 }
 
 /// @a particles.skipped as one list: "group 'splash', string attribute 'name'"; without

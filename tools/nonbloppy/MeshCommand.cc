@@ -510,7 +510,7 @@ MeshedFrame meshFrameSurface(const MeshOptions& o, ProgressInterrupter& interrup
     // Once per run, and only where the particles' attributes are used; particles left out
     // (a .vdb's other point grids) whatever the outputs.
     const std::string notRead = joinedSkipped(frame.particles, /*withSurfaces=*/false);
-    const bool particlesLeft = notRead.find("point grid '") != std::string::npos;
+    const bool particlesLeft = std::any_of(frame.particles.skipped.begin(), frame.particles.skipped.end(), isPointGridSkipped);
     if ((o.outputs.needParticles() || particlesLeft) && !notRead.empty() && !once.attributesNotRead.exchange(true)) {
         warning(once) << "not read from " << o.input << ": " << notRead;
     }
@@ -649,9 +649,9 @@ void warnIfLengthsMove(int frame, const nonbloppy::ResolvedParameters& p, bool m
         pin += " --max-step " + formatNumber(first.second.maxStep);
     }
     warning(once) << "the spacing estimate moves between frames (" << formatNumber(reference)
-              << " in frame " << first.first << ", " << formatNumber(p.spacing) << " in frame " << frame
-              << ") and the lengths derived from it move too; to mesh every frame alike, give frame "
-              << first.first << "'s:" << pin;
+                  << " in frame " << first.first << ", " << formatNumber(p.spacing) << " in frame " << frame
+                  << ") and the lengths derived from it move too; to mesh every frame alike, give frame "
+                  << first.first << "'s:" << pin;
 }
 
 /// Once per run: relaxation too strong for the calibrated r_0 shrinks every flat face.
@@ -659,9 +659,9 @@ void warnIfFacesEndInside(const MeshOptions& o, const nonbloppy::ResolvedParamet
 {
     if (p.thresholdReachesSurface || once.facesEndInside.exchange(true)) return;
     warning(once) << "--blend " << formatNumber(o.blend) << " --iterations " << o.iterations
-              << " relax too strongly for --threshold to be calibrated: flat faces end inside the "
-                 "particles; lower --blend or --iterations"
-              << (p.spacingGiven ? "" : ", or give --spacing to correct the volume");
+                  << " relax too strongly for --threshold to be calibrated: flat faces end inside the "
+                     "particles; lower --blend or --iterations"
+                  << (p.spacingGiven ? "" : ", or give --spacing to correct the volume");
 }
 
 /// Once per run: positions are floats, whose step grows with the distance from the origin;
@@ -686,10 +686,11 @@ void warnIfCoarseFloats(const nonbloppy::SurfaceResult& result, OnceWarnings& on
     const double limit = bySpacing ? spacing / 16.0 : voxelSize / 8.0;
     if (!(limit > 0.0) || !(step > limit) || once.coarseFloats.exchange(true)) return;
     warning(once) << "the particles reach " << formatNumber(farthest)
-              << " from the origin, where float positions step by " << formatNumber(step) << ", more than "
-              << (bySpacing ? "1/16 of the spacing " + formatNumber(spacing) : "1/8 of the voxel size " + formatNumber(voxelSize))
-              << ": the surface is quantized there" << (step >= 8.0 * limit ? ", and droplets may vanish" : "")
-              << "; move the particles nearer the origin";
+                  << " from the origin, where float positions step by " << formatNumber(step) << ", more than "
+                  << (bySpacing ? "1/16 of the spacing " + formatNumber(spacing)
+                                : "1/8 of the voxel size " + formatNumber(voxelSize))
+                  << ": the surface is quantized there" << (step >= 8.0 * limit ? ", and droplets may vanish" : "")
+                  << "; move the particles nearer the origin";
 }
 
 /// An empty mesh from particles is written (a frame of spray may have none), but said: an
@@ -712,7 +713,7 @@ void warnIfMeshInput(const std::string& input, const std::string& faces, OnceWar
 {
     if (faces.empty() || once.meshInput.exchange(true)) return;
     warning(once) << input << " is a mesh (its " << faces << " was not read): its "
-              << "vertices were meshed as particles";
+                  << "vertices were meshed as particles";
 }
 
 /// Once per run: vertices without a normal ((0,0,0), computeNormals()) shade black or not at
@@ -721,6 +722,7 @@ void warnIfMeshInput(const std::string& input, const std::string& faces, OnceWar
 /// free-particle frame with --method paper).
 void warnIfNormalsMissing(const nonbloppy::SurfaceResult& result, const std::string& output, OnceWarnings& once)
 {
+    if (once.normalsMissing.load()) return;  // said: no pass over the next frames' normals
     const std::vector<openvdb::Vec3s>& normals = result.mesh.normals;
     const size_t missing = size_t(std::count(normals.begin(), normals.end(), openvdb::Vec3s(0.0f)));
     if (missing == 0 || once.normalsMissing.exchange(true)) return;
@@ -817,9 +819,15 @@ std::string fileIdentity(const std::string& path)
     return "path:" + (ec ? path : normal.string());
 }
 
+/// fileIdentity() of the directory @a input's frames lie in.
+std::string directoryIdentity(const FramePattern& input)
+{
+    return fileIdentity(input.directory().empty() ? "." : input.directory());
+}
+
 /// The frame number the input pattern @a input would read @a path as, if any: its file name
 /// matches the pattern and it lies in the pattern's directory (whose fileIdentity() is
-/// @a inputDirectory).
+/// @a inputDirectory, directoryIdentity()).
 std::optional<int> frameReadAs(const FramePattern& input, const std::string& inputDirectory, const std::string& path)
 {
     const fs::path asPath(path);
@@ -841,7 +849,7 @@ std::optional<int> frameReadAs(const FramePattern& input, const std::string& inp
 void requireOutputsApart(const FramePattern& input, const std::vector<Frame>& sequence,
                          const std::vector<BatchJob>& jobs, const std::string& logPath)
 {
-    const std::string inputDirectory = fileIdentity(input.directory().empty() ? "." : input.directory());
+    const std::string inputDirectory = directoryIdentity(input);
     std::map<std::string, int> inputs;
     for (const Frame& frame : sequence) {
         inputs.emplace(fileIdentity(frame.input), frame.number);
@@ -899,7 +907,7 @@ void logEarlyFailure(const MeshOptions& o, const FramePattern& input, const std:
                 if (fileIdentity(output) == log) return;
             }
         }
-        if (frameReadAs(input, fileIdentity(input.directory().empty() ? "." : input.directory()), o.logPath)) return;
+        if (frameReadAs(input, directoryIdentity(input), o.logPath)) return;
     } catch (const std::exception&) {
         return;
     }

@@ -35,9 +35,9 @@ namespace {
 /// Link @a target to a new name beside it and return that name ("" if no link could be
 /// made): `target.nonbloppy-old-<pid>`, or `.nonbloppy-old-<pid>` in the same directory
 /// where that name would be longer than the directory allows (an output name of about 230
-/// bytes or more, with the pid's digits), with -2, -3, ... appended while the name is taken (by a killed run of
-/// the same pid: containers reuse them). Both cases lost the old file on a failure: the
-/// link() failed, and the undo then only removed the new file (bug hunt).
+/// bytes or more, with the pid's digits), with -2, -3, ... appended while the name is taken
+/// (by a killed run of the same pid: containers reuse them). Both cases lost the old file on
+/// a failure: the link() failed, and the undo then only removed the new file (bug hunt).
 std::string linkBeside(const std::string& target)
 {
     const size_t slash = target.rfind('/');
