@@ -155,14 +155,17 @@ lowerCase(std::string_view text)
     return out;
 }
 
-/// The component number @a digits spells: 0 to 99 without a leading zero; -1 otherwise.
+/// The component number @a digits spells: 0 to kMaxFileComponents - 1 without a leading
+/// zero; -1 otherwise.
 int componentNumber(std::string_view digits)
 {
-    if (digits.empty() || digits.size() > 2 || (digits.size() == 2 && digits[0] == '0')) return -1;
+    if (digits.empty() || digits.size() > 4 || (digits.size() > 1 && digits[0] == '0')) return -1;
+    int number = 0;
     for (char c : digits) {
         if (c < '0' || c > '9') return -1;
+        number = number * 10 + (c - '0');
     }
-    return digits.size() == 1 ? digits[0] - '0' : (digits[0] - '0') * 10 + (digits[1] - '0');
+    return number < kMaxFileComponents ? number : -1;
 }
 
 } // namespace
@@ -443,6 +446,15 @@ integerValue(const unsigned char* p, ScalarType type, int64_t& value)
             return v <= uint64_t(std::numeric_limits<int64_t>::max());
         }
         default: return false;
+    }
+}
+
+void
+requireFileComponents(const std::string& name, int components, const std::string& suffix)
+{
+    if (components > kMaxFileComponents) {
+        throw ParameterError("attribute '" + name + "' has " + std::to_string(components) + " components, more than the " +
+                             std::to_string(kMaxFileComponents) + " a file holds" + suffix);
     }
 }
 
@@ -856,7 +868,7 @@ public:
                 if (words.size() < 3 || words.size() > 4) badHeader();
                 uint64_t components = 1;
                 if (words.size() == 4) components = count(words[3]);
-                if (components < 1 || components > 4096) badHeader();
+                if (components < 1 || components > uint64_t(kMaxFileComponents)) badHeader();
                 const ScalarType type = dataType(words[2]);
                 // The LOOKUP_TABLE line is optional from VTK 5; binary data never starts
                 // with that word, so peeking is safe.
@@ -880,7 +892,7 @@ public:
                 requireAttributeSection(key);
                 requireWords(words, 3);
                 const uint64_t components = count(words[2]);
-                if (components < 1 || components > 4096) badHeader();
+                if (components < 1 || components > uint64_t(kMaxFileComponents)) badHeader();
                 // Binary color scalars are bytes, ASCII ones floats in [0,1].
                 readAttribute(key, words[1],
                     mReader->binary() ? ScalarType::UInt8 : ScalarType::Float32,
@@ -1113,7 +1125,7 @@ private:
             const uint64_t components = count(words[1]);
             const uint64_t tuples = count(words[2]);
             const ScalarType type = dataType(words[3]);
-            if (components < 1 || components > 4096) badHeader();
+            if (components < 1 || components > uint64_t(kMaxFileComponents)) badHeader();
 
             NumericArray array;
             array.name = decodeVtkName(words[0]);

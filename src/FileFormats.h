@@ -79,14 +79,14 @@ std::string requireMeshExtension(const std::string& path);
 std::string printable(std::string_view text, size_t maxLength = 40);
 
 /// If the table (CSV/TXT) column @a name is "<base><suffix>" with suffix one of the
-/// component spellings (_x .x, _y .y, _z .z, any case, for 0 to 2, or :c [c] for any c up
-/// to 99, as ParaView and writeParticles() spell components past the third), the
+/// component spellings (_x .x, _y .y, _z .z, any case, for 0 to 2, or :c [c] for any c
+/// below kMaxFileComponents, no leading zero, as ParaView and writeParticles() spell components past the third), the
 /// component, with @a base set; else -1.
 int tableComponentOf(const std::string& name, std::string& base);
 
 /// The component a property or attribute name spells as nonbloppy's writers write the
-/// components of vectors in PLY and .vdb: "<base>_x/_y/_z" (0 to 2) or "<base>_<c>" (c up
-/// to 99, no leading zero), with @a base set; -1 otherwise.
+/// components of vectors in PLY and .vdb: "<base>_x/_y/_z" (0 to 2) or "<base>_<c>" (c
+/// below kMaxFileComponents, no leading zero), with @a base set; -1 otherwise.
 int suffixComponentOf(const std::string& name, std::string& base);
 
 /// The axis (0..2) a table column named @a name holds: x, y or z, or a component of
@@ -188,6 +188,14 @@ const char* plyTypeName(ScalarType type);
 
 /// The legacy VTK data type name of @a type ("float", "unsigned_int", "vtktypeint64", ...).
 const char* vtkTypeName(ScalarType type);
+
+/// The most components an attribute has in a particle or mesh file: the readers refuse
+/// more (as a bad header), and the writers refuse to write more (requireFileComponents()).
+constexpr int kMaxFileComponents = 4096;
+
+/// @throw ParameterError("attribute 'q' has 5000 components, more than the 4096 a file
+///        holds", then @a suffix) if @a components exceeds kMaxFileComponents.
+void requireFileComponents(const std::string& name, int components, const std::string& suffix);
 
 /// @throw ParameterError("attribute 'id' has -1 components, at least 1 needed" or "attribute
 ///        'id' has the unknown scalar type 17", then @a suffix) for an attribute whose values

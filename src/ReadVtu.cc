@@ -1388,7 +1388,7 @@ private:
             fail(mPath, "unsupported type '" + printable(typeName) + "' of " + what);
         }
         const int components = xmlIntAttribute(attributes, "NumberOfComponents", 1);
-        if (components < 1 || components > 4096) fail(mPath, "bad NumberOfComponents of " + what);
+        if (components < 1 || components > kMaxFileComponents) fail(mPath, "bad NumberOfComponents of " + what);
         const size_t index = mPiece.attributeIndex++;
         int target = int(index);
         std::string mismatch;

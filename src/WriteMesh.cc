@@ -462,6 +462,9 @@ writeMesh(const SurfaceMesh& mesh, const std::string& path, const MeshWriteSetti
 {
     const std::string ext = io_internal::requireMeshExtension(path);
     validateMesh(mesh, path);
+    if (ext != ".obj") {  // OBJ drops the attributes
+        for (const MeshAttribute& a : mesh.attributes) io_internal::requireFileComponents(a.name, a.components, " (" + path + ")");
+    }
     const PolygonView polygons{mesh, settings.keepQuads};
     // A lower bound of every format's size: binary positions and corner indices.
     const size_t expectedBytes = mesh.points.size() * sizeof(openvdb::Vec3s) + polygons.cornerCount() * 4;

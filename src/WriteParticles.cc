@@ -526,6 +526,9 @@ writeParticles(const ParticleSet& particles, const std::string& path, const Part
 {
     const std::string ext = requireParticleOutput(path);
     requireSizes(particles, " (" + path + ")");
+    if (ext != ".xyz") {  // .xyz drops the attributes
+        for (const ParticleAttribute& a : particles.attributes) io_internal::requireFileComponents(a.name, a.components, " (" + path + ")");
+    }
     if (ext == ".vdb") {
         const double largest = requirePlaceablePositions(particles, " (" + path + ")");
         openvdb::GridBase::Ptr grid;

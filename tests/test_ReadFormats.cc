@@ -865,10 +865,12 @@ TEST_F(ReadFormatsTest, WhatNoAttributeCanTakeIsListedAsSkipped)
 TEST_F(ReadFormatsTest, ComponentsPastTheThirdRoundTripThroughEveryFormat)
 {
     // A 4-component attribute went to CSV as q:0..q:3 and came back as a 3-vector plus a
-    // scalar "q:3"; to .vdb as q_0..q_3 and came back as four scalars (bug hunt).
+    // scalar "q:3"; to .vdb as q_0..q_3 and came back as four scalars (bug hunt). Past
+    // component 99 the PLY, CSV and .vdb readers split the columns off as scalars.
     ParticleSet particles;
     particles.positions = {openvdb::Vec3f(0.0f), openvdb::Vec3f(1.0f, 2.0f, 3.0f)};
-    for (const int components : {4, 9, 16}) {
+    const std::vector<int> componentCounts = {4, 9, 16, 150};
+    for (const int components : componentCounts) {
         std::vector<float> floats;
         std::vector<int32_t> ints;
         for (int k = 0; k < 2 * components; ++k) {
@@ -884,9 +886,9 @@ TEST_F(ReadFormatsTest, ComponentsPastTheThirdRoundTripThroughEveryFormat)
         nonbloppy::writeParticles(particles, file);
         const ParticleSet back = readParticles(file);
         ASSERT_EQ(back.size(), 2u) << ext;
-        ASSERT_EQ(back.attributes.size(), 3u) << ext;
+        ASSERT_EQ(back.attributes.size(), componentCounts.size()) << ext;
         // Points of a .vdb come back in voxel order: the origin first here either way.
-        for (size_t i = 0; i < 3; ++i) {
+        for (size_t i = 0; i < componentCounts.size(); ++i) {
             const ParticleAttribute& written = particles.attributes[i];
             const ParticleAttribute& read = back.attributes[i];
             EXPECT_EQ(read.name, written.name) << ext;
@@ -924,6 +926,17 @@ TEST_F(ReadFormatsTest, WhatTheWritersWriteTheirReadersRead)
     ASSERT_EQ(fromVtu.attributes.size(), 2u);
     EXPECT_EQ(fromVtu.attributes[1].components, 65);
     EXPECT_EQ(fromVtu.attributes[1].asDouble(1, 64), 129.0);
+    // Past the 4096 components the readers take, the writers refuse (but .xyz, which
+    // stores no attributes).
+    ParticleSet wider = particles;
+    wider.attributes[1] = ParticleAttribute::of("wider", 4097, std::vector<float>(2 * 4097, 1.0f));
+    for (const std::string ext : {".csv", ".ply", ".vdb", ".vtk", ".vtu"}) {
+        const std::string file = path("wider" + ext);
+        EXPECT_EQ(nonbloppy_test::messageOf<nonbloppy::ParameterError>([&] { nonbloppy::writeParticles(wider, file); }),
+                  "attribute 'wider' has 4097 components, more than the 4096 a file holds (" + file + ")");
+    }
+    nonbloppy::writeParticles(wider, path("wider.xyz"));
+    EXPECT_EQ(readParticles(path("wider.xyz")).size(), 2u);
 
     // A .vtp's polygons are listed as not read, as a legacy VTK's are (bug hunt).
     const std::string vtp = write("tri.vtp",

@@ -402,6 +402,24 @@ TEST_F(WriteMeshTest, RefusesAnAttributeWhoseValuesAreInTheArrayItsFlagDoesNotNa
     EXPECT_TRUE(listDirectory(dir()).empty());
 }
 
+TEST_F(WriteMeshTest, RefusesMoreComponentsThanTheReadersTake)
+{
+    // The readers take up to 4096 components; a wider attribute made a file none read back.
+    SurfaceMesh mesh = mixedMesh();
+    nonbloppy::MeshAttribute wide;
+    wide.name = "wide";
+    wide.components = 4097;
+    wide.values.assign(mesh.points.size() * 4097, 0.5f);
+    mesh.attributes.push_back(wide);
+    for (const std::string name : {"m.ply", "m.vtk"}) {
+        EXPECT_EQ(messageOf<nonbloppy::ParameterError>([&] { writeMesh(mesh, path(name)); }),
+                  "attribute 'wide' has 4097 components, more than the 4096 a file holds (" + path(name) + ")");
+    }
+    EXPECT_TRUE(listDirectory(dir()).empty());
+    writeMesh(mesh, path("m.obj"));  // OBJ stores no attributes
+    EXPECT_EQ(listDirectory(dir()), std::set<std::string>{"m.obj"});
+}
+
 TEST_F(WriteMeshTest, ObjTextIsExact)
 {
     SurfaceMesh mesh;

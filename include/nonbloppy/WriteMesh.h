@@ -57,8 +57,9 @@ struct MeshWriteSettings
 ///        vertices or polygon corners ("too many vertices for 32-bit indices (PATH)").
 /// @throw ParameterError if a polygon references a vertex that does not exist,
 ///        mesh.normals is non-empty but not one per vertex, or an attribute has fewer than
-///        one component, not V·components values, or values in the array its
-///        MeshAttribute::integer flag does not name.
+///        one component (more than 4096, the most the readers take, for PLY and VTK), not
+///        V·components values, or values in the array its MeshAttribute::integer flag
+///        does not name.
 NONBLOPPY_API void writeMesh(const SurfaceMesh& mesh, const std::string& path,
                const MeshWriteSettings& settings = MeshWriteSettings());
 

@@ -48,7 +48,8 @@ struct ParticleWriteSettings
 /// or without direct I/O, see ParticleWriteSettings; `.vdb` goes through OpenVDB's own
 /// writer and always uses the page cache).
 /// @throw FileError for an unknown extension or an unwritable path; ParameterError for an
-///        attribute that does not hold one value per particle, or (`.vdb`) a uint64 value
+///        attribute that does not hold one value per particle or has more than 4096
+///        components (the most the readers take; not for `.xyz`), or (`.vdb`) a uint64 value
 ///        above 2^63 - 1 or a non-finite position ("non-finite position of particle N,
 ///        which a .vdb points grid cannot hold (PATH)"; other formats write it as it is).
 NONBLOPPY_API void writeParticles(const ParticleSet& particles, const std::string& path,

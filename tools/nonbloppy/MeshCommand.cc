@@ -23,6 +23,7 @@
 #include <openvdb/util/NullInterrupter.h>
 #include <tbb/blocked_range.h>
 #include <tbb/global_control.h>
+#include <tbb/parallel_reduce.h>
 
 #include <algorithm>
 #include <atomic>
@@ -33,6 +34,7 @@
 #include <cstring>
 #include <exception>
 #include <filesystem>
+#include <functional>
 #include <iostream>
 #include <limits>
 #include <map>
@@ -724,7 +726,15 @@ void warnIfNormalsMissing(const nonbloppy::SurfaceResult& result, const std::str
 {
     if (once.normalsMissing.load()) return;  // said: no pass over the next frames' normals
     const std::vector<openvdb::Vec3s>& normals = result.mesh.normals;
-    const size_t missing = size_t(std::count(normals.begin(), normals.end(), openvdb::Vec3s(0.0f)));
+    // In parallel: it runs after the write, when nothing else is left, and a 64x benchmark
+    // frame has 2.4M normals (4 ms alone).
+    const size_t missing = tbb::parallel_reduce(
+        tbb::blocked_range<size_t>(0, normals.size(), 65536), size_t(0),
+        [&](const tbb::blocked_range<size_t>& range, size_t count) {
+            return count + size_t(std::count(normals.begin() + range.begin(), normals.begin() + range.end(),
+                                             openvdb::Vec3s(0.0f)));
+        },
+        std::plus<size_t>());
     if (missing == 0 || once.normalsMissing.exchange(true)) return;
     warning(once) << missing << " of the " << normals.size() << " vertices of " << output
                   << " have no normal (the faces around them have no area)"
