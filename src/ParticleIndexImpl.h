@@ -104,13 +104,21 @@ inline void forEachRunInBox(const ParticleIndex::Impl& index, AccessorT& accesso
                             VisitorT&& visit)
 {
     // Clipped in world units first: a corner too far out for an int cell number (a huge
-    // query radius) must not overflow the conversion.
+    // query radius) must not overflow the conversion. A box beyond the bounds on some axis
+    // (or a NaN corner) leaves that axis empty and returns before any conversion: clipping
+    // only its far corner left the near one out of int range, and the loop then ran from
+    // INT_MIN, for minutes, for a vertex 2^31 cells out (API review).
     if (index.leafBounds.empty()) return;
     const double cellSize = index.cellSize;
     const openvdb::Vec3d boundsMin = (index.leafBounds.min().asVec3d() - 0.5) * cellSize;
     const openvdb::Vec3d boundsMax = (index.leafBounds.max().asVec3d() + 0.5) * cellSize;
-    const openvdb::Coord lo = cellOf(openvdb::math::maxComponent(minCorner, boundsMin), cellSize);
-    const openvdb::Coord hi = cellOf(openvdb::math::minComponent(maxCorner, boundsMax), cellSize);
+    const openvdb::Vec3d clippedMin = openvdb::math::maxComponent(minCorner, boundsMin);
+    const openvdb::Vec3d clippedMax = openvdb::math::minComponent(maxCorner, boundsMax);
+    for (int axis = 0; axis < 3; ++axis) {
+        if (!(clippedMin[axis] <= clippedMax[axis])) return;
+    }
+    const openvdb::Coord lo = cellOf(clippedMin, cellSize);
+    const openvdb::Coord hi = cellOf(clippedMax, cellSize);
     constexpr int kLeafMask = int(IndexLeaf::DIM) - 1;
     openvdb::Coord ijk;
     for (ijk[0] = lo[0]; ijk[0] <= hi[0]; ++ijk[0]) {

@@ -90,6 +90,25 @@ TEST(InterpolateAttributes, ConstantFieldComesBackExactly)
     EXPECT_EQ(c.values.back(), 0.0f);  // the far vertex
 }
 
+TEST(InterpolateAttributes, VerticesPastIntCellNumbersGetNoValue)
+{
+    // A vertex more than 2^31 index cells out, beyond the particles in +x: the search box's
+    // near corner was left unclipped, its cell number wrapped to INT_MIN, and the search
+    // walked 2^31 cells for minutes (API review). One also 2^31 cells out in -y, and one in
+    // both directions at once.
+    Fixture fx;
+    const float far = float(3.0 * double(std::numeric_limits<int>::max()) * fx.radius);  // cells of r_e/2
+    fx.mesh.points.push_back(openvdb::Vec3s(far, 0.0f, 0.0f));
+    fx.mesh.points.push_back(openvdb::Vec3s(0.0f, -far, 0.0f));
+    fx.mesh.points.push_back(openvdb::Vec3s(far, -far, far));
+    if (!fx.mesh.normals.empty()) fx.mesh.normals.resize(fx.mesh.points.size(), openvdb::Vec3s(0.0f, 0.0f, 1.0f));
+    interpolateAttributes(fx.mesh, fx.particles, {"c"}, fx.radius);
+    const std::vector<float>& c = fx.mesh.attributes.at(0).values;
+    ASSERT_EQ(c.size(), fx.mesh.points.size());
+    EXPECT_EQ(c[0], 2.5f);
+    for (size_t i = c.size() - 4; i < c.size(); ++i) EXPECT_EQ(c[i], 0.0f) << "vertex " << i;
+}
+
 TEST(InterpolateAttributes, LinearFieldGivesTheFieldAtTheWeightedMean)
 {
     Fixture fx;

@@ -151,6 +151,23 @@ TEST(RelaxVertices, PiecesFarApartRelaxAsEachWouldAlone)
     }
 }
 
+TEST(RelaxVertices, VerticesPastIntCellNumbersStayWhereTheyAre)
+{
+    // Vertices 2^31 to 3·2^31 index cells out got past the out-of-reach filter (which
+    // counts grouping cells, 3 index cells wide), and the particle search from there walked
+    // from cell INT_MIN for minutes (API review). They have no particle in reach and stay.
+    const std::vector<openvdb::Vec3f> particles = {openvdb::Vec3f(0.0f), openvdb::Vec3f(0.3f, 0.0f, 0.0f)};
+    const double cell = 0.5;
+    const float far = float(1.2 * double(std::numeric_limits<int>::max()) * cell);
+    SurfaceMesh mesh;
+    mesh.points = {openvdb::Vec3s(0.0f, 0.5f, 0.0f), openvdb::Vec3s(far, 0.0f, 0.0f),
+                   openvdb::Vec3s(0.0f, 0.0f, -far), openvdb::Vec3s(far, far, -far)};
+    const std::vector<openvdb::Vec3s> start = mesh.points;
+    relaxVertices(mesh, ParticleIndex::build(particles, cell), relaxSettings(0.5, 2));
+    EXPECT_NE(mesh.points[0], start[0]);  // pulled towards the particles
+    for (size_t i = 1; i < start.size(); ++i) EXPECT_EQ(mesh.points[i], start[i]) << "vertex " << i;
+}
+
 TEST(RelaxVertices, VerticesThatTravelFarMatchTheDirectSum)
 {
     // Vertices are grouped by cell once, before the first iteration. With c = 1 each step
