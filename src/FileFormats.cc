@@ -11,7 +11,9 @@
 #include <cerrno>
 #include <charconv>
 #include <cstdlib>
+#include <stdlib.h>
 #include <cstring>
+#include <locale.h>
 #include <limits>
 #include <memory>
 #include <string_view>
@@ -319,24 +321,30 @@ parseCount(std::string_view text, uint64_t& value)
     return !text.empty() && result.ec == std::errc() && result.ptr == end;
 }
 
+std::errc
+parseDoubleText(std::string_view text, double& value)
+{
+    if (!text.empty() && text.front() == '+') text.remove_prefix(1);
+    if (text.empty()) return std::errc::invalid_argument;
+    const char* end = text.data() + text.size();
+    const auto result = std::from_chars(text.data(), end, value);
+    if (result.ec == std::errc() && result.ptr == end) return std::errc();
+    if (result.ec != std::errc::result_out_of_range || text.size() >= 64) return std::errc::invalid_argument;
+    // from_chars leaves the value unset for 1e-310 (a denormal), 1e-400 or 1e400; strtod
+    // gives it, in a C locale of our own (one per process, never changed).
+    static const locale_t cLocale = ::newlocale(LC_ALL_MASK, "C", locale_t(0));
+    const std::string copy(text);
+    char* parsedEnd = nullptr;
+    value = ::strtod_l(copy.c_str(), &parsedEnd, cLocale);
+    return parsedEnd == copy.c_str() + copy.size() ? std::errc::result_out_of_range : std::errc::invalid_argument;
+}
+
 namespace {
 
 bool
 parseDouble(std::string_view text, double& value)
 {
-    if (!text.empty() && text.front() == '+') text.remove_prefix(1);
-    if (text.empty()) return false;
-    const char* end = text.data() + text.size();
-    const auto result = std::from_chars(text.data(), end, value);
-    if (result.ec == std::errc() && result.ptr == end) return true;
-    if (result.ec == std::errc::result_out_of_range && text.size() < 64) {
-        // from_chars leaves the value unset for 1e-400 or 1e400; strtod gives 0 or inf.
-        const std::string copy(text);
-        char* parsedEnd = nullptr;
-        value = std::strtod(copy.c_str(), &parsedEnd);
-        return parsedEnd == copy.c_str() + copy.size();
-    }
-    return false;
+    return parseDoubleText(text, value) != std::errc::invalid_argument;
 }
 
 template<typename IntT, typename WideT>

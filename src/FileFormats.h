@@ -16,6 +16,7 @@
 #include <nonbloppy/Particles.h>
 
 #include <charconv>
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <memory>
@@ -162,6 +163,23 @@ bool parseWhole(std::string_view text, NumberT& value)
     const char* end = text.data() + text.size();
     const auto result = std::from_chars(text.data(), end, value);
     return !text.empty() && result.ec == std::errc() && result.ptr == end;
+}
+
+/// @a text (an optional '+', then what std::from_chars takes) as a double, in the C locale
+/// whatever the process's: std::strtod, the fallback for values out of double's range,
+/// follows setlocale(), and under a host application's comma-decimal locale it read
+/// "1.5e-400" as 1 (API review). Returns std::errc() for a value in range;
+/// std::errc::result_out_of_range with @a value the correctly rounded denormal or 0 below
+/// the smallest double, ±inf above the largest; std::errc::invalid_argument unless all of
+/// @a text is one number.
+std::errc parseDoubleText(std::string_view text, double& value);
+
+/// parseDoubleText(), taking 0 or a denormal below the smallest double but refusing a
+/// value above the largest: ±inf there would hide a corrupt file.
+inline bool parseDoubleRefusingOverflow(std::string_view text, double& value)
+{
+    const std::errc parsed = parseDoubleText(text, value);
+    return parsed == std::errc() || (parsed == std::errc::result_out_of_range && std::isfinite(value));
 }
 
 /// A whole decimal unsigned count (no sign, nothing after it).

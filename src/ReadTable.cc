@@ -102,18 +102,6 @@ struct Column
 /// write.csv() put first, left out (and said: ParticleSet::skipped).
 constexpr int kUnnamed = -2;
 
-bool
-parseDoubleField(std::string_view text, double& value)
-{
-    if (!text.empty() && text[0] == '+') text.remove_prefix(1);
-    const auto result = std::from_chars(text.data(), text.data() + text.size(), value);
-    if (result.ec == std::errc::result_out_of_range) {
-        value = std::strtod(std::string(text).c_str(), nullptr);
-        return std::isfinite(value);
-    }
-    return result.ec == std::errc() && result.ptr == text.data() + text.size() && !text.empty();
-}
-
 /// Appends the 8 native bytes of @a value to @a bytes.
 template<typename T>
 void
@@ -259,7 +247,7 @@ parseTable(StreamReader& in, const std::string& path)
                 }
             }
             double value;
-            if (!parseDoubleField(field, value)) {
+            if (!parseDoubleRefusingOverflow(field, value)) {
                 fail(path, "bad number '" + printable(field) + "' on line " + std::to_string(lineNumber));
             }
             if (attribute < 0) {

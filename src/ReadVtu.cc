@@ -907,15 +907,7 @@ parseNumber(std::string_view word, unsigned char* out)
 {
     if constexpr (std::is_floating_point_v<T>) {
         double value;
-        const auto result = std::from_chars(word.data(), word.data() + word.size(), value);
-        if (result.ec == std::errc::result_out_of_range) {
-            // Denormals and overflow: std::from_chars reports range errors; accept them
-            // as 0 or ±inf would hide a corrupt file, so only underflow is tolerated.
-            value = std::strtod(std::string(word).c_str(), nullptr);
-            if (!std::isfinite(value)) return false;
-        } else if (result.ec != std::errc() || result.ptr != word.data() + word.size()) {
-            return false;
-        }
+        if (!parseDoubleRefusingOverflow(word, value)) return false;
         const T narrowed = static_cast<T>(value);
         std::memcpy(out, &narrowed, sizeof(T));
         return true;

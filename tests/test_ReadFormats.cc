@@ -20,6 +20,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <clocale>
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
@@ -29,6 +30,7 @@
 #include <string>
 #include <vector>
 
+#include <sys/stat.h>
 #include <unistd.h>
 
 namespace {
@@ -988,6 +990,58 @@ TEST_F(ReadFormatsTest, VdbWithoutPointsIsAClearError)
                                  "cache cannot be meshed as particles (" + file + ")");
     const std::string junk = write("junk.vdb", "not a vdb file at all");
     EXPECT_EQ(fileErrorOf(junk).rfind("cannot read .vdb file: ", 0), 0u) << fileErrorOf(junk);
+}
+
+} // namespace
+
+namespace {
+
+TEST_F(ReadFormatsTest, TextNumbersReadTheSameUnderACommaDecimalLocale)
+{
+    // Values past double's range went through std::strtod, which follows the process's
+    // locale: a host application that called setlocale() for German read 1.5e-400 as 1
+    // (CSV, VTU) or refused it (ASCII PLY) (API review). The locale is built here, as a
+    // host's would be installed; tools/setup.sh installs the definitions (package locales).
+    const std::string localeDir = path("locales");
+    ASSERT_EQ(::mkdir(localeDir.c_str(), 0700), 0);
+    ASSERT_EQ(std::system(("localedef -i de_DE -f UTF-8 " + localeDir + "/de_DE.UTF-8 2>/dev/null").c_str()), 0)
+        << "localedef needs the Debian package locales";
+    ASSERT_EQ(::setenv("LOCPATH", localeDir.c_str(), 1), 0);
+    ASSERT_NE(std::setlocale(LC_ALL, "de_DE.UTF-8"), nullptr);
+    ASSERT_EQ(std::string(std::localeconv()->decimal_point), ",");
+    struct RestoreLocale
+    {
+        ~RestoreLocale()
+        {
+            std::setlocale(LC_ALL, "C");
+            ::unsetenv("LOCPATH");
+        }
+    } restore;
+
+    const double denormal = std::numeric_limits<double>::denorm_min();  // 4.9e-324
+    const auto expectValues = [&](const ParticleSet& particles, const std::string& what) {
+        ASSERT_EQ(particles.size(), 3u) << what;
+        const ParticleAttribute& c = attribute(particles, "c");
+        EXPECT_EQ(c.asDouble(0), 0.0) << what;
+        EXPECT_EQ(c.asDouble(1), denormal) << what;
+        EXPECT_EQ(c.asDouble(2), 2.5) << what;
+    };
+    const char* values[3] = {"1.5e-400", "4.9406564584124654e-324", "2.5"};
+    std::string csv = "x,y,z,c\n", ply = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\n"
+        "property float y\nproperty float z\nproperty double c\nend_header\n", vtuValues;
+    for (int n = 0; n < 3; ++n) {
+        csv += std::to_string(n) + ",0,0," + values[n] + "\n";
+        ply += std::to_string(n) + " 0 0 " + values[n] + "\n";
+        vtuValues += std::string(" ") + values[n];
+    }
+    expectValues(readParticles(write("c.csv", csv)), "CSV");
+    expectValues(readParticles(write("c.ply", ply)), "ASCII PLY");
+    expectValues(readParticles(write("c.vtu",
+        "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\">\n"
+        "<UnstructuredGrid>\n<Piece NumberOfPoints=\"3\" NumberOfCells=\"0\">\n"
+        "<PointData><DataArray type=\"Float64\" Name=\"c\" format=\"ascii\">" + vtuValues + "</DataArray></PointData>\n"
+        "<Points><DataArray type=\"Float32\" NumberOfComponents=\"3\" format=\"ascii\">0 0 0 1 0 0 2 0 0</DataArray></Points>\n"
+        "</Piece>\n</UnstructuredGrid>\n</VTKFile>\n")), "VTU");
 }
 
 } // namespace

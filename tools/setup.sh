@@ -8,7 +8,7 @@ build_dir="${1:-build}"
 
 packages=(cmake g++ make pkg-config libopenvdb-dev libopenvdb-tools libtbb-dev libblosc-dev
           zlib1g-dev libexpat1-dev nlohmann-json3-dev clang libclang-rt-14-dev
-          libboost-iostreams-dev googletest libgtest-dev libcli11-dev libbenchmark-dev doxygen)
+          libboost-iostreams-dev googletest libgtest-dev libcli11-dev libbenchmark-dev doxygen locales)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
