@@ -16,7 +16,7 @@ SurfaceResult buildSurface(std::vector<openvdb::Vec3f> positions, const SurfaceP
     surface_stages_internal::resolveAndIndex(params, nullptr, positions, index, result, interrupter);
     // Freed after fold repair, before the normals; filled in parallel, without a memset.
     memory_internal::UnwrittenVector<openvdb::Vec3s> unrelaxed;
-    surface_stages_internal::runSurfaceStages(index, params.keepDensity, result, unrelaxed,
+    surface_stages_internal::runSurfaceStages(index, params, result, unrelaxed,
                                               surface_stages_internal::UnrelaxedBuffer::Release,
                                               interrupter);
     return result;

@@ -331,17 +331,9 @@ void requireVoxelWithinRadius(double effectiveRadius, double voxelSize, const Le
     }
 }
 
-/// @throw ParameterError if r_e > 1e18: the kernel squares lengths in single precision, so
-/// beyond it r_e² overflows to +inf and the mesh came out wrong or empty (a lattice scaled
-/// by 1e20 kept 2.6% of its volume).
 void requireRadiusBelowMaximum(double effectiveRadius, const LengthNames& names = {})
 {
-    constexpr double kMaxRadius = 1.0e18;
-    if (effectiveRadius > kMaxRadius) {
-        throw ParameterError(names.radius + " " + formatNumber(effectiveRadius) + " is too large: at most " +
-                             formatNumber(kMaxRadius) + " (lengths are squared in single precision); give the "
-                             "positions in a larger unit");
-    }
+    parameter_checks_internal::requireRadiusBelowMaximum(effectiveRadius, names.radius);
 }
 
 /// The limits of the lengths that are known: each against OpenVDB's smallest (voxel, index

@@ -423,7 +423,7 @@ struct Region
 /// region; otherwise fills @a mesh, oriented outwards.
 bool extractByRegionImpl(const openvdb::FloatGrid& density, double threshold, SurfaceMesh& mesh,
                          cancellation_internal::CancelPoll& poll, size_t leavesPerRegion, int minLayers,
-                         openvdb::FloatTree* release)
+                         openvdb::FloatTree* release, bool trimFreedMemory)
 {
     const openvdb::FloatTree& tree = density.tree();
     // volumeToMesh compares values with float(threshold) but places crossings with the
@@ -594,7 +594,7 @@ bool extractByRegionImpl(const openvdb::FloatGrid& density, double threshold, Su
         // threads, peak RSS / extract stage against trimming every 4096 leaves (8 paired
         // runs each): never 371 MB; every 32768 leaves 322 MB, -0.07 to -0.17 s; 16384
         // 302 MB, -0.01 to -0.06 s; 8192 and 4096 292 MB.
-        if (leavesUntrimmed >= kLeavesPerTrim) {
+        if (trimFreedMemory && leavesUntrimmed >= kLeavesPerTrim) {
             malloc_trim(0);
             leavesUntrimmed = 0;
         }
@@ -877,10 +877,12 @@ namespace surface_stages_internal {
 
 void extractSurfaceInto(const openvdb::FloatGrid& density, double threshold, double adaptivity,
                         size_t leavesPerRegion, SurfaceMesh& mesh,
-                        openvdb::util::NullInterrupter* interrupter, openvdb::FloatTree* release)
+                        openvdb::util::NullInterrupter* interrupter, openvdb::FloatTree* release,
+                        bool trimFreedMemory)
 {
     if (adaptivity == 0.0 && leavesPerRegion > 0) {
-        extractByRegion(density, threshold, mesh, interrupter, leavesPerRegion, kMinLayersPerRegion, release);
+        extractByRegion(density, threshold, mesh, interrupter, leavesPerRegion, kMinLayersPerRegion, release,
+                        trimFreedMemory);
     } else {
         extractInto(density, threshold, adaptivity, mesh);
     }
@@ -888,13 +890,13 @@ void extractSurfaceInto(const openvdb::FloatGrid& density, double threshold, dou
 
 void extractByRegion(const openvdb::FloatGrid& density, double threshold, SurfaceMesh& mesh,
                      openvdb::util::NullInterrupter* interrupter, size_t leavesPerRegion,
-                     int minLayersPerRegion, openvdb::FloatTree* release)
+                     int minLayersPerRegion, openvdb::FloatTree* release, bool trimFreedMemory)
 {
     checkExtractParameters(threshold, 0.0, double(density.background()));
     cancellation_internal::CancelPoll poll(interrupter, "extract surface");
     poll.throwIfStopped();
     if (!extractByRegionImpl(density, threshold, mesh, poll, std::max<size_t>(leavesPerRegion, 1),
-                             std::max(minLayersPerRegion, 1), release)) {
+                             std::max(minLayersPerRegion, 1), release, trimFreedMemory)) {
         extractInto(density, threshold, 0.0, mesh);
         return;
     }

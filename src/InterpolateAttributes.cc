@@ -148,6 +148,7 @@ interpolateAttributes(SurfaceMesh& mesh, const ParticleSet& particles,
                       openvdb::util::NullInterrupter* interrupter)
 {
     parameter_checks_internal::requirePositive(effectiveRadius, "--radius");
+    parameter_checks_internal::requireRadiusBelowMaximum(effectiveRadius);
     // Every check before start(), so that a start() is always followed by its end().
     const std::vector<const ParticleAttribute*> attributes = checkAttributes(particles, names);
 

@@ -457,6 +457,7 @@ openvdb::FloatGrid::Ptr instruction_set_internal::rasterizeDensity(const Particl
 {
     openvdb::initialize();
     parameter_checks_internal::requirePositive(settings.effectiveRadius, "--radius");
+    parameter_checks_internal::requireRadiusBelowMaximum(settings.effectiveRadius);
     openvdb::math::Transform::Ptr transform = settings.transform;
     if (!transform) {
         parameter_checks_internal::requirePositive(settings.voxelSize, "--voxel-size");
@@ -466,6 +467,8 @@ openvdb::FloatGrid::Ptr instruction_set_internal::rasterizeDensity(const Particl
         throw ParameterError("rasterizeDensity needs a uniform-scale transform without translation or rotation");
     }
     const double voxelSize = transform->voxelSize()[0];
+    // A caller's transform too: OpenVDB makes one of any scale (API review).
+    openvdb_scale_internal::requireOpenVdbScale(voxelSize, kMinCellSize, "--voxel-size");
     surface_stages_internal::requireVoxelsPerRadius(settings.effectiveRadius, voxelSize);
     particle_index_internal::requireCellsPerRadius(particles, settings.effectiveRadius);
 

@@ -479,6 +479,7 @@ void instruction_set_internal::relaxVertices(SurfaceMesh& mesh, const ParticleIn
 {
     std::ostringstream msg;
     parameter_checks_internal::requirePositive(settings.effectiveRadius, "--radius");
+    parameter_checks_internal::requireRadiusBelowMaximum(settings.effectiveRadius);
     parameter_checks_internal::requireUnitInterval(settings.blend, "--blend");
     if (settings.iterations < 0) {
         msg << "--iterations must be >= 0, got " << settings.iterations;

@@ -56,7 +56,7 @@ SurfaceReconstructor::reconstructBuffered(openvdb::util::NullInterrupter* interr
     try {
         surface_stages_internal::resolveAndIndex(mParams, reuse ? &mKeptParameters : nullptr, mPositions,
                                                  mIndex, result, interrupter);
-        surface_stages_internal::runSurfaceStages(mIndex, mParams.keepDensity, result, mUnrelaxed,
+        surface_stages_internal::runSurfaceStages(mIndex, mParams, result, mUnrelaxed,
                                                   surface_stages_internal::UnrelaxedBuffer::Keep,
                                                   interrupter);
     } catch (...) {

@@ -86,7 +86,7 @@ void copyInParallel(const std::vector<openvdb::Vec3s>& points, VertexBufferT& un
 } // namespace
 
 template<typename VertexBufferT>
-void runSurfaceStages(const ParticleIndex& index, bool keepDensity, SurfaceResult& result,
+void runSurfaceStages(const ParticleIndex& index, const SurfaceParameters& settings, SurfaceResult& result,
                       VertexBufferT& unrelaxed, UnrelaxedBuffer whenRepaired,
                       openvdb::util::NullInterrupter* interrupter)
 {
@@ -115,8 +115,8 @@ void runSurfaceStages(const ParticleIndex& index, bool keepDensity, SurfaceResul
         // outside (see Cancellation.h), so the regions bound the wait for a cancel.
         // A grid nobody keeps gives its memory back as the regions pass.
         extractSurfaceInto(*result.density, p.threshold, p.adaptivity, p.regionLeaves, result.mesh, interrupter,
-                           keepDensity ? nullptr : &result.density->tree());
-        if (!keepDensity) result.density.reset();
+                           settings.keepDensity ? nullptr : &result.density->tree(), settings.trimFreedMemory);
+        if (!settings.keepDensity) result.density.reset();
         checkCancelled(interrupter, "extract surface");
     }
     {
@@ -186,9 +186,9 @@ void runSurfaceStages(const ParticleIndex& index, bool keepDensity, SurfaceResul
     }
 }
 
-template void runSurfaceStages(const ParticleIndex&, bool, SurfaceResult&, std::vector<openvdb::Vec3s>&,
+template void runSurfaceStages(const ParticleIndex&, const SurfaceParameters&, SurfaceResult&, std::vector<openvdb::Vec3s>&,
                                UnrelaxedBuffer, openvdb::util::NullInterrupter*);
-template void runSurfaceStages(const ParticleIndex&, bool, SurfaceResult&,
+template void runSurfaceStages(const ParticleIndex&, const SurfaceParameters&, SurfaceResult&,
                                memory_internal::UnwrittenVector<openvdb::Vec3s>&, UnrelaxedBuffer,
                                openvdb::util::NullInterrupter*);
 

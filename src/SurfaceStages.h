@@ -90,8 +90,8 @@ enum class UnrelaxedBuffer
 /// rasterize density (metadata holding the parameters), extract surface (into result.mesh's
 /// vectors, which keep their capacity), relax vertices, fold repair, compute normals, the
 /// volume correction and the smoothing (each followed by a fold repair against the surface
-/// it started from), timing each in result.timings. result.density is reset when
-/// @a keepDensity is false.
+/// it started from), timing each in result.timings. Of @a settings only keepDensity
+/// (result.density is reset when false) and trimFreedMemory are read.
 /// @param index        the frame's particle index, cell size kCellOverRadius·r_e
 /// @param unrelaxed    scratch for the vertex positions before each step fold repair checks
 ///                     (relaxation, then the volume correction and the smoothing), a
@@ -101,7 +101,7 @@ enum class UnrelaxedBuffer
 /// Cost: as buildSurface() minus its first two stages. Thread-safety: reentrant.
 /// @throw ParameterError, CancelledError as buildSurface(); result is then unspecified.
 template<typename VertexBufferT>
-void runSurfaceStages(const ParticleIndex& index, bool keepDensity, SurfaceResult& result,
+void runSurfaceStages(const ParticleIndex& index, const SurfaceParameters& settings, SurfaceResult& result,
                       VertexBufferT& unrelaxed, UnrelaxedBuffer whenRepaired,
                       openvdb::util::NullInterrupter* interrupter);
 
@@ -139,10 +139,13 @@ constexpr int kMinLayersPerRegion = 12;
 ///                 become inactive tiles, so the grid's memory goes as the mesh's grows (the
 ///                 grid is left partial, fit only to be destroyed); the mesh is the same, bit
 ///                 for bit (tested). Null leaves the grid untouched.
+/// @param trimFreedMemory  with @a release: hand the freed leaves' pages back to the system
+///                 as it goes (see SurfaceParameters::trimFreedMemory)
 /// @throw ParameterError as extractSurface(); CancelledError("interrupted during extract surface")
 void extractSurfaceInto(const openvdb::FloatGrid& density, double threshold, double adaptivity,
                         size_t leavesPerRegion, SurfaceMesh& mesh,
-                        openvdb::util::NullInterrupter* interrupter, openvdb::FloatTree* release = nullptr);
+                        openvdb::util::NullInterrupter* interrupter, openvdb::FloatTree* release = nullptr,
+                        bool trimFreedMemory = false);
 
 /// The surface φ = @a threshold of a density grid (adaptivity 0), meshed region by region:
 /// slabs across the grid's longest axis, each cut again across the second longest when it
@@ -164,10 +167,12 @@ void extractSurfaceInto(const openvdb::FloatGrid& density, double threshold, dou
 /// the grid is only read.
 /// @param release  optional: @a density's own tree, whose leaves are freed as the slabs pass
 ///                 (see extractSurfaceInto()); null leaves the grid untouched
+/// @param trimFreedMemory  as extractSurfaceInto()'s
 /// @throw ParameterError if @a threshold is not finite; CancelledError as above
 void extractByRegion(const openvdb::FloatGrid& density, double threshold, SurfaceMesh& mesh,
                      openvdb::util::NullInterrupter* interrupter, size_t leavesPerRegion,
-                     int minLayersPerRegion = kMinLayersPerRegion, openvdb::FloatTree* release = nullptr);
+                     int minLayersPerRegion = kMinLayersPerRegion, openvdb::FloatTree* release = nullptr,
+                     bool trimFreedMemory = false);
 
 } // namespace surface_stages_internal
 } // namespace nonbloppy

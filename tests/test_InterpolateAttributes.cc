@@ -242,7 +242,11 @@ TEST(InterpolateAttributes, NamesAndErrors)
     } catch (const ParameterError& e) {
         EXPECT_STREQ(e.what(), "unknown attribute 'velocity'; the particles have no attributes");
     }
-    EXPECT_THROW(interpolateAttributes(fx.mesh, fx.particles, {"c"}, 0.0), ParameterError);
+    EXPECT_EQ(nonbloppy_test::messageOf<ParameterError>([&] { interpolateAttributes(fx.mesh, fx.particles, {"c"}, 0.0); }),
+              "--radius must be > 0, got 0");
+    EXPECT_EQ(nonbloppy_test::messageOf<ParameterError>([&] { interpolateAttributes(fx.mesh, fx.particles, {"c"}, 2e18); }),
+              "--radius 2e+18 is too large: at most 1e+18 (lengths are squared in single precision); give the "
+              "positions in a larger unit");
 
     // A uint64 past int64 (a hash, say) has no place in the 64-bit signed integers.
     std::vector<uint64_t> hashes(fx.particles.size(), 5);

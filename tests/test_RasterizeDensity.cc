@@ -184,6 +184,22 @@ TEST(RasterizeDensity, RejectsBadSettings)
               "--voxel-size 0.03 is too small for --radius 1: at most 32 voxels per radius");
     settings.transform = openvdb::math::Transform::createLinearTransform(1.0 / 32.0);
     EXPECT_GT(rasterizeDensity(index, settings)->activeVoxelCount(), 130000u);  // (4π/3)·32³ ≈ 137k
+    // A caller's transform below OpenVDB's smallest scale went through (API review).
+    const ParticleIndex tiny = ParticleIndex::build({openvdb::Vec3f(0.0f)}, 1.5e-5);
+    settings.effectiveRadius = 4.35e-5;
+    settings.transform = openvdb::math::Transform::createLinearTransform(1.45e-5);
+    EXPECT_EQ(nonbloppy_test::messageOf<ParameterError>([&] { rasterizeDensity(tiny, settings); }),
+              "--voxel-size 1.45e-05 is below 1.5e-05, the smallest OpenVDB accepts: give the positions in a "
+              "smaller unit");
+    // Past r_e = 1e18 the kernel's squared lengths overflow single precision: r_e = 4e19
+    // gave a particle's voxels within reach density 0 (API review).
+    const ParticleIndex huge = ParticleIndex::build({openvdb::Vec3f(0.0f)}, 2.0e19);
+    settings.effectiveRadius = 4.0e19;
+    settings.transform = openvdb::math::Transform::createLinearTransform(1.0e19);
+    EXPECT_EQ(nonbloppy_test::messageOf<ParameterError>([&] { rasterizeDensity(huge, settings); }),
+              "--radius 4e+19 is too large: at most 1e+18 (lengths are squared in single precision); give the "
+              "positions in a larger unit");
+    settings.effectiveRadius = 1.0;
     settings.transform.reset();
     // OpenVDB's transforms refuse such a scale with "Non-zero scale values required".
     settings.voxelSize = 1e-6;

@@ -307,6 +307,9 @@ TEST(RelaxVertices, RejectsBadSettings)
     expectMessage(noRadius, "--radius must be > 0, got 0");
     noRadius.effectiveRadius = -std::numeric_limits<double>::infinity();
     expectMessage(noRadius, "--radius must be finite, got -inf");
+    noRadius.effectiveRadius = 2e18;  // r_e² overflows single precision
+    expectMessage(noRadius, "--radius 2e+18 is too large: at most 1e+18 (lengths are squared in single precision); "
+                            "give the positions in a larger unit");
     RelaxSettings badCap = relaxSettings(0.3, 2);
     badCap.maxStep = -1.0;
     expectMessage(badCap, "--max-step must be >= 0 (0 or inf: no cap), got -1");

@@ -65,7 +65,7 @@ NONBLOPPY_API std::vector<const ParticleAttribute*> checkAttributes(const Partic
 /// @param interrupter  optional; start("interpolate attributes") … end() around the work
 ///                     (not for an empty mesh or no names), wasInterrupted() before each
 ///                     block of 256 vertices
-/// @throw ParameterError for r_e ≤ 0 or not finite, what checkAttributes() refuses, or
+/// @throw ParameterError for r_e ≤ 0, > 1e18 or not finite, what checkAttributes() refuses, or
 ///        particles ParticleIndex::build() refuses
 ///        (r_e below kMinCellSize, a non-finite position, coordinates too far from the
 ///        origin); CancelledError("interrupted during interpolate attributes") when

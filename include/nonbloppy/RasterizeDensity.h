@@ -48,7 +48,8 @@ struct DensitySettings
 ///                     while assembling the tree; end().
 ///                     After a stop the partial grid is freed.
 /// Thread-safety: reentrant; the index is only read.
-/// @throw ParameterError if r_e or h is not finite or ≤ 0, h < kMinCellSize, a given
+/// @throw ParameterError if r_e or h is not finite or ≤ 0, r_e > 1e18 (lengths are squared
+///        in single precision), h < kMinCellSize, a given
 ///        transform is not a uniform scale, r_e/h > kMaxVoxelsPerRadius, or @a particles
 ///        holds particles in cells outside kMinCellsPerRadius..kMaxCellsPerRadius of r_e,
 ///        or, before anything is allocated, if even half the bytes of the candidate leaves

@@ -46,7 +46,7 @@ struct RelaxSettings
 ///                     after it; end(), also when it throws. A stop leaves every vertex
 ///                     either where it was or fully relaxed (t steps).
 /// Thread-safety: reentrant; the index is only read, the mesh is written.
-/// @throw ParameterError for r_e ≤ 0, c outside [0,1], t < 0, maxStep < 0, or @a particles
+/// @throw ParameterError for r_e ≤ 0 or > 1e18, c outside [0,1], t < 0, maxStep < 0, or @a particles
 ///        holding particles in cells outside kMinCellsPerRadius..kMaxCellsPerRadius of r_e;
 ///        CancelledError("interrupted during relax vertices") on interrupt.
 NONBLOPPY_API void relaxVertices(SurfaceMesh& mesh, const ParticleIndex& particles,

@@ -246,6 +246,7 @@ nonbloppy::SurfaceParameters surfaceParameters(const MeshOptions& o)
     // Without --vdb nothing needs the grid: the library frees it before relaxing, which
     // lowers the peak memory of large frames.
     params.keepDensity = !o.vdbPath.empty();
+    params.trimFreedMemory = true;  // the process is ours: no host's threads to stall
     params.regionLeaves = size_t(o.regionLeaves);
     return params;
 }
