@@ -105,6 +105,18 @@ TEST(MeshToLevelSet, VerticesAndBandsItCannotHoldAreRefusedBeforeAnyGridIsMade)
                                "below 3";
     ASSERT_GT(message.size(), advice.size());
     EXPECT_EQ(message.substr(message.size() - advice.size()), advice) << message;
+
+    // A small mesh's band grows as the half width cubed, not as its area times the width:
+    // one triangle of 0.005 at h = 1 made 902,813 voxels at half width 60, which the area
+    // put at 0.6, and half width 2000 passed the check (API review). Its ball is 3.4e10
+    // voxels, about 1.07 TB.
+    SurfaceMesh chip;
+    chip.points = {{0, 0, 0}, {0.1f, 0, 0}, {0, 0.1f, 0}};
+    chip.triangles = {{0, 1, 2}};
+    const std::string chipMessage =
+        nonbloppy_test::messageOf<ParameterError>([&] { nonbloppy::meshToLevelSet(chip, 1.0, 2000.0f); });
+    EXPECT_EQ(chipMessage.rfind("the level set's narrow band would hold about 3.4e+10 voxels, about 1.07 TB at its "
+                                "peak, more than the ", 0), 0u) << chipMessage;
 }
 
 TEST(MeshToLevelSet, AnInterrupterStopsItAndOneThatDoesNotChangesNothing)

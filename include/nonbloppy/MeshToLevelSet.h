@@ -30,7 +30,8 @@ namespace nonbloppy {
 ///        of vertex I") or lies beyond 1e9 voxels of the origin (32-bit index space); if a
 ///        polygon references a vertex the mesh does not have ("polygon P references vertex
 ///        I but the mesh has N vertices", polygons numbered triangles first, then quads);
-///        or if the band (area/h² · 2·halfWidth voxels, at about 32 bytes each at the peak)
+///        or if the band (area/h² · 2·halfWidth voxels plus a ball of halfWidth voxels,
+///        at most the bounding box grown by the band; about 32 bytes a voxel at the peak)
 ///        would need more than the process can still take (the machine's memory, ulimit -v
 ///        or -d, or its cgroup's memory.max, less what it holds);
 ///        CancelledError("interrupted during mesh to level set") if @a interrupter says so.
