@@ -44,9 +44,15 @@ TEST(ExtractSurface, OneParticleGivesASphereOfRadiusReOverOnePlusR0)
         const SurfaceMesh mesh = singleParticleSurface(radius, threshold, voxelSize);
         ASSERT_GT(mesh.points.size(), 100u);
         const double expected = radius / (1.0 + threshold);
+        // Measured with voxels of 0.04: vertices at most 0.0009, 0.0011 and 0.0021 off for
+        // r_0 = 0.5, 1 and 3, the mean radius 0.05%, 0.09% and 0.37% short.
+        double radiusSum = 0.0;
         for (const openvdb::Vec3s& p : mesh.points) {
-            ASSERT_NEAR((p - kCentre).length(), expected, voxelSize / 4) << "r_0 = " << threshold;
+            const double distance = (p - kCentre).length();
+            ASSERT_NEAR(distance, expected, voxelSize / 16) << "r_0 = " << threshold;
+            radiusSum += distance;
         }
+        EXPECT_NEAR(radiusSum / double(mesh.points.size()), expected, 0.005 * expected) << "r_0 = " << threshold;
     }
 }
 
