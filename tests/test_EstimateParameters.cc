@@ -137,7 +137,20 @@ TEST(EstimateParameters, SpacingNeedsTwoDistinctParticles)
     EXPECT_EQ(nonbloppy_test::messageOf<ParameterError>([] { estimateSpacing({}); }),
               "cannot estimate the particle spacing from no particles; give --spacing or --radius, --threshold and "
               "--voxel-size");
-    EXPECT_THROW(estimateSpacing(std::vector<openvdb::Vec3f>(5, openvdb::Vec3f(1.0f))), ParameterError);
+    const std::vector<openvdb::Vec3f> onePlace(5, openvdb::Vec3f(1.0f));
+    EXPECT_EQ(nonbloppy_test::messageOf<ParameterError>([&] { estimateSpacing(onePlace); }),
+              "cannot estimate the particle spacing: all particles are at the same position");
+}
+
+TEST(EstimateParameters, SpacingOfParticlesStackedInThreesIsRefused)
+{
+    // Distinct positions, but each one three times: every nearest neighbour is at distance 0.
+    std::vector<openvdb::Vec3f> stacked;
+    for (const openvdb::Vec3f& p : latticeParticles(0.1, 0.5, [](const openvdb::Vec3d&) { return true; })) {
+        stacked.insert(stacked.end(), 3, p);
+    }
+    EXPECT_EQ(nonbloppy_test::messageOf<ParameterError>([&] { estimateSpacing(stacked); }),
+              "cannot estimate the particle spacing: most particles sit on top of another one; give --spacing");
 }
 
 TEST(EstimateParameters, CalibratedThresholdPutsAFlatSurfaceHalfASpacingOutside)
@@ -164,9 +177,15 @@ TEST(EstimateParameters, ThresholdGrowsWithTheRadius)
 {
     EXPECT_GT(calibrateThreshold(3.0), calibrateThreshold(2.0));
     EXPECT_GT(calibrateThreshold(2.0), 0.0);
-    EXPECT_THROW(calibrateThreshold(0.5), ParameterError);
-    EXPECT_THROW(calibrateThreshold(32.5), ParameterError);
-    EXPECT_THROW(calibrateRelaxedThreshold(32.5, 0.3, 2), ParameterError);
+    for (const auto& [ratio, spelled] : {std::pair<double, const char*>{0.5, "0.5"}, {0.4, "0.4"}}) {
+        EXPECT_EQ(nonbloppy_test::messageOf<ParameterError>([&] { calibrateThreshold(ratio); }),
+                  std::string("--radius must exceed half the particle spacing to calibrate --threshold, got ") +
+                      spelled + " spacings");
+    }
+    const std::string tooLarge = "--radius must be at most 32 particle spacings to calibrate --threshold, got 32.5 "
+                                 "spacings; give --threshold";
+    EXPECT_EQ(nonbloppy_test::messageOf<ParameterError>([] { calibrateThreshold(32.5); }), tooLarge);
+    EXPECT_EQ(nonbloppy_test::messageOf<ParameterError>([] { calibrateRelaxedThreshold(32.5, 0.3, 2); }), tooLarge);
     // Just above half a spacing the kernel reached no sample: both returned r_0 = 0, and
     // buildSurface() meshed nothing without a word.
     for (const auto& [ratio, spelled] : {std::pair<double, const char*>{0.5000001, "0.5"}, {0.501, "0.501"}}) {

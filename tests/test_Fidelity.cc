@@ -213,9 +213,12 @@ TEST(Fidelity, RelaxedThresholdIsTheBlobThresholdWithoutRelaxation)
     EXPECT_LT(calibrateRelaxedThreshold(2.0, 0.3, 2), calibrateThreshold(2.0));
     EXPECT_LT(calibrateRelaxedThreshold(2.0, 0.3, 3), calibrateRelaxedThreshold(2.0, 0.3, 2));
     EXPECT_GT(calibrateRelaxedThreshold(2.0, 1.0, 10), 0.0);  // limited start height, no throw
-    EXPECT_THROW(calibrateRelaxedThreshold(0.5, 0.3, 2), ParameterError);
-    EXPECT_THROW(calibrateRelaxedThreshold(2.0, 1.5, 2), ParameterError);
-    EXPECT_THROW(calibrateRelaxedThreshold(2.0, 0.3, -1), ParameterError);
+    EXPECT_EQ(nonbloppy_test::messageOf<ParameterError>([] { calibrateRelaxedThreshold(0.5, 0.3, 2); }),
+              "--radius must exceed half the particle spacing to calibrate --threshold, got 0.5 spacings");
+    EXPECT_EQ(nonbloppy_test::messageOf<ParameterError>([] { calibrateRelaxedThreshold(2.0, 1.5, 2); }),
+              "--blend must lie in [0,1], got 1.5");
+    EXPECT_EQ(nonbloppy_test::messageOf<ParameterError>([] { calibrateRelaxedThreshold(2.0, 0.3, -1); }),
+              "--iterations must be >= 0, got -1");
 }
 
 TEST(Fidelity, RelaxedThresholdTakesTheStepCapIntoAccount)
@@ -266,7 +269,8 @@ TEST(Fidelity, FoldedTrianglesAreFoundAndUnfolded)
     EXPECT_EQ(countFoldedTriangles(mesh, before), 0u);
     // Vertices of unfolded triangles only: vertex 0 is not in the folded triangle.
     EXPECT_EQ(mesh.points[0], before[0]);
-    EXPECT_THROW(repairFolds(mesh, {}), ParameterError);
+    EXPECT_EQ(nonbloppy_test::messageOf<ParameterError>([&] { repairFolds(mesh, {}); }),
+              "fold repair needs the positions before relaxation of all 4 vertices, got 0");
     // A negative round count moved every folded vertex all the way back, as 0 does.
     mesh.points[3] = openvdb::Vec3s(-0.2f, -0.2f, 0.0f);
     const std::vector<openvdb::Vec3s> folded = mesh.points;
@@ -317,7 +321,8 @@ TEST(Fidelity, MaxStepCapsEveryRelaxationStep)
         ASSERT_NEAR(mesh.points[i].length(), before[i].length() - 0.1f, 1e-5f) << i;
     }
     relax.maxStep = -1.0;
-    EXPECT_THROW(relaxVertices(mesh, index, relax), ParameterError);
+    EXPECT_EQ(nonbloppy_test::messageOf<ParameterError>([&] { relaxVertices(mesh, index, relax); }),
+              "--max-step must be >= 0 (0 or inf: no cap), got -1");
 }
 
 TEST(Fidelity, ConvexVolumeOffsetGrowsEdgesAndLeavesFlatFaces)
@@ -455,5 +460,6 @@ TEST(Fidelity, PreserveVolumeReachesTheTargetWithinItsLimit)
 
     SurfaceMesh limited = sphere;
     EXPECT_DOUBLE_EQ(preserveVolume(limited, 1.3 * volume, 0.01), 0.01);
-    EXPECT_THROW(preserveVolume(limited, 0.0), ParameterError);
+    EXPECT_EQ(nonbloppy_test::messageOf<ParameterError>([&] { preserveVolume(limited, 0.0); }),
+              "target volume must be > 0, got 0");
 }

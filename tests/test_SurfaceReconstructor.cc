@@ -152,7 +152,9 @@ TEST(SurfaceReconstructor, BadParametersThrowParameterError)
     SurfaceParameters params;
     params.blend = 2.0;
     SurfaceReconstructor reconstructor(params);
-    EXPECT_THROW(reconstructor.reconstruct(ParticleSet{ballFrame(0.5, 1), {}}), ParameterError);
+    const ParticleSet frame{ballFrame(0.5, 1), {}};
+    EXPECT_EQ(nonbloppy_test::messageOf<ParameterError>([&] { reconstructor.reconstruct(frame); }),
+              "--blend must lie in [0,1], got 2");
 }
 
 TEST(SurfaceReconstructor, AFrameThatThrowsLeavesAnEmptyUsableIndex)

@@ -425,6 +425,24 @@ TEST_F(CliTest, ZeroParticles)
     expectFailure("mesh " + quote(path) + " -o " + quote(out("x.obj")), "no particles in " + path);
 }
 
+TEST_F(CliTest, ParticlesStackedOnEachOtherAskForTheSpacing)
+{
+    // Every particle written three times (an exporter that repeats its substeps): the median
+    // nearest-neighbour distance is 0, so there is no spacing to estimate; the run says so
+    // rather than meshing at a made-up one.
+    std::string csv = "x,y,z\n";
+    for (int i = 0; i < 5 * 5 * 5; ++i) {
+        const std::string row = std::to_string(0.1 * (i % 5)) + "," + std::to_string(0.1 * (i / 5 % 5)) + ","
+                                + std::to_string(0.1 * (i / 25)) + "\n";
+        csv += row + row + row;
+    }
+    const std::string path = in("stacked.csv");
+    writeText(path, csv);
+    expectFailure("mesh " + quote(path) + " -o " + quote(out("x.obj")),
+                  path + ": cannot estimate the particle spacing: most particles sit on top of another one; give "
+                  "--spacing");
+}
+
 TEST_F(CliTest, BadParameters)
 {
     const std::string base = "mesh " + quote(kCube) + " -o " + quote(out("x.obj")) + " --vdb "
