@@ -20,6 +20,7 @@
 #include <cstdio>
 #include <limits>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <sys/stat.h>
@@ -404,18 +405,12 @@ TEST_F(CliTest, TruncatedInput)
 
 TEST_F(CliTest, NanCoordinate)
 {
+    // The reader takes the token 'nan' as a value; the position check names the particle.
     const std::string path = in("nan.vtk");
     writeText(path, "# vtk DataFile Version 3.0\nnan test\nASCII\nDATASET POLYDATA\n"
                     "POINTS 3 float\n0 0 0\n1 nan 0\n0 1 0\n");
-    const RunResult r = run("mesh " + quote(path) + " -o " + quote(out("x.obj")));
-    EXPECT_NE(r.exitCode, 0);
-    const std::vector<std::string> errLines = lines(r.err);
-    ASSERT_EQ(errLines.size(), 1u) << r.err;
-    // The reader either refuses the token or the value; both name the file.
-    EXPECT_TRUE(errLines[0] == "nonbloppy: non-finite position of particle 1 (" + path + ")"
-                || errLines[0] == "nonbloppy: bad float32 value 'nan' in POINTS section (" + path + ")")
-        << errLines[0];
-    EXPECT_TRUE(listDir(dir() + "/out").empty());
+    expectFailure("mesh " + quote(path) + " -o " + quote(out("x.obj")),
+                  "non-finite position of particle 1 (" + path + ")");
 }
 
 TEST_F(CliTest, ZeroParticles)
@@ -609,18 +604,25 @@ TEST_F(CliTest, InspectTruncatedMeshIsNotCalledAParticleFile)
 
 TEST_F(CliTest, InspectTruncatedVdbIsOneLine)
 {
-    // Cut in its second grid: io::File took a minute and 8.5 GB on such a file and printed a
-    // 1.4 GB line; cut in its header, it reported "0 grids", exit 0.
+    // Cut inside a grid: io::File took a minute and 8.5 GB on such a file and printed a
+    // 1.4 GB line; cut in its header, it reported "0 grids", exit 0. The cube's cache holds
+    // one grid, density, which ends where the file does.
     ASSERT_EQ(meshCube("cube", "-q").exitCode, 0);
     const std::string bytes = readText(out("cube.vdb"));
-    for (size_t size : {size_t(4), size_t(64), bytes.size() / 2}) {
+    const size_t half = bytes.size() / 2;
+    const std::vector<std::pair<size_t, std::string>> cuts = {
+        {4, "not a VDB file"},
+        {64, "metadata of the file claims 1 items"},
+        {half, "truncated grid 'density' (it ends at byte " + std::to_string(bytes.size()) + ", the file has "
+                   + std::to_string(half) + ")"},
+    };
+    for (const auto& [size, reason] : cuts) {
+        SCOPED_TRACE(size);
         const std::string path = in("cut.vdb");
         writeText(path, bytes.substr(0, size));
         const RunResult r = run("inspect " + quote(path));
-        EXPECT_EQ(r.exitCode, 1) << size;
-        EXPECT_EQ(r.err.rfind("nonbloppy: cannot read .vdb file: ", 0), 0u) << r.err;
-        EXPECT_EQ(lines(r.err).size(), 1u) << r.err;
-        EXPECT_NE(r.err.find(" (" + path + ")\n"), std::string::npos) << r.err;
+        EXPECT_EQ(r.exitCode, 1);
+        EXPECT_EQ(r.err, "nonbloppy: cannot read .vdb file: " + reason + " (" + path + ")\n");
         EXPECT_EQ(r.out, "");
     }
 }
@@ -668,16 +670,12 @@ TEST_F(CliTest, VerticesWithoutANormalAreSaid)
 
 TEST_F(CliTest, UsageErrorsAreOneLine)
 {
-    for (const std::string& args : {std::string(""), std::string("mesh"),
-                                   "mesh " + quote(kCube), std::string("frobnicate"),
-                                   "mesh " + quote(kCube) + " -o x.obj --radius abc"}) {
-        SCOPED_TRACE(args);
-        const RunResult r = run(args);
-        EXPECT_EQ(r.exitCode, 2);
-        const std::vector<std::string> errLines = lines(r.err);
-        ASSERT_EQ(errLines.size(), 1u) << r.err;
-        EXPECT_EQ(errLines[0].rfind("nonbloppy: ", 0), 0u) << errLines[0];
-    }
+    // Missing pieces of the command line are said in the tool's words, not CLI11's.
+    expectUsageError("", "no command given; commands are mesh, inspect, convert, help");
+    expectUsageError("mesh", "IN is required");
+    expectUsageError("mesh " + quote(kCube), "--output is required");
+    expectUsageError("frobnicate", "unknown command 'frobnicate'; commands are mesh, inspect, convert, help");
+    expectUsageError("mesh " + quote(kCube) + " -o x.obj --radius abc", "--radius needs a number, got 'abc'");
 }
 
 TEST_F(CliTest, UnreadableNumbersAreNamed)
