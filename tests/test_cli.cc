@@ -985,10 +985,11 @@ TEST_F(CliTest, ConvertStopsOnASignalAndLeavesItsOutputAsItWas)
 TEST_F(CliTest, ASignalWhileConvertWritesUndoesTheWrite)
 {
     // A signal seen only once OUT is in place: the old OUT is put back. 400,000 particles
-    // to CSV (about 40 MB of text) take long enough to be caught writing, which the
-    // temporary file beside OUT shows. A machine so fast that the write ends before the
-    // signal lands gives exit 0 and the new OUT; never the new OUT with exit 130, nor a
-    // file left beside it.
+    // to CSV (about 7.6 MB of text) take long enough to be caught writing, which the
+    // temporary file beside OUT shows; the test needs to have seen it, or it would pass
+    // without the undo. A machine so fast that the write ends before the signal lands
+    // gives exit 0 and the new OUT; never the new OUT with exit 130, nor a file left
+    // beside it.
     nonbloppy::ParticleSet many;
     for (int n = 0; n < 400000; ++n) many.positions.emplace_back(0.001f * float(n % 1000), 0.37f * float(n), 0.5f);
     nonbloppy::writeParticles(many, in("many.xyz"));
@@ -1003,9 +1004,11 @@ TEST_F(CliTest, ASignalWhileConvertWritesUndoesTheWrite)
         return false;
     };
     const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(30);
-    while (!writing() && std::chrono::steady_clock::now() < deadline) std::this_thread::yield();
+    bool seen = false;
+    while (!(seen = writing()) && std::chrono::steady_clock::now() < deadline) std::this_thread::yield();
     ASSERT_EQ(::kill(pid, SIGINT), 0);
     const int status = waitForExit(pid);
+    ASSERT_TRUE(seen) << "the temporary file beside OUT never appeared";
     ASSERT_TRUE(status == 130 || status == 0) << status << ": " << readText(errFile);
     EXPECT_EQ(listDir(dir() + "/out"), std::vector<std::string>{"p.csv"});
     if (status == 130) {
