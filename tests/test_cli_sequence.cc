@@ -224,6 +224,14 @@ TEST_F(CliSequenceTest, SequenceOptionsNeedASequence)
     EXPECT_EQ(r.err, "nonbloppy: --frames needs a frame sequence as IN (a name with {}, #### or "
                      "%04d), got '" + kFree + "'\n");
     EXPECT_TRUE(listDir(dir() + "/out").empty());
+    // So do the options that only a run over frames has a use for.
+    for (const std::string option : {"--skip-existing", "--keep-going", "--frame-jobs 2", "--log"}) {
+        const std::string extra = option == "--log" ? " " + quote(dir() + "/run.jsonl") : "";
+        expectUsageError("mesh " + quote(kFree) + " -o " + quote(out("m.obj")) + " " + option + extra,
+                         option.substr(0, option.find(' ')) + " needs a frame sequence as IN (a name with {}, "
+                         "#### or %04d), got '" + kFree + "'");
+    }
+    EXPECT_FALSE(fs::exists(dir() + "/run.jsonl"));
     // And outputs named for a sequence: a file literally named 'm_{}.obj' was written.
     expectUsageError("mesh " + quote(kFree) + " -o " + quote(out("m_{}.obj")),
                      "--output: a frame placeholder ({}, #### or %04d) in '" + out("m_{}.obj")
@@ -296,6 +304,20 @@ TEST_F(CliSequenceTest, SkipExistingResumes)
     EXPECT_EQ(count(log, "\"status\": \"done\""), 1u) << log;
     // Skipped on all its outputs, the mesh and the .vdb (it named the mesh alone).
     EXPECT_NE(r.out.find("skipped, its 2 outputs exist"), std::string::npos) << r.out;
+
+    // A frame with only some of its outputs (the mesh, not the .vdb) is made again, all of it.
+    fs::remove(out("density_0002.vdb"));
+    writeText(out("mesh_0002.obj"), "# stale\n");
+    const RunResult partial = meshSequence(dir() + "/out", "--skip-existing --log " + quote(dir() + "/partial.jsonl"));
+    ASSERT_EQ(partial.exitCode, 0) << partial.err;
+    const std::vector<std::string> logLines = lines(readText(dir() + "/partial.jsonl"));
+    ASSERT_EQ(logLines.size(), 4u);  // three frames and the summary
+    EXPECT_EQ(logLines[0].rfind("{\"frame\": 1, \"status\": \"skipped\"", 0), 0u) << logLines[0];
+    EXPECT_EQ(logLines[1].rfind("{\"frame\": 2, \"status\": \"done\"", 0), 0u) << logLines[1];
+    EXPECT_EQ(logLines[2].rfind("{\"frame\": 3, \"status\": \"skipped\"", 0), 0u) << logLines[2];
+    EXPECT_TRUE(fs::exists(out("density_0002.vdb")));
+    EXPECT_NE(readText(out("mesh_0002.obj")), "# stale\n");
+    EXPECT_EQ(listDir(dir() + "/out").size(), 6u);
 
     // Without --skip-existing every frame is made again.
     ASSERT_EQ(meshSequence(dir() + "/out", "").exitCode, 0);
