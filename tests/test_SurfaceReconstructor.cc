@@ -99,6 +99,35 @@ TEST(SurfaceReconstructor, KeepsTheFirstFramesParametersWhenAsked)
     EXPECT_NEAR(reconstructor.reconstruct(ParticleSet{sparse, {}}).parameters.spacing, 0.2, 0.005 * 0.2);
 }
 
+TEST(SurfaceReconstructor, NewParametersForgetTheKeptOnes)
+{
+    // Kept from a dense frame (s = 0.1) with c = 0.5, then replaced by the defaults: the
+    // sparser frame's spacing (0.2) is estimated again, and the mesh is the one a fresh
+    // reconstructor with the defaults makes, bit for bit.
+    const auto dense = latticeParticles(0.1, 0.7, [](const openvdb::Vec3d& x) { return x.length() < 0.6; });
+    const auto sparse = latticeParticles(0.2, 0.7, [](const openvdb::Vec3d& x) { return x.length() < 0.6; });
+    SurfaceParameters strong;
+    strong.blend = 0.5;
+    SurfaceReconstructor reconstructor(strong);
+    reconstructor.setKeepParameters(true);
+    EXPECT_NEAR(reconstructor.reconstruct(ParticleSet{dense, {}}).parameters.spacing, 0.1, 0.005 * 0.1);
+    reconstructor.setParameters(SurfaceParameters());
+    EXPECT_EQ(reconstructor.parameters().blend, SurfaceParameters().blend);
+    EXPECT_TRUE(reconstructor.keepParameters());  // only the kept values are forgotten
+    const SurfaceResult& next = reconstructor.reconstruct(ParticleSet{sparse, {}});
+    EXPECT_NEAR(next.parameters.spacing, 0.2, 0.005 * 0.2);
+    SurfaceReconstructor fresh;
+    fresh.setKeepParameters(true);
+    const SurfaceResult& expected = fresh.reconstruct(ParticleSet{sparse, {}});
+    EXPECT_EQ(next.parameters.spacing, expected.parameters.spacing);
+    EXPECT_EQ(next.parameters.effectiveRadius, expected.parameters.effectiveRadius);
+    EXPECT_EQ(next.parameters.threshold, expected.parameters.threshold);
+    EXPECT_EQ(next.parameters.voxelSize, expected.parameters.voxelSize);
+    expectSameMesh(next.mesh, expected.mesh);
+    // And the new parameters are kept in turn: a dense frame now keeps the sparse spacing.
+    EXPECT_EQ(reconstructor.reconstruct(ParticleSet{dense, {}}).parameters.spacing, next.parameters.spacing);
+}
+
 TEST(SurfaceReconstructor, AFrameWithoutParticlesIsRefusedKeptParametersOrNot)
 {
     // With kept parameters nothing was resolved to refuse it: an empty mesh, or with the
