@@ -547,6 +547,9 @@ TEST_F(CliTest, BadParameters)
     expectUsageError(base + "--spacing 1e308",
                      "--spacing 1e+308: the radius 2 s = inf is too large: at most 1e+18 (lengths are squared in "
                      "single precision); give the positions in a larger unit");
+    // Past double's range the text read as 0 or inf: "--spacing must be > 0, got 0".
+    expectUsageError(base + "--spacing 1e-400", "--spacing 1e-400 lies outside double's range (it reads as 0)");
+    expectUsageError(base + "--radius 1e400", "--radius 1e400 lies outside double's range (it reads as infinity)");
     // A threshold a float density cannot hold: 1e-46 became 0, an empty mesh blamed on the
     // particles.
     expectUsageError(base + "--threshold 1e-46",

@@ -305,6 +305,19 @@ void validateParameters(const MeshOptions& o)
             }
         }
     }
+    // CLI11 reads 1e-400 as 0 and 1e400 as inf, which the range checks then answered with
+    // "--spacing must be > 0, got 0": say what the text was.
+    for (const CLI::Option* option : {o.spacingOpt, o.radiusOpt, o.thresholdOpt, o.voxelSizeOpt, o.blendOpt,
+                                      o.adaptivityOpt, o.maxStepOpt}) {
+        for (const std::string& value : option->results()) {
+            errno = 0;
+            const double parsed = std::strtod(value.c_str(), nullptr);
+            if (errno == ERANGE && (parsed == 0.0 || std::isinf(parsed))) {
+                throw UsageError(option->get_name() + " " + value + " lies outside double's range (it reads as " +
+                                 (parsed == 0.0 ? "0" : "infinity") + ")");
+            }
+        }
+    }
     // Every range, and the limits between given lengths (--voxel-size 0.001 with --radius 1),
     // in the library's words: exit 2 before the input is read, not 1 after.
     try {
