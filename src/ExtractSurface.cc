@@ -267,11 +267,13 @@ class SeamTable
 public:
     static constexpr uint32_t kNone = std::numeric_limits<uint32_t>::max();
 
-    /// Remember @a index for @a key (a key already present keeps its first index).
-    void insert(const PositionKey& key, uint32_t index)
+    /// Remember @a index for @a key unless @a key is present; whether it was not.
+    bool insert(const PositionKey& key, uint32_t index)
     {
         if (2 * (mSize + 1) > mSlots.size()) grow();
-        if (place(mSlots, key, index)) ++mSize;
+        if (!place(mSlots, key, index)) return false;
+        ++mSize;
+        return true;
     }
     /// The index remembered for @a key, or kNone.
     uint32_t find(const PositionKey& key) const
@@ -506,6 +508,10 @@ bool extractByRegionImpl(const openvdb::FloatGrid& density, double threshold, Su
     // their mesh index: those of the current slab, and of the slab before it (a seam
     // vertex lies within three planes of a face, and a slab is at least a leaf thick).
     SeamTable seamThisSlab, seamSlabBefore;
+    // Positions of one region's vertices near its seams, each once (see weldRegion()), and
+    // whether two vertices shared one: then welding by position cannot tell them apart.
+    SeamTable seamPositions;
+    std::atomic<bool> ambiguousSeam{false};
     std::vector<uint32_t> remap;
     std::unique_ptr<std::atomic<uint8_t>[]> used;
     std::vector<size_t> newBefore;
@@ -703,6 +709,20 @@ bool extractByRegionImpl(const openvdb::FloatGrid& density, double threshold, Su
             return (!region.lastSlab && double(p[axis]) >= slabKeepFrom)
                 || (!region.lastBand && double(p[cross]) >= bandKeepFrom);
         };
+        // Two vertices (used or not) at one position near a seam: cells whose crossings
+        // fall on a shared voxel corner or face (a density exactly at the threshold there,
+        // or, far from the origin, floats coarser than a tenth of a voxel) put their
+        // vertices on one point. Welding by position joined them, and the seam's quads
+        // collapsed into degenerate triangles (differential hunt: 2 particles 43.75 apart,
+        // -t 0 --radius 1 --voxel-size 0.5 --threshold 3 --region-leaves 1; the dam break
+        // 10 km from the origin at --voxel-size 0.009). The whole grid is meshed instead.
+        seamPositions.clear();
+        for (size_t n = 0; n < pointCount; ++n) {
+            if ((nearLowerSeam(points[n]) || nearUpperSeam(points[n])) && !seamPositions.insert(keyOf(points[n]), 0)) {
+                ambiguousSeam = true;
+                return;
+            }
+        }
         remap.assign(pointCount, kNew);
         if (!(region.firstSlab && region.firstBand)) {
             tbb::parallel_for(tbb::blocked_range<size_t>(0, pointCount),
@@ -780,7 +800,7 @@ bool extractByRegionImpl(const openvdb::FloatGrid& density, double threshold, Su
     tbb::parallel_pipeline(threads + 1,
         tbb::make_filter<void, size_t>(tbb::filter_mode::serial_in_order,
             [&](tbb::flow_control& control) -> size_t {
-                if (nextRegion == regions.size() || poll.stopped()) {
+                if (nextRegion == regions.size() || poll.stopped() || ambiguousSeam) {
                     control.stop();
                     return 0;
                 }
@@ -793,16 +813,23 @@ bool extractByRegionImpl(const openvdb::FloatGrid& density, double threshold, Su
             })
         & tbb::make_filter<size_t, void>(tbb::filter_mode::serial_in_order,
             [&](size_t r) {
-                if (!meshers[r]) return;  // stopped
+                if (!meshers[r] || ambiguousSeam) return;  // stopped, or meshed whole below
                 // Isolated: a thread waiting on the weld's loops must not take up the
                 // meshing of another region, which would hold every later weld back.
                 tbb::this_task_arena::isolate([&] { weldRegion(r, *meshers[r]); });
                 meshers[r].reset();
                 // Regions come in slab order along the axis and read one leaf layer before
                 // their own slab, so the regions after this one need none before that.
-                if (r + 1 < regions.size()) releaseLayersBefore(regions[r + 1].slab.first - 1);
+                if (r + 1 < regions.size() && !ambiguousSeam) releaseLayersBefore(regions[r + 1].slab.first - 1);
             }));
     poll.throwIfStopped();
+    if (ambiguousSeam) {
+        // The caller meshes the whole grid, unless leaves were freed: then it must be made again.
+        if (releasedLayers > 0) throw surface_stages_internal::AmbiguousSeamError();
+        mesh.points.clear();
+        mesh.quads.clear();
+        return false;
+    }
     return true;
 }
 

@@ -91,7 +91,7 @@ void runSurfaceStages(const ParticleIndex& index, const SurfaceParameters& setti
                       openvdb::util::NullInterrupter* interrupter)
 {
     const ResolvedParameters p = result.parameters;
-    {
+    const auto rasterize = [&] {
         ScopedStageTimer timer(result.timings, "rasterize density");
         DensitySettings settings;
         settings.effectiveRadius = p.effectiveRadius;
@@ -108,17 +108,24 @@ void runSurfaceStages(const ParticleIndex& index, const SurfaceParameters& setti
         grid.insertMeta("method", openvdb::StringMetadata(p.method == Method::Paper ? "paper" : "faithful"));
         grid.insertMeta("particle_count", openvdb::Int64Metadata(int64_t(result.particleCount)));
         grid.insertMeta("nonbloppy_version", openvdb::StringMetadata(version()));
-    }
-    {
+    };
+    rasterize();
+    try {
         StageScope scope(result.timings, interrupter, "extract surface");
         // Region by region (adaptivity 0): volumeToMesh cannot be stopped safely from
         // outside (see Cancellation.h), so the regions bound the wait for a cancel.
         // A grid nobody keeps gives its memory back as the regions pass.
         extractSurfaceInto(*result.density, p.threshold, p.adaptivity, p.regionLeaves, result.mesh, interrupter,
                            settings.keepDensity ? nullptr : &result.density->tree(), settings.trimFreedMemory);
-        if (!settings.keepDensity) result.density.reset();
-        checkCancelled(interrupter, "extract surface");
+    } catch (const AmbiguousSeamError&) {
+        // Seam vertices that only their cells tell apart, found after leaves were freed:
+        // the grid again, meshed whole (uninterruptible, as regionLeaves = 0 is).
+        rasterize();
+        StageScope scope(result.timings, interrupter, "extract surface");
+        extractSurfaceInto(*result.density, p.threshold, p.adaptivity, 0, result.mesh, interrupter);
     }
+    if (!settings.keepDensity) result.density.reset();
+    checkCancelled(interrupter, "extract surface");
     {
         ScopedStageTimer timer(result.timings, "relax vertices");
         RelaxSettings settings;

@@ -17,6 +17,7 @@
 #include <openvdb/openvdb.h>
 #include <openvdb/util/NullInterrupter.h>
 
+#include <exception>
 #include <string>
 #include <vector>
 
@@ -141,11 +142,20 @@ constexpr int kMinLayersPerRegion = 12;
 ///                 for bit (tested). Null leaves the grid untouched.
 /// @param trimFreedMemory  with @a release: hand the freed leaves' pages back to the system
 ///                 as it goes (see SurfaceParameters::trimFreedMemory)
-/// @throw ParameterError as extractSurface(); CancelledError("interrupted during extract surface")
+/// @throw ParameterError as extractSurface(); CancelledError("interrupted during extract
+///        surface"); AmbiguousSeamError as extractByRegion()
 void extractSurfaceInto(const openvdb::FloatGrid& density, double threshold, double adaptivity,
                         size_t leavesPerRegion, SurfaceMesh& mesh,
                         openvdb::util::NullInterrupter* interrupter, openvdb::FloatTree* release = nullptr,
                         bool trimFreedMemory = false);
+
+/// Thrown by extractByRegion() when two vertices near a seam share one position (welding by
+/// position cannot tell them apart) after it freed leaves of the grid (@a release): the
+/// caller rasterizes the grid again and meshes it whole. Never leaves the library.
+struct AmbiguousSeamError : std::exception
+{
+    const char* what() const noexcept override { return "two seam vertices at one position"; }
+};
 
 /// The surface φ = @a threshold of a density grid (adaptivity 0), meshed region by region:
 /// slabs across the grid's longest axis, each cut again across the second longest when it
@@ -168,7 +178,10 @@ void extractSurfaceInto(const openvdb::FloatGrid& density, double threshold, dou
 /// @param release  optional: @a density's own tree, whose leaves are freed as the slabs pass
 ///                 (see extractSurfaceInto()); null leaves the grid untouched
 /// @param trimFreedMemory  as extractSurfaceInto()'s
-/// @throw ParameterError if @a threshold is not finite; CancelledError as above
+/// Two vertices at one position near a seam (see AmbiguousSeamError) make it mesh the
+/// whole grid instead, as extractSurface(); if leaves were freed already, it throws.
+/// @throw ParameterError if @a threshold is not finite; CancelledError as above;
+///        AmbiguousSeamError as said
 void extractByRegion(const openvdb::FloatGrid& density, double threshold, SurfaceMesh& mesh,
                      openvdb::util::NullInterrupter* interrupter, size_t leavesPerRegion,
                      int minLayersPerRegion = kMinLayersPerRegion, openvdb::FloatTree* release = nullptr,
