@@ -266,6 +266,8 @@ class SeamTable
 {
 public:
     static constexpr uint32_t kNone = std::numeric_limits<uint32_t>::max();
+    /// What find() gives for a position two vertices of one region had (see markAmbiguous()).
+    static constexpr uint32_t kAmbiguous = kNone - 1;
 
     /// Remember @a index for @a key unless @a key is present; whether it was not.
     bool insert(const PositionKey& key, uint32_t index)
@@ -275,7 +277,16 @@ public:
         ++mSize;
         return true;
     }
-    /// The index remembered for @a key, or kNone.
+    /// Remember that two vertices had @a key: find() gives kAmbiguous for it from now on.
+    void markAmbiguous(const PositionKey& key)
+    {
+        if (2 * (mSize + 1) > mSlots.size()) grow();
+        Slot& slot = mSlots[slotOf(mSlots, key)];
+        if (slot.index == kNone) ++mSize;
+        slot.key = key;
+        slot.index = kAmbiguous;
+    }
+    /// The index remembered for @a key, kAmbiguous, or kNone.
     uint32_t find(const PositionKey& key) const
     {
         return mSlots.empty() ? kNone : mSlots[slotOf(mSlots, key)].index;
@@ -508,10 +519,10 @@ bool extractByRegionImpl(const openvdb::FloatGrid& density, double threshold, Su
     // their mesh index: those of the current slab, and of the slab before it (a seam
     // vertex lies within three planes of a face, and a slab is at least a leaf thick).
     SeamTable seamThisSlab, seamSlabBefore;
-    // Positions of one region's vertices near its seams, each once (see weldRegion()), and
-    // whether two vertices shared one: then welding by position cannot tell them apart.
-    SeamTable seamPositions;
+    // Whether a seam vertex matched a position two vertices of a region had: welding by
+    // position cannot tell them apart (see weldRegion()).
     std::atomic<bool> ambiguousSeam{false};
+    std::vector<uint32_t> welded, unusedNearSeam;
     std::vector<uint32_t> remap;
     std::unique_ptr<std::atomic<uint8_t>[]> used;
     std::vector<size_t> newBefore;
@@ -709,20 +720,6 @@ bool extractByRegionImpl(const openvdb::FloatGrid& density, double threshold, Su
             return (!region.lastSlab && double(p[axis]) >= slabKeepFrom)
                 || (!region.lastBand && double(p[cross]) >= bandKeepFrom);
         };
-        // Two vertices (used or not) at one position near a seam: cells whose crossings
-        // fall on a shared voxel corner or face (a density exactly at the threshold there,
-        // or, far from the origin, floats coarser than a tenth of a voxel) put their
-        // vertices on one point. Welding by position joined them, and the seam's quads
-        // collapsed into degenerate triangles (differential hunt: 2 particles 43.75 apart,
-        // -t 0 --radius 1 --voxel-size 0.5 --threshold 3 --region-leaves 1; the dam break
-        // 10 km from the origin at --voxel-size 0.009). The whole grid is meshed instead.
-        seamPositions.clear();
-        for (size_t n = 0; n < pointCount; ++n) {
-            if ((nearLowerSeam(points[n]) || nearUpperSeam(points[n])) && !seamPositions.insert(keyOf(points[n]), 0)) {
-                ambiguousSeam = true;
-                return;
-            }
-        }
         remap.assign(pointCount, kNew);
         if (!(region.firstSlab && region.firstBand)) {
             tbb::parallel_for(tbb::blocked_range<size_t>(0, pointCount),
@@ -732,8 +729,18 @@ bool extractByRegionImpl(const openvdb::FloatGrid& density, double threshold, Su
                         const PositionKey key = keyOf(points[n]);
                         const uint32_t found = seamThisSlab.find(key);
                         remap[n] = found != SeamTable::kNone ? found : seamSlabBefore.find(key);
+                        if (remap[n] == SeamTable::kAmbiguous) ambiguousSeam = true;
                     }
                 });
+            // Two vertices welded to one: both had its position. (Checked in both
+            // regions: there, the position got kAmbiguous.)
+            welded.clear();
+            for (size_t n = 0; n < pointCount; ++n) {
+                if (remap[n] != kNew) welded.push_back(remap[n]);
+            }
+            std::sort(welded.begin(), welded.end());
+            if (std::adjacent_find(welded.begin(), welded.end()) != welded.end()) ambiguousSeam = true;
+            if (ambiguousSeam) return;
         }
         // New vertices numbered in region order: a count per block, then its prefix sum.
         constexpr size_t kBlock = 16384;
@@ -771,11 +778,29 @@ bool extractByRegionImpl(const openvdb::FloatGrid& density, double threshold, Su
             });
         // This region's new vertices that a later region may share. A vertex welded here
         // came from a region before, whose map still holds it for as long as it is needed.
+        // Cells whose crossings fall on a shared voxel corner or face (a density exactly at
+        // the threshold there, or, far from the origin, floats near a tenth of a voxel) put
+        // their vertices on one point: such a position is marked, used twice or used once
+        // beside an unused vertex (the next region may use the other one), and a later
+        // vertex there cannot be welded. Welding by position alone joined them, and the
+        // seam's quads collapsed into triangles with a repeated corner (differential hunt:
+        // 2 particles 43.75 apart, -t 0 --radius 1 --voxel-size 0.5 --threshold 3
+        // --region-leaves 1; the dam break 10 km out at --voxel-size 0.009). The 512x
+        // benchmark input has such positions, harmlessly: none is welded.
         if (!(region.lastSlab && region.lastBand)) {
+            unusedNearSeam.clear();
             for (size_t n = 0; n < pointCount; ++n) {
-                if (isUsed(n) && remap[n] >= firstNew && nearUpperSeam(points[n])) {
-                    seamThisSlab.insert(keyOf(points[n]), remap[n]);
+                if (!nearUpperSeam(points[n])) continue;
+                if (!isUsed(n)) {
+                    unusedNearSeam.push_back(uint32_t(n));
+                } else if (remap[n] >= firstNew && !seamThisSlab.insert(keyOf(points[n]), remap[n])) {
+                    seamThisSlab.markAmbiguous(keyOf(points[n]));
                 }
+            }
+            for (const uint32_t n : unusedNearSeam) {  // beside a vertex of this region's
+                const PositionKey key = keyOf(points[n]);
+                const uint32_t found = seamThisSlab.find(key);
+                if (found != SeamTable::kNone && found >= firstNew) seamThisSlab.markAmbiguous(key);
             }
         }
         // Mesh indices, each polygon reversed (see orientOutwards()).
