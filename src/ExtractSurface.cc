@@ -833,7 +833,7 @@ bool extractByRegionImpl(const openvdb::FloatGrid& density, double threshold, Su
             })
         & tbb::make_filter<size_t, size_t>(tbb::filter_mode::parallel,
             [&](size_t r) {
-                if (!poll.stopped()) meshers[r] = meshRegion(regions[r]);
+                if (!poll.stopped() && !ambiguousSeam) meshers[r] = meshRegion(regions[r]);
                 return r;
             })
         & tbb::make_filter<size_t, void>(tbb::filter_mode::serial_in_order,
@@ -851,8 +851,6 @@ bool extractByRegionImpl(const openvdb::FloatGrid& density, double threshold, Su
     if (ambiguousSeam) {
         // The caller meshes the whole grid, unless leaves were freed: then it must be made again.
         if (releasedLayers > 0) throw surface_stages_internal::AmbiguousSeamError();
-        mesh.points.clear();
-        mesh.quads.clear();
         return false;
     }
     return true;

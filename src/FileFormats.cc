@@ -333,6 +333,7 @@ parseDoubleText(std::string_view text, double& value)
     // from_chars leaves the value unset for 1e-310 (a denormal), 1e-400 or 1e400; strtod
     // gives it, in a C locale of our own (one per process, never changed).
     static const locale_t cLocale = ::newlocale(LC_ALL_MASK, "C", locale_t(0));
+    if (cLocale == locale_t(0)) return std::errc::invalid_argument;  // out of memory at first use
     const std::string copy(text);
     char* parsedEnd = nullptr;
     value = ::strtod_l(copy.c_str(), &parsedEnd, cLocale);

@@ -28,8 +28,6 @@ namespace {
 /// h/4 with half widths 3 and 10, rounded up.
 constexpr double kPeakBytesPerBandVoxel = 32.0;
 
-/// @throw ParameterError naming the first vertex that is not finite, or the largest
-///        coordinate if it is too far from the origin for 32-bit voxel coordinates.
 /// The vertices' bounding box (BBoxd() without vertices).
 /// @throw ParameterError naming the first vertex that is not finite, or the largest
 ///        coordinate if it is too far from the origin for 32-bit voxel coordinates.

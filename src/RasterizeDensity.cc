@@ -463,12 +463,14 @@ openvdb::FloatGrid::Ptr instruction_set_internal::rasterizeDensity(const Particl
         parameter_checks_internal::requirePositive(settings.voxelSize, "--voxel-size");
         openvdb_scale_internal::requireOpenVdbScale(settings.voxelSize, kMinCellSize, "--voxel-size");
         transform = openvdb::math::Transform::createLinearTransform(settings.voxelSize);
-    } else if (transform->baseMap()->type() != openvdb::math::UniformScaleMap::mapType()) {
-        throw ParameterError("rasterizeDensity needs a uniform-scale transform without translation or rotation");
+    } else {
+        if (transform->baseMap()->type() != openvdb::math::UniformScaleMap::mapType()) {
+            throw ParameterError("rasterizeDensity needs a uniform-scale transform without translation or rotation");
+        }
+        // OpenVDB makes a transform of any scale (API review).
+        openvdb_scale_internal::requireOpenVdbScale(transform->voxelSize()[0], kMinCellSize, "--voxel-size");
     }
     const double voxelSize = transform->voxelSize()[0];
-    // A caller's transform too: OpenVDB makes one of any scale (API review).
-    openvdb_scale_internal::requireOpenVdbScale(voxelSize, kMinCellSize, "--voxel-size");
     surface_stages_internal::requireVoxelsPerRadius(settings.effectiveRadius, voxelSize);
     particle_index_internal::requireCellsPerRadius(particles, settings.effectiveRadius);
 

@@ -86,7 +86,7 @@ void copyInParallel(const std::vector<openvdb::Vec3s>& points, VertexBufferT& un
 } // namespace
 
 template<typename VertexBufferT>
-void runSurfaceStages(const ParticleIndex& index, const SurfaceParameters& settings, SurfaceResult& result,
+void runSurfaceStages(const ParticleIndex& index, const SurfaceParameters& params, SurfaceResult& result,
                       VertexBufferT& unrelaxed, UnrelaxedBuffer whenRepaired,
                       openvdb::util::NullInterrupter* interrupter)
 {
@@ -110,22 +110,34 @@ void runSurfaceStages(const ParticleIndex& index, const SurfaceParameters& setti
         grid.insertMeta("nonbloppy_version", openvdb::StringMetadata(version()));
     };
     rasterize();
-    try {
+    bool wholeGrid = false;
+    {
         StageScope scope(result.timings, interrupter, "extract surface");
         // Region by region (adaptivity 0): volumeToMesh cannot be stopped safely from
         // outside (see Cancellation.h), so the regions bound the wait for a cancel.
         // A grid nobody keeps gives its memory back as the regions pass.
-        extractSurfaceInto(*result.density, p.threshold, p.adaptivity, p.regionLeaves, result.mesh, interrupter,
-                           settings.keepDensity ? nullptr : &result.density->tree(), settings.trimFreedMemory);
-    } catch (const AmbiguousSeamError&) {
+        try {
+            extractSurfaceInto(*result.density, p.threshold, p.adaptivity, p.regionLeaves, result.mesh, interrupter,
+                               params.keepDensity ? nullptr : &result.density->tree(), params.trimFreedMemory);
+        } catch (const AmbiguousSeamError&) {
+            wholeGrid = true;
+        }
+        if (!wholeGrid) {
+            if (!params.keepDensity) result.density.reset();
+            checkCancelled(interrupter, "extract surface");
+        }
+    }
+    if (wholeGrid) {
         // Seam vertices that only their cells tell apart, found after leaves were freed:
-        // the grid again, meshed whole (uninterruptible, as regionLeaves = 0 is).
+        // the grid again (the partial one freed first), meshed whole (uninterruptible, as
+        // regionLeaves = 0 is).
+        result.density.reset();
         rasterize();
         StageScope scope(result.timings, interrupter, "extract surface");
         extractSurfaceInto(*result.density, p.threshold, p.adaptivity, 0, result.mesh, interrupter);
+        if (!params.keepDensity) result.density.reset();
+        checkCancelled(interrupter, "extract surface");
     }
-    if (!settings.keepDensity) result.density.reset();
-    checkCancelled(interrupter, "extract surface");
     {
         ScopedStageTimer timer(result.timings, "relax vertices");
         RelaxSettings settings;

@@ -91,7 +91,7 @@ enum class UnrelaxedBuffer
 /// rasterize density (metadata holding the parameters), extract surface (into result.mesh's
 /// vectors, which keep their capacity), relax vertices, fold repair, compute normals, the
 /// volume correction and the smoothing (each followed by a fold repair against the surface
-/// it started from), timing each in result.timings. Of @a settings only keepDensity
+/// it started from), timing each in result.timings. Of @a params only keepDensity
 /// (result.density is reset when false) and trimFreedMemory are read.
 /// @param index        the frame's particle index, cell size kCellOverRadius·r_e
 /// @param unrelaxed    scratch for the vertex positions before each step fold repair checks
@@ -102,7 +102,7 @@ enum class UnrelaxedBuffer
 /// Cost: as buildSurface() minus its first two stages. Thread-safety: reentrant.
 /// @throw ParameterError, CancelledError as buildSurface(); result is then unspecified.
 template<typename VertexBufferT>
-void runSurfaceStages(const ParticleIndex& index, const SurfaceParameters& settings, SurfaceResult& result,
+void runSurfaceStages(const ParticleIndex& index, const SurfaceParameters& params, SurfaceResult& result,
                       VertexBufferT& unrelaxed, UnrelaxedBuffer whenRepaired,
                       openvdb::util::NullInterrupter* interrupter);
 

@@ -56,7 +56,9 @@ struct SurfaceResult
 ///                     header). "extract surface" meshes regions of about regionLeaves leaves
 ///                     and asks between them (volumeToMesh itself takes no interrupter);
 ///                     with adaptivity > 0 or regionLeaves = 0 it is one volumeToMesh()
-///                     call and cannot be stopped. Not interruptible either: OpenVDB's
+///                     call and cannot be stopped, as it is when two vertices near a seam
+///                     share a position and a later region welds to it (then the grid is
+///                     meshed whole, rasterized again if keepDensity is false). Not interruptible either: OpenVDB's
 ///                     point partitioner (part of "index particles" and of "estimate
 ///                     parameters") and measureAreaAndVolume() in the volume correction.
 ///                     A stop throws CancelledError("interrupted during <stage>") and

@@ -124,8 +124,8 @@ struct SurfaceParameters
     /// Return the exact density grid in SurfaceResult::density. false lets the extraction
     /// free the grid's leaves as its regions pass (adaptivity 0 and regionLeaves > 0), and
     /// SurfaceResult::density is then null: the same mesh, bit for bit, with a lower peak
-    /// memory (64x benchmark input, `mesh` without and with `--vdb`: peak RSS 313 against
-    /// 394 MiB).
+    /// memory (64x benchmark input, `mesh` without and with `--vdb`, which sets
+    /// trimFreedMemory: peak RSS 313 against 394 MiB).
     bool keepDensity = true;
     /// With keepDensity false: hand the freed leaves' pages back to the system as the
     /// extraction goes (glibc's malloc_trim(0) after every 32,768 freed leaves), which they

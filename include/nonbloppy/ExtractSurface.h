@@ -28,7 +28,8 @@ namespace nonbloppy {
 /// points allocated and zeroed). buildSurface() and SurfaceReconstructor therefore mesh
 /// their own density grids region by region (about SurfaceParameters::regionLeaves leaves
 /// each), asking the interrupter in between; the result has
-/// the same vertices and polygons as this function's, in another order.
+/// the same vertices and polygons as this function's, in another order (or in the same
+/// order where seam vertices that share a position make them call this function instead).
 /// Thread-safety: reentrant; the grid is only read.
 /// @throw ParameterError if adaptivity lies outside [0,1], threshold is not finite or not
 ///        above the grid's background value (0 for rasterizeDensity()'s: "--threshold must lie

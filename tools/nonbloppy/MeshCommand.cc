@@ -309,12 +309,15 @@ void validateParameters(const MeshOptions& o)
     // "--spacing must be > 0, got 0": say what the text was.
     for (const CLI::Option* option : {o.spacingOpt, o.radiusOpt, o.thresholdOpt, o.voxelSizeOpt, o.blendOpt,
                                       o.adaptivityOpt, o.maxStepOpt}) {
+        if (!option) continue;
         for (const std::string& value : option->results()) {
             errno = 0;
             const double parsed = std::strtod(value.c_str(), nullptr);
+            // --max-step 1e400 is +inf, which means no cap, as "inf" does.
+            if (option == o.maxStepOpt && parsed > 0.0) continue;
             if (errno == ERANGE && (parsed == 0.0 || std::isinf(parsed))) {
                 throw UsageError(option->get_name() + " " + value + " lies outside double's range (it reads as " +
-                                 (parsed == 0.0 ? "0" : "infinity") + ")");
+                                 (parsed == 0.0 ? "0" : parsed > 0.0 ? "infinity" : "-infinity") + ")");
             }
         }
     }
