@@ -53,7 +53,8 @@ plyColumns(const std::string& base, int components)
 // the normals gave a PLY with two properties "nx", which readers resolve either way.
 std::vector<std::string>
 uniqueNames(const std::vector<NamedAttribute>& attributes, std::string (*word)(const std::string&),
-            const ColumnsOf& columnsOf, const IsReserved& isReserved)
+            const ColumnsOf& columnsOf, const IsReserved& isReserved,
+            const ComponentOf& componentOf)
 {
     std::set<std::string> taken;
     std::vector<std::string> names(attributes.size());
@@ -85,6 +86,37 @@ uniqueNames(const std::vector<NamedAttribute>& attributes, std::string (*word)(c
                 name = base + "_" + std::to_string(suffix);
             }
             names[i] = name;
+        }
+    }
+    // Scalars named like one vector's columns in a row came back from PLY and CSV as that
+    // vector (format round-trip hunt: n_x, n_y, n_z as 'n'). The reader joins a run that
+    // starts at component 0; the scalar that would continue one gets a suffix.
+    if (componentOf) {
+        std::string runBase;
+        int runNext = -1;  // the component that would continue the run; -1: no run
+        for (size_t i = 0; i < attributes.size(); ++i) {
+            if (attributes[i].second != 1) {
+                runNext = -1;  // a vector's own columns; its next spellings are claimed above
+                continue;
+            }
+            std::string base;
+            int component = componentOf(names[i], base);
+            if (component > 0 && component == runNext && base == runBase) {
+                for (int suffix = 2;; ++suffix) {
+                    const std::string candidate = names[i] + "_" + std::to_string(suffix);
+                    if (!isReserved(candidate) && taken.insert(candidate).second) {
+                        names[i] = candidate;
+                        break;
+                    }
+                }
+                component = componentOf(names[i], base);  // n_y_2: component 2 of n_y
+            }
+            if (component == 0) {
+                runBase = base;
+                runNext = 1;
+            } else {
+                runNext = -1;
+            }
         }
     }
     return names;

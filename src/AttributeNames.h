@@ -25,6 +25,10 @@ using ColumnsOf = std::function<std::vector<std::string>(const std::string& base
 /// Whether a column name is the format's own (positions, normals) and cannot be taken.
 using IsReserved = std::function<bool(const std::string& column)>;
 
+/// The component a column name spells to the format's reader (setting @a base), or -1:
+/// io_internal::suffixComponentOf() for PLY, tableComponentOf() for CSV.
+using ComponentOf = std::function<int(const std::string& column, std::string& base)>;
+
 /// An attribute name as one header word (PLY, VTK, VTU, CSV): whitespace, control and
 /// non-ASCII bytes, ',', '"', '<', '>' and '&' become '_'; an empty name is "attribute".
 std::string headerWord(const std::string& name);
@@ -47,10 +51,13 @@ std::vector<std::string> plyColumns(const std::string& base, int components);
 /// columns also claims its bare name and its next component's spellings (name_N, name:N,
 /// name[N] for N components), so that no other column joins its run on reading back: a
 /// scalar "a_2" beside a 2-component "a" is written as "a_2_2".
+/// With @a componentOf, scalars named like the columns of one vector in a row (n_x, n_y,
+/// n_z; b_0, b_1), which the reader would join into that vector, are kept apart: the
+/// first that would continue such a run gets _2 (n_x, n_y_2, n_z).
 /// Cost: O(A log A) set operations for A attributes (times their columns).
 std::vector<std::string> uniqueNames(const std::vector<NamedAttribute>& attributes,
                                      std::string (*word)(const std::string&), const ColumnsOf& columnsOf,
-                                     const IsReserved& isReserved);
+                                     const IsReserved& isReserved, const ComponentOf& componentOf = nullptr);
 
 } // namespace attribute_names_internal
 } // namespace nonbloppy

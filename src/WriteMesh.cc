@@ -331,7 +331,7 @@ attributeNamesFor(const SurfaceMesh& mesh, const std::string& ext)
         return uniqueNames(attributes, headerWord, plyColumns, [withNormals](const std::string& column) {
             return column == "x" || column == "y" || column == "z"
                 || (withNormals && (column == "nx" || column == "ny" || column == "nz"));
-        });
+        }, io_internal::suffixComponentOf);
     }
     if (ext == ".vtk") {
         return uniqueNames(attributes, headerWord, wholeColumn,

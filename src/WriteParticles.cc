@@ -100,7 +100,7 @@ namesForExtension(const ParticleSet& particles, const std::string& ext)
     std::vector<NamedAttribute> attributes;
     for (const ParticleAttribute& a : particles.attributes) attributes.emplace_back(a.name, a.components);
     using attribute_names_internal::uniqueNames;
-    if (ext == ".ply") return uniqueNames(attributes, headerWord, plyColumns, isPositionName);
+    if (ext == ".ply") return uniqueNames(attributes, headerWord, plyColumns, isPositionName, io_internal::suffixComponentOf);
     if (ext == ".vtk") {
         // A FIELD array line "metadata ..." reads as the METADATA block keyword (any case):
         // the file came back unreadable (bug hunt).
@@ -109,7 +109,7 @@ namesForExtension(const ParticleSet& particles, const std::string& ext)
         });
     }
     if (ext == ".vtu") return uniqueNames(attributes, headerWord, wholeColumn, isPositionName);
-    if (ext == ".csv") return uniqueNames(attributes, headerWord, csvColumns, isCsvPositionName);
+    if (ext == ".csv") return uniqueNames(attributes, headerWord, csvColumns, isCsvPositionName, io_internal::tableComponentOf);
     if (ext == ".vdb") return uniqueNames(attributes, vdbWord, vdbColumns, isPositionName);
     return std::vector<std::string>(particles.attributes.size());
 }
