@@ -128,14 +128,14 @@ void runSurfaceStages(const ParticleIndex& index, const SurfaceParameters& param
         }
     }
     if (wholeGrid) {
-        // Seam vertices that only their cells tell apart, found after leaves were freed:
-        // the grid again (the partial one freed first), meshed whole (uninterruptible, as
-        // regionLeaves = 0 is).
+        // Seam vertices that only their cells tell apart, found after leaves were freed
+        // (so keepDensity is false): the grid again (the partial one freed first), meshed
+        // whole (uninterruptible, as regionLeaves = 0 is), and freed.
         result.density.reset();
         rasterize();
         StageScope scope(result.timings, interrupter, "extract surface");
         extractSurfaceInto(*result.density, p.threshold, p.adaptivity, 0, result.mesh, interrupter);
-        if (!params.keepDensity) result.density.reset();
+        result.density.reset();
         checkCancelled(interrupter, "extract surface");
     }
     {

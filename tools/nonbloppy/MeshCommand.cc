@@ -294,23 +294,21 @@ void validateParameters(const MeshOptions& o)
 {
     if (o.vdbOpt->count() > 0) requireFileName(o.vdbPath, "--vdb");
     checkAttributeList(o.outputs);
-    // CLI11 reads an empty value ('--blend ""') as 0 without a word.
+    // CLI11 reads an empty value ('--blend ""') as 0 without a word, and a real one past
+    // double's range, 1e-400 or 1e400, as 0 or inf, which the range checks then answered
+    // with "--spacing must be > 0, got 0": say what the text was.
+    const std::vector<const CLI::Option*> integerOptions = {o.iterationsOpt, o.regionLeavesOpt, o.threadsOpt,
+                                                            o.frameJobsOpt};
     for (const CLI::Option* option : {o.spacingOpt, o.radiusOpt, o.thresholdOpt, o.voxelSizeOpt, o.blendOpt,
                                       o.iterationsOpt, o.adaptivityOpt, o.regionLeavesOpt, o.threadsOpt,
                                       o.frameJobsOpt, o.maxStepOpt}) {
         if (!option) continue;
+        const bool real = std::find(integerOptions.begin(), integerOptions.end(), option) == integerOptions.end();
         for (const std::string& value : option->results()) {
             if (value.find_first_not_of(" \t") == std::string::npos) {
                 throw UsageError(option->get_name() + " needs a number, got ''");
             }
-        }
-    }
-    // CLI11 reads 1e-400 as 0 and 1e400 as inf, which the range checks then answered with
-    // "--spacing must be > 0, got 0": say what the text was.
-    for (const CLI::Option* option : {o.spacingOpt, o.radiusOpt, o.thresholdOpt, o.voxelSizeOpt, o.blendOpt,
-                                      o.adaptivityOpt, o.maxStepOpt}) {
-        if (!option) continue;
-        for (const std::string& value : option->results()) {
+            if (!real) continue;
             errno = 0;
             const double parsed = std::strtod(value.c_str(), nullptr);
             // --max-step 1e400 is +inf, which means no cap, as "inf" does.
