@@ -8,17 +8,34 @@
 namespace nonbloppy {
 namespace attribute_names_internal {
 
+namespace {
+
+/// headerWord() of @a name, keeping ',' and '"' if @a quoted (a CSV field in quotes).
 std::string
-headerWord(const std::string& name)
+wordOf(const std::string& name, bool quoted)
 {
     std::string word = name.empty() ? std::string("attribute") : name;
     for (char& ch : word) {
         if (static_cast<unsigned char>(ch) <= ' ' || static_cast<unsigned char>(ch) >= 0x7f
-            || ch == ',' || ch == '"' || ch == '<' || ch == '>' || ch == '&') {
+            || (!quoted && (ch == ',' || ch == '"')) || ch == '<' || ch == '>' || ch == '&') {
             ch = '_';
         }
     }
     return word;
+}
+
+} // namespace
+
+std::string
+headerWord(const std::string& name)
+{
+    return wordOf(name, /*quoted=*/false);
+}
+
+std::string
+csvWord(const std::string& name)
+{
+    return wordOf(name, /*quoted=*/true);
 }
 
 std::string

@@ -33,6 +33,10 @@ using ComponentOf = std::function<int(const std::string& column, std::string& ba
 /// non-ASCII bytes, ',', '"', '<', '>' and '&' become '_'; an empty name is "attribute".
 std::string headerWord(const std::string& name);
 
+/// An attribute name as one CSV header field: headerWord() but for ',' and '"', which
+/// writeCsv() quotes (RFC 4180) instead; they came back as '_' before.
+std::string csvWord(const std::string& name);
+
 /// An attribute name in OpenVDB's alphabet (letters, digits, '_', '|', ':'), which
 /// appendAttribute() enforces by throwing; an empty name is "attribute".
 std::string vdbWord(const std::string& name);

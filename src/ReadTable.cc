@@ -6,8 +6,9 @@
 /// blank lines; the first other line names the columns, separated by ',' or ';' or tabs or
 /// spaces (the first of these found
 /// in the header is the separator), names and values optionally quoted (a separator inside
-/// double quotes is no separator). A column without a name (the row numbers pandas and R
-/// write first) is left out and listed in ParticleSet::skipped. Positions are the columns
+/// double quotes is no separator; a quote inside them is doubled, RFC 4180). A column
+/// without a name (the row numbers pandas and R write first) is left out and listed in
+/// ParticleSet::skipped. Positions are the columns
 /// x, y, z (any case), or ParaView's `Points:0..2`, or `<name>_x/_y/_z` with name
 /// position, pos or p. Every other column is an attribute; consecutive columns
 /// `<name>:0,:1,...` (ParaView; up to 100), `<name>[0],[1],...`, `<name>_x,_y,_z` or
@@ -44,20 +45,46 @@ namespace io_internal {
 namespace {
 
 
+/// @a text without the spaces, tabs and '\r' around it.
 std::string_view
-trimmed(std::string_view text)
+unpadded(std::string_view text)
 {
     while (!text.empty() && (text.front() == ' ' || text.front() == '\t' || text.front() == '\r')) text.remove_prefix(1);
     while (!text.empty() && (text.back() == ' ' || text.back() == '\t' || text.back() == '\r')) text.remove_suffix(1);
+    return text;
+}
+
+std::string_view
+trimmed(std::string_view text)
+{
+    text = unpadded(text);
     if (text.size() >= 2 && (text.front() == '"' || text.front() == '\'') && text.back() == text.front()) {
         text = text.substr(1, text.size() - 2);
     }
     return text;
 }
 
-/// Split @a line at @a separator (' ' means runs of spaces and tabs).
+/// The name a header field gives its column: trimmed(), but inside double quotes as RFC 4180
+/// has it, a doubled quote being one ("e""f" names e"f, as writeCsv() writes it; the name
+/// kept both) and single quotes part of the name ("'s'" names 's'); only spaces around it
+/// go. @a field is as splitLine(..., /*trimFields=*/false) gives it.
+std::string
+columnName(std::string_view field)
+{
+    const std::string_view text = unpadded(field);
+    if (text.size() < 2 || text.front() != '"' || text.back() != '"') return std::string(trimmed(trimmed(text)));
+    std::string name;
+    for (size_t i = 1; i + 1 < text.size(); ++i) {
+        name += text[i];
+        if (text[i] == '"' && text[i + 1] == '"') ++i;
+    }
+    return std::string(unpadded(name));
+}
+
+/// Split @a line at @a separator (' ' means runs of spaces and tabs); each field trimmed()
+/// unless @a trimFields is false (the header, whose names columnName() unquotes).
 void
-splitLine(std::string_view line, char separator, std::vector<std::string_view>& fields)
+splitLine(std::string_view line, char separator, std::vector<std::string_view>& fields, bool trimFields = true)
 {
     fields.clear();
     if (separator == ' ') {
@@ -86,7 +113,8 @@ splitLine(std::string_view line, char separator, std::vector<std::string_view>& 
         } else {
             end = line.find(separator, start);
         }
-        fields.push_back(trimmed(line.substr(start, end == std::string_view::npos ? end : end - start)));
+        const std::string_view field = line.substr(start, end == std::string_view::npos ? end : end - start);
+        fields.push_back(trimFields ? trimmed(field) : field);
         if (end == std::string_view::npos) break;
         start = end + 1;
     }
@@ -171,14 +199,14 @@ parseTable(StreamReader& in, const std::string& path)
         }
     }
     std::vector<std::string_view> fields;
-    splitLine(header, separator, fields);
+    splitLine(header, separator, fields, /*trimFields=*/false);
 
     // Map the columns to positions and attributes (vectors as groupColumns() forms them).
     std::vector<Column> columns(fields.size());
     std::vector<AttributeColumn> attributeColumns;
     int axisColumn[3] = {-1, -1, -1};
     for (size_t i = 0; i < fields.size(); ++i) {
-        const std::string name(trimmed(fields[i]));
+        const std::string name = columnName(fields[i]);
         if (name.empty()) {
             columns[i] = {kUnnamed, 0};
             continue;

@@ -39,6 +39,7 @@ namespace nonbloppy {
 
 namespace {
 
+using attribute_names_internal::csvWord;
 using attribute_names_internal::headerWord;
 using attribute_names_internal::NamedAttribute;
 using attribute_names_internal::plyColumns;
@@ -109,7 +110,7 @@ namesForExtension(const ParticleSet& particles, const std::string& ext)
         });
     }
     if (ext == ".vtu") return uniqueNames(attributes, headerWord, wholeColumn, isPositionName);
-    if (ext == ".csv") return uniqueNames(attributes, headerWord, csvColumns, isCsvPositionName, io_internal::tableComponentOf);
+    if (ext == ".csv") return uniqueNames(attributes, csvWord, csvColumns, isCsvPositionName, io_internal::tableComponentOf);
     if (ext == ".vdb") return uniqueNames(attributes, vdbWord, vdbColumns, isPositionName);
     return std::vector<std::string>(particles.attributes.size());
 }
@@ -340,13 +341,26 @@ appendNumber(std::string& out, const ParticleAttribute& a, size_t n, int c)
     }
 }
 
+/// @a column as a CSV header field: in double quotes, each quote in it doubled (RFC 4180), if
+/// it holds ',' or a quote; the reader strips single quotes around an unquoted name.
+std::string
+csvField(const std::string& column)
+{
+    if (column.find_first_of(",\"'") == std::string::npos) return column;
+    std::string field = "\"";
+    for (const char ch : column) field += ch == '"' ? std::string("\"\"") : std::string(1, ch);
+    return field + "\"";
+}
+
 void
 writeCsv(const ParticleSet& particles, std::ostream& os)
 {
     std::string out = "x,y,z";
     const std::vector<std::string> names = namesForExtension(particles, ".csv");
     for (size_t i = 0; i < particles.attributes.size(); ++i) {
-        for (const std::string& column : csvColumns(names[i], particles.attributes[i].components)) out += "," + column;
+        for (const std::string& column : csvColumns(names[i], particles.attributes[i].components)) {
+            out += "," + csvField(column);
+        }
     }
     out += "\n";
     char buffer[64];

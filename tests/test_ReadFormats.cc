@@ -553,6 +553,32 @@ TEST_F(ReadFormatsTest, CsvFromPandasAndRWithTheirRowNumbersAndQuotes)
     EXPECT_EQ(fileErrorOf(semicolons), "bad number '1,5' on line 2 (" + semicolons + ")");
 }
 
+TEST_F(ReadFormatsTest, CsvNamesWithQuotesAndCommasRoundTripExactly)
+{
+    // A doubled quote inside a quoted name (RFC 4180: "e""f" names e"f) stayed doubled, and
+    // the writer gave a name's '"' and ',' as '_' (renamed, with a warning) where quoting
+    // the name keeps it (format round-trip hunt).
+    const ParticleSet read = readParticles(write("quoted.csv", "x,y,z,\"e\"\"f\",\"a,b\",\"\"\"\"\n0,0,0,1,2,3\n"));
+    std::vector<std::string> names;
+    for (const ParticleAttribute& a : read.attributes) names.push_back(a.name);
+    EXPECT_EQ(names, (std::vector<std::string>{"e\"f", "a,b", "\""}));
+
+    ParticleSet particles;
+    particles.positions = {openvdb::Vec3f(0.0f), openvdb::Vec3f(1.0f, 2.0f, 3.0f)};
+    const std::vector<std::string> awkward = {"e\"f", "a,b", "\"q\"", "'s'", "\"", "c,\"d\"", "v,\"w\""};
+    for (size_t i = 0; i + 1 < awkward.size(); ++i) {
+        particles.attributes.push_back(ParticleAttribute::of(awkward[i], 1, std::vector<double>{0.5 + double(i), -1.0}));
+    }
+    particles.attributes.push_back(ParticleAttribute::of(awkward.back(), 3, std::vector<double>{1, 2, 3, 4, 5, 6}));
+    const std::string file = path("awkward.csv");
+    EXPECT_EQ(nonbloppy::writtenAttributeNames(particles, file), awkward);
+    nonbloppy::writeParticles(particles, file);
+    const std::string header = "x,y,z,\"e\"\"f\",\"a,b\",\"\"\"q\"\"\",\"'s'\",\"\"\"\",\"c,\"\"d\"\"\","
+                               "\"v,\"\"w\"\":0\",\"v,\"\"w\"\":1\",\"v,\"\"w\"\":2\"\n";
+    EXPECT_EQ(readBytes(file).substr(0, header.size()), header);
+    expectSameParticles(readParticles(file), particles);
+}
+
 TEST_F(ReadFormatsTest, CsvComponentSpellingsFormVectorsOnlyWhenTheyAreOne)
 {
     // speed_x alone is a scalar of that name (it was read as a 1-component "speed", so a

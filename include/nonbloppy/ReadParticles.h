@@ -37,7 +37,8 @@
 ///           plus any others; consecutive `name:0, name:1, ...` (up to 100), `name[0], ...`,
 ///           `name_x/_y/_z` or `name.x/.y/.z` form a vector `name` unless a column is itself
 ///           called `name`; a lone `name_x` keeps its name; `name_0` is a scalar),
-///           separated by ',', ';', tabs or spaces, names and values optionally quoted;
+///           separated by ',', ';', tabs or spaces, names and values optionally quoted
+///           (in double quotes a doubled quote is one: `"e""f"` names `e"f`, RFC 4180);
 ///           a column without a name (pandas' and R's row numbers) is left out and listed in
 ///           ParticleSet::skipped; attributes are int64 if every value is an integer that
 ///           fits, uint64 if none is negative and some pass int64, else float64.

@@ -35,12 +35,14 @@ struct ParticleWriteSettings
 /// - `.vtu`  VTK XML UnstructuredGrid, raw appended data with UInt64 headers, Float32
 ///           points, vertex cells, attributes in their types.
 /// - `.xyz`  raw little-endian float32 triples (attributes cannot be stored: dropped).
-/// - `.csv`  header "x,y,z,<name>" (multi-component: "<name>:0,<name>:1,...", as ParaView),
+/// - `.csv`  header "x,y,z,<name>" (multi-component: "<name>:0,<name>:1,...", as ParaView;
+///           a name holding ',' or a quote in double quotes, a '"' in it doubled: RFC 4180),
 ///           shortest round-trip decimal text (whole float attribute values as "300.0", so
 ///           that they read back as floats, not integers; positions are always floats).
 /// - `.vdb`  one PointDataGrid named "points" (see makePointDataGrid()).
 /// Attribute names are written in the format's alphabet (spaces, commas, quotes, <, >, &
-/// and non-ASCII bytes become '_'; for `.vdb` all but letters, digits, '_', '|' and ':'),
+/// and non-ASCII bytes become '_', but for commas and quotes in CSV; for `.vdb` all but
+/// letters, digits, '_', '|' and ':'),
 /// and kept distinct: a name that would repeat another column, or that the format's
 /// reader takes for positions (x, y, z, P; in CSV also X, Points:0, p_y, ...), gets _2,
 /// _3, ...; names that need no change keep theirs ("a b" beside "a_b" is "a_b_2").
