@@ -35,7 +35,9 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
+#include <iterator>
 #include <string_view>
 #include <unordered_set>
 
@@ -242,10 +244,13 @@ parseTable(StreamReader& in, const std::string& path)
     // exact); as uint64 once one passes int64 if none was negative (the bytes of the values
     // before are the same: a CSV of uint64 ids came back rounded, bug hunt); then as float64
     // from the first that fits neither, the integers before it converted.
+    // A "-0" is the integer 0 there, and -0.0 once the attribute turns float64 (it came back
+    // +0.0, format round-trip hunt): where each lies is kept for that.
     ParticleSet particles;
     particles.attributes.resize(names.size());
     std::vector<ScalarType> kinds(names.size(), ScalarType::Int64);
     std::vector<bool> negative(names.size(), false);
+    std::vector<std::vector<size_t>> minusZeroAt(names.size());  // byte offsets
     const uint64_t dataStart = in.pos();
     std::string_view line;
     while (nextLine(line)) {
@@ -265,6 +270,7 @@ parseTable(StreamReader& in, const std::string& path)
                 uint64_t large;
                 if (kinds[a] == ScalarType::Int64 && io_internal::parseWhole(field, whole)) {
                     negative[a] = negative[a] || whole < 0;
+                    if (whole == 0 && field.front() == '-') minusZeroAt[a].push_back(particles.attributes[a].bytes.size());
                     appendBytes(particles.attributes[a].bytes, whole);
                     continue;
                 }
@@ -293,6 +299,9 @@ parseTable(StreamReader& in, const std::string& path)
                     const double converted = kind == ScalarType::Int64 ? double(signedValue) : double(unsignedValue);
                     std::memcpy(bytes.data() + at, &converted, 8);
                 }
+                const double minusZero = -0.0;
+                for (const size_t at : minusZeroAt[size_t(attribute)]) std::memcpy(bytes.data() + at, &minusZero, 8);
+                minusZeroAt[size_t(attribute)].clear();
                 kind = ScalarType::Float64;
             }
             appendBytes(bytes, value);
@@ -336,6 +345,34 @@ readTableFile(const std::string& path)
 
 namespace {
 
+/// StreamReader::CharIterator that keeps the last three characters passed in *@a recent
+/// (the latest in the low byte), for JsonPointsHandler::number_integer().
+class RecentCharIterator
+{
+public:
+    using iterator_category = std::input_iterator_tag;
+    using value_type = char;
+    using difference_type = std::ptrdiff_t;
+    using pointer = const char*;
+    using reference = const char&;
+
+    RecentCharIterator() = default;
+    RecentCharIterator(StreamReader& reader, uint32_t& recent) : mChars(reader), mRecent(&recent) {}
+    const char& operator*() const { return *mChars; }
+    RecentCharIterator& operator++()
+    {
+        *mRecent = ((*mRecent << 8) | static_cast<unsigned char>(*mChars)) & 0xffffff;
+        ++mChars;
+        return *this;
+    }
+    bool operator==(const RecentCharIterator& other) const { return mChars == other.mChars; }
+    bool operator!=(const RecentCharIterator& other) const { return !(*this == other); }
+
+private:
+    StreamReader::CharIterator mChars;
+    uint32_t* mRecent = nullptr;
+};
+
 /// SAX handler for `[[x,y,z], ...]`: nothing but numbers two levels deep, three per inner
 /// array; no DOM is built, so memory is the particles only.
 class JsonPointsHandler : public nlohmann::json_sax<nlohmann::json>
@@ -345,6 +382,7 @@ public:
 
     std::vector<openvdb::Vec3f> positions;
     std::string error;
+    uint32_t recentChars = 0;  ///< RecentCharIterator's
 
     bool number(double value)
     {
@@ -355,7 +393,14 @@ public:
     }
     bool null() override { return reject("null where a coordinate was expected"); }
     bool boolean(bool) override { return reject("boolean where a coordinate was expected"); }
-    bool number_integer(number_integer_t value) override { return number(double(value)); }
+    bool number_integer(number_integer_t value) override
+    {
+        // nlohmann hands "-0" over as the integer 0, its text gone: a coordinate -0 came back
+        // +0 while -0.0 kept its sign (format round-trip hunt). The parser has read the
+        // number and the one character after it; a 0 with '-' before it was "-0".
+        const bool minusZero = value == 0 && (recentChars >> 8) == ((uint32_t('-') << 8) | uint32_t('0'));
+        return number(minusZero ? -0.0 : double(value));
+    }
     bool number_unsigned(number_unsigned_t value) override { return number(double(value)); }
     bool number_float(number_float_t value, const string_t&) override { return number(value); }
     bool string(string_t&) override { return reject("string where a coordinate was expected"); }
@@ -414,7 +459,7 @@ ParticleSet
 readJson(StreamReader& in, const std::string& path)
 {
     JsonPointsHandler handler(in, path);
-    const bool ok = nlohmann::json::sax_parse(StreamReader::CharIterator(in), StreamReader::CharIterator(),
+    const bool ok = nlohmann::json::sax_parse(RecentCharIterator(in, handler.recentChars), RecentCharIterator(),
                                               &handler, nlohmann::json::input_format_t::json, true);
     if (!ok || !handler.error.empty()) {
         fail(path, "bad JSON particle list: " + (handler.error.empty() ? "parse error" : handler.error));

@@ -671,6 +671,40 @@ TEST_F(ReadFormatsTest, JsonPointList)
         << fileErrorOf(cut);
 }
 
+TEST_F(ReadFormatsTest, MinusZeroKeepsItsSignInJsonAndCsv)
+{
+    // nlohmann's SAX parser hands the integer -0 to number_integer() as 0, its text gone: a
+    // JSON coordinate -0 came back +0 while -0.0 kept its sign (format round-trip hunt). A
+    // CSV column's "-0" lost its sign alike when a later value made the column float; a
+    // column that stays integer holds 0, there being no integer -0.
+    const ParticleSet json = readParticles(write("zero.json", "[[-0, 0, -0.0], [0,-0e0,-0\n], [-0,-0,-0]]"));
+    ASSERT_EQ(json.size(), 3u);
+    const bool negative[3][3] = {{true, false, true}, {false, true, true}, {true, true, true}};
+    for (size_t n = 0; n < 3; ++n) {
+        for (int a = 0; a < 3; ++a) {
+            EXPECT_EQ(json.positions[n][a], 0.0f) << n << " " << a;
+            EXPECT_EQ(std::signbit(json.positions[n][a]), negative[n][a]) << n << " " << a;
+        }
+    }
+
+    const ParticleSet csv = readParticles(write("zero.csv", "x,y,z,turned,whole\n-0,0,0,-0,-0\n0,-0,-0,0.5,0\n"));
+    ASSERT_EQ(csv.size(), 2u);
+    EXPECT_TRUE(std::signbit(csv.positions[0][0]));
+    EXPECT_FALSE(std::signbit(csv.positions[0][1]));
+    EXPECT_TRUE(std::signbit(csv.positions[1][1]));
+    const ParticleAttribute& turned = attribute(csv, "turned");
+    ASSERT_EQ(turned.type, ScalarType::Float64);
+    EXPECT_EQ(turned.asDouble(0), 0.0);
+    EXPECT_TRUE(std::signbit(turned.asDouble(0)));
+    EXPECT_EQ(turned.asDouble(1), 0.5);
+    const ParticleAttribute& whole = attribute(csv, "whole");
+    ASSERT_EQ(whole.type, ScalarType::Int64);
+    int64_t values[2];
+    std::memcpy(values, whole.bytes.data(), sizeof(values));
+    EXPECT_EQ(values[0], 0);
+    EXPECT_EQ(values[1], 0);
+}
+
 // ---------------------------------------------------------------------------------------
 // VDB points
 
