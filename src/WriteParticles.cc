@@ -19,6 +19,7 @@
 #pragma GCC visibility push(default)
 #include <openvdb/points/PointConversion.h>
 #include <openvdb/points/PointDataGrid.h>
+#include <openvdb/tree/LeafManager.h>
 #pragma GCC visibility pop
 
 #include <algorithm>
@@ -389,15 +390,34 @@ writeCsv(const ParticleSet& particles, std::ostream& os)
 using PointDataGrid = openvdb::points::PointDataGrid;
 using PointIndexGrid = openvdb::tools::PointIndexGrid;
 
+/// Appends the attribute @a name holding @a values (one per particle, in the order
+/// @a index's leaves list them) to every leaf of @a grid, as openvdb::points::
+/// populateAttribute() does, but a leaf's array is made uniform (one value stored) only
+/// when its values are the same bits: populateAttribute() compacts it when they compare
+/// equal, as 0.0 and -0.0 do, and the zeros of a leaf came back with the first one's sign
+/// (format round-trip hunt).
 template<typename ValueT>
 void
 addVdbAttribute(PointDataGrid& grid, const PointIndexGrid& index, const std::string& name,
                 const std::vector<ValueT>& values)
 {
     openvdb::points::appendAttribute<ValueT>(grid.tree(), name);
-    openvdb::points::populateAttribute<openvdb::points::PointDataTree, openvdb::tools::PointIndexTree,
-        openvdb::points::PointAttributeVector<ValueT>>(grid.tree(), index.tree(), name,
-            openvdb::points::PointAttributeVector<ValueT>(values));
+    openvdb::tree::LeafManager<openvdb::points::PointDataTree> leaves(grid.tree());
+    leaves.foreach([&](openvdb::points::PointDataTree::LeafNodeType& leaf, size_t) {
+        const auto* indexLeaf = index.tree().probeConstLeaf(leaf.origin());
+        if (!indexLeaf || indexLeaf->indices().empty()) return;
+        const auto& indices = indexLeaf->indices();
+        openvdb::points::AttributeWriteHandle<ValueT> handle(leaf.attributeArray(name));
+        const ValueT& first = values[openvdb::Index64(indices.front())];
+        const bool sameBits = std::all_of(indices.begin(), indices.end(), [&](openvdb::Index64 i) {
+            return std::memcmp(&values[i], &first, sizeof(ValueT)) == 0;
+        });
+        if (sameBits) {
+            handle.collapse(first);
+            return;
+        }
+        for (size_t n = 0; n < indices.size(); ++n) handle.set(openvdb::Index(n), values[openvdb::Index64(indices[n])]);
+    });
 }
 
 template<typename ScalarT>

@@ -1083,6 +1083,39 @@ TEST_F(ReadFormatsTest, VdbWithoutPointsIsAClearError)
     EXPECT_EQ(fileErrorOf(junk).rfind("cannot read .vdb file: ", 0), 0u) << fileErrorOf(junk);
 }
 
+TEST_F(ReadFormatsTest, VdbAttributesKeepTheSignOfZero)
+{
+    // OpenVDB's populateAttribute() collapses a leaf's array to its first value when all
+    // values compare equal (==), as 0.0 and -0.0 do: the zeros came back with the first
+    // one's sign (format round-trip hunt).
+    ParticleSet particles;
+    particles.positions = {openvdb::Vec3f(0.0f), openvdb::Vec3f(0.25f, 0.0f, 0.0f)};  // one leaf
+    particles.attributes.push_back(ParticleAttribute::of("f", 1, std::vector<float>{0.0f, -0.0f}));
+    particles.attributes.push_back(ParticleAttribute::of("d", 1, std::vector<double>{-0.0, 0.0}));
+    particles.attributes.push_back(ParticleAttribute::of("negative", 1, std::vector<double>{-0.0, -0.0}));
+    particles.attributes.push_back(ParticleAttribute::of("v", 3, std::vector<float>{0.0f, -0.0f, 0.0f, -0.0f, 0.0f, -0.0f}));
+    particles.attributes.push_back(ParticleAttribute::of("q", 4, std::vector<float>{-0.0f, 0.0f, 0.0f, 0.0f,
+                                                                                     0.0f, 0.0f, 0.0f, -0.0f}));
+    const std::string file = path("zeros.vdb");
+    nonbloppy::writeParticles(particles, file);
+    const ParticleSet back = readParticles(file);
+    ASSERT_EQ(back.size(), 2u);
+    ASSERT_EQ(back.attributes.size(), particles.attributes.size());
+    for (size_t n = 0; n < 2; ++n) {
+        const size_t original = back.positions[n][0] > 0.1f ? 1 : 0;  // a .vdb may reorder them
+        for (size_t i = 0; i < particles.attributes.size(); ++i) {
+            const ParticleAttribute& written = particles.attributes[i];
+            const ParticleAttribute& read = back.attributes[i];
+            ASSERT_EQ(read.name, written.name);
+            ASSERT_EQ(read.type, written.type) << read.name;
+            ASSERT_EQ(read.components, written.components) << read.name;
+            const size_t bytes = size_t(written.components) * nonbloppy::scalarSize(written.type);
+            EXPECT_EQ(std::memcmp(read.bytes.data() + n * bytes, written.bytes.data() + original * bytes, bytes), 0)
+                << read.name << " of particle " << original;
+        }
+    }
+}
+
 } // namespace
 
 namespace {

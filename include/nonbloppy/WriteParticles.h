@@ -89,7 +89,7 @@ NONBLOPPY_API void requireParticleOutputFile(const std::string& path);
 /// components become vec3s, vec3d, vec3i for int8 to int32, uint8 and uint16, vec3d for
 /// uint32, int64 and uint64; scalar unsigned integers widen to the next signed type,
 /// uint64 to int64; other component counts become one scalar attribute per component,
-/// "name_<c>"). The grid
+/// "name_<c>"), its values bit for bit (-0.0 stays -0.0). The grid
 /// holds the particles in voxel order: readParticles() gives them back in that order.
 /// @a voxelSize ≤ 0 picks one with about 8 points per voxel (points::computeVoxelSize).
 /// A @a voxelSize far above the particles' extent keeps their positions to about
