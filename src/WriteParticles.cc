@@ -504,6 +504,14 @@ pointDataGridOfFinitePositions(const ParticleSet& particles, double voxelSize, d
     auto grid = openvdb::points::createPointDataGrid<openvdb::points::NullCodec, PointDataGrid>(
         *index, wrapper, *transform);
     grid->setName("points");
+    if (positions.empty() && !particles.attributes.empty()) {
+        // Attributes are described by the leaves only, and no particles make no leaf: those
+        // of an empty set were gone without a word (format round-trip hunt). One leaf of no
+        // points, initialised as createPointDataGrid() does each, carries them.
+        const auto descriptor = openvdb::points::AttributeSet::Descriptor::create(
+            openvdb::points::TypedAttributeArray<openvdb::Vec3f, openvdb::points::NullCodec>::attributeType());
+        grid->tree().touchLeaf(openvdb::Coord(0))->initializeAttributes(descriptor, 0);
+    }
     const std::vector<std::string> names = namesForExtension(particles, ".vdb");
     std::string split;  // the attributes written as scalars name_0, name_1, ...
     for (size_t i = 0; i < particles.attributes.size(); ++i) {

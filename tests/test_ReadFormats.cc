@@ -1116,6 +1116,28 @@ TEST_F(ReadFormatsTest, VdbAttributesKeepTheSignOfZero)
     }
 }
 
+TEST_F(ReadFormatsTest, AnEmptyVdbKeepsItsAttributes)
+{
+    // With no particles OpenVDB makes no leaf, and the attributes, which only the leaves
+    // describe, were gone without a word (format round-trip hunt).
+    ParticleSet empty;
+    empty.attributes.push_back(ParticleAttribute::of("temperature", 1, std::vector<float>{}));
+    empty.attributes.push_back(ParticleAttribute::of("v", 3, std::vector<double>{}));
+    empty.attributes.push_back(ParticleAttribute::of("id", 1, std::vector<int64_t>{}));
+    empty.attributes.push_back(ParticleAttribute::of("q", 4, std::vector<float>{}));
+    empty.attributes.push_back(ParticleAttribute::of("flag", 1, std::vector<int8_t>{}));
+    const std::string file = path("empty.vdb");
+    nonbloppy::writeParticles(empty, file);
+    const ParticleSet back = readParticles(file);
+    EXPECT_EQ(back.size(), 0u);
+    EXPECT_TRUE(back.skipped.empty());
+    expectSameParticles(back, empty);
+    // As makePointDataGrid() gives it to a caller too.
+    openvdb::GridBase::Ptr grid = nonbloppy::makePointDataGrid(empty);
+    nonbloppy::writeVdb({grid}, path("grid.vdb"));
+    expectSameParticles(readParticles(path("grid.vdb")), empty);
+}
+
 } // namespace
 
 namespace {

@@ -835,3 +835,22 @@ TEST_F(CliFormatsTest, APointsGridRefusesVoxelSizesThatWouldLoseThePositions)
     ASSERT_TRUE(grid);
     EXPECT_EQ(openvdb::points::pointCount(grid->tree()), 3u);
 }
+
+TEST_F(CliFormatsTest, AnEmptyParticleFileKeepsItsAttributesThroughAVdb)
+{
+    // Zero particles through .vdb lost their attributes without a word (format round-trip
+    // hunt): OpenVDB made no leaf, and only leaves describe attributes.
+    const std::string csv = path("empty.csv"), vdb = path("empty.vdb");
+    writeText(csv, "x,y,z,temperature,v:0,v:1,v:2\n");
+    RunResult r = run("convert " + quote(csv) + " " + quote(vdb));
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_EQ(r.err, "");
+    EXPECT_EQ(r.out, "converted 0 particles with 2 attributes: " + csv + " -> " + vdb + "\n");
+    r = run("convert -q " + quote(vdb) + " " + quote(path("back.csv")));
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_EQ(r.err, "");
+    EXPECT_EQ(readText(path("back.csv")), "x,y,z,temperature,v:0,v:1,v:2\n");
+    r = run("inspect " + quote(vdb));
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_NE(r.out.find("\n    points: 0; attributes: P vec3s, temperature int64, v vec3d\n"), std::string::npos) << r.out;
+}

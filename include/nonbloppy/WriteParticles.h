@@ -91,6 +91,8 @@ NONBLOPPY_API void requireParticleOutputFile(const std::string& path);
 /// uint64 to int64; other component counts become one scalar attribute per component,
 /// "name_<c>"), its values bit for bit (-0.0 stays -0.0). The grid
 /// holds the particles in voxel order: readParticles() gives them back in that order.
+/// No particles with attributes make one leaf of no points, which names them (OpenVDB
+/// describes attributes in its leaves only; readParticles() gives them back, empty).
 /// @a voxelSize ≤ 0 picks one with about 8 points per voxel (points::computeVoxelSize).
 /// A @a voxelSize far above the particles' extent keeps their positions to about
 /// voxelSize·6e-8 only (OpenVDB stores them as float offsets within their voxel).
