@@ -492,8 +492,17 @@ pointDataGridOfFinitePositions(const ParticleSet& particles, double voxelSize, d
     if (!(voxelSize > 0.0)) {
         // One particle has no spacing to size voxels by: 1, or coarser where it lies too far
         // out for 32-bit voxel coordinates at 1 (one particle 5e9 out was refused).
-        voxelSize = positions.size() > 1 ? double(openvdb::points::computeVoxelSize(wrapper, 8))
-                                         : std::max(1.0, 2.0 * largest / openvdb_scale_internal::kMaxIndexCoordinate);
+        const double chosen = positions.size() > 1
+                                  ? double(openvdb::points::computeVoxelSize(wrapper, 8))
+                                  : std::max(1.0, 2.0 * largest / openvdb_scale_internal::kMaxIndexCoordinate);
+        // A power of two: OpenVDB keeps a position as its voxel plus a float offset, and
+        // scales their sum by the voxel size. A float position divided by a power of two
+        // splits into voxel and offset exactly, and their sum scales back exactly; sizes like
+        // computeVoxelSize()'s 1.7457 rounded twice, and some positions came back one float
+        // step off (0.45 as 0.44999996; format round-trip hunt). The nearest power, or the one
+        // above where the one below would put particles past 32-bit voxel coordinates.
+        voxelSize = std::exp2(std::round(std::log2(chosen)));
+        if (voxelSize < chosen && largest / voxelSize > openvdb_scale_internal::kMaxIndexCoordinate) voxelSize *= 2.0;
     } else {
         openvdb_scale_internal::requireOpenVdbScale(voxelSize, kMinCellSize, "--voxel-size");
     }

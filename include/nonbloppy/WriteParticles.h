@@ -93,7 +93,10 @@ NONBLOPPY_API void requireParticleOutputFile(const std::string& path);
 /// holds the particles in voxel order: readParticles() gives them back in that order.
 /// No particles with attributes make one leaf of no points, which names them (OpenVDB
 /// describes attributes in its leaves only; readParticles() gives them back, empty).
-/// @a voxelSize ≤ 0 picks one with about 8 points per voxel (points::computeVoxelSize).
+/// @a voxelSize ≤ 0 picks one with about 8 points per voxel (points::computeVoxelSize),
+/// rounded to a power of two, which gives every position back bit for bit (but -0.0 as
+/// +0.0); another size may move some by a float step, as OpenVDB stores positions as float
+/// offsets within their voxel and scales their sum by the size.
 /// A @a voxelSize far above the particles' extent keeps their positions to about
 /// voxelSize·6e-8 only (OpenVDB stores them as float offsets within their voxel).
 /// @throw ParameterError for a NaN or infinite @a voxelSize or one below kMinCellSize, one
