@@ -541,7 +541,10 @@ bool extractByRegionImpl(const openvdb::FloatGrid& density, double threshold, Su
         const int bandBegin = bounds.min()[cross] + region.band.first * dim;
         const int bandEnd = bounds.min()[cross] + region.band.second * dim;
         openvdb::FloatGrid::Ptr regionGrid = openvdb::FloatGrid::create(tree.background());
-        regionGrid->setTransform(transform.copy());
+        // The grid's own transform, shared (only read): transform.copy() rebuilds a translated
+        // map from its matrix with a scale off in the last bits, which moved vertices by a
+        // float step from the whole grid's.
+        regionGrid->setTransform(std::const_pointer_cast<openvdb::math::Transform>(density.constTransformPtr()));
         regionGrid->setGridClass(density.getGridClass());
         openvdb::FloatTree& regionTree = regionGrid->tree();
         // The voxels a region keeps: kShellPlanes planes beyond each cut face, unbounded

@@ -154,6 +154,37 @@ TEST(ExtractByRegion, ResolvesAmbiguousFacesAtASeamAsTheWholeGridDoes)
     }
 }
 
+TEST(ExtractByRegion, GivesTheWholeGridsVertexBitsOnATranslatedGrid)
+{
+    // Each region's grid took transform.copy(), and OpenVDB rebuilds a translated map from
+    // its matrix: this grid's UniformScaleTranslateMap came back a ScaleTranslateMap whose x
+    // scale is 0.025000000000005684, so the regions placed vertices a few double steps off
+    // the whole grid's, and one float step off where that crossed a rounding boundary: 289 of
+    // these 706 vertices (differential hunt, random grids translated out to 1e6). The
+    // library's own grids have no translation (rasterizeDensity() takes a UniformScaleMap
+    // only, whose copy is exact); extractByRegion() accepts translated ones.
+    openvdb::FloatGrid::Ptr slab = openvdb::FloatGrid::create(0.0f);
+    openvdb::math::Transform::Ptr transform = openvdb::math::Transform::createLinearTransform(kVoxelSize);
+    transform->postTranslate(openvdb::Vec3d(100.0, 0.0, 0.0));
+    slab->setTransform(transform);
+    // A slab three voxels thick, 16 x 16 (four regions of one leaf), its crossings at dyadic
+    // fractions of a voxel.
+    const float past = 9.0f / 16384.0f;
+    auto accessor = slab->getAccessor();
+    for (int j = 0; j < 16; ++j)
+        for (int k = 0; k < 16; ++k) {
+            for (int i = 0; i <= 2; ++i) accessor.setValue(openvdb::Coord(i, j, k), 1.0f + past);
+            accessor.setValue(openvdb::Coord(3, j, k), past);
+        }
+    const SurfaceMesh whole = extractSurface(*slab, 1.0);
+    ASSERT_GT(whole.quads.size(), 500u);
+    SurfaceMesh regions;
+    extractByRegion(*slab, 1.0, regions, nullptr, 1, 1);
+    ASSERT_EQ(regions.points.size(), whole.points.size());
+    EXPECT_FALSE(regions.points == whole.points);  // meshed by region: another order
+    EXPECT_TRUE(canonicalQuads(regions) == canonicalQuads(whole));
+}
+
 TEST(ExtractByRegion, LeavesOutAndTilesLeavesNoCrossingTouchesWithoutChangingTheMesh)
 {
     // A solid block of particles: a deep interior (tiles after tileDeepInterior(), "above"
