@@ -37,7 +37,6 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
-#include <iterator>
 #include <string_view>
 #include <unordered_set>
 
@@ -345,34 +344,6 @@ readTableFile(const std::string& path)
 
 namespace {
 
-/// StreamReader::CharIterator that keeps the last three characters passed in *@a recent
-/// (the latest in the low byte), for JsonPointsHandler::number_integer().
-class RecentCharIterator
-{
-public:
-    using iterator_category = std::input_iterator_tag;
-    using value_type = char;
-    using difference_type = std::ptrdiff_t;
-    using pointer = const char*;
-    using reference = const char&;
-
-    RecentCharIterator() = default;
-    RecentCharIterator(StreamReader& reader, uint32_t& recent) : mChars(reader), mRecent(&recent) {}
-    const char& operator*() const { return *mChars; }
-    RecentCharIterator& operator++()
-    {
-        *mRecent = ((*mRecent << 8) | static_cast<unsigned char>(*mChars)) & 0xffffff;
-        ++mChars;
-        return *this;
-    }
-    bool operator==(const RecentCharIterator& other) const { return mChars == other.mChars; }
-    bool operator!=(const RecentCharIterator& other) const { return !(*this == other); }
-
-private:
-    StreamReader::CharIterator mChars;
-    uint32_t* mRecent = nullptr;
-};
-
 /// SAX handler for `[[x,y,z], ...]`: nothing but numbers two levels deep, three per inner
 /// array; no DOM is built, so memory is the particles only.
 class JsonPointsHandler : public nlohmann::json_sax<nlohmann::json>
@@ -382,7 +353,7 @@ public:
 
     std::vector<openvdb::Vec3f> positions;
     std::string error;
-    uint32_t recentChars = 0;  ///< RecentCharIterator's
+    uint32_t recentChars = 0;  ///< the last three bytes parsed (StreamReader::CharIterator)
 
     bool number(double value)
     {
@@ -459,7 +430,7 @@ ParticleSet
 readJson(StreamReader& in, const std::string& path)
 {
     JsonPointsHandler handler(in, path);
-    const bool ok = nlohmann::json::sax_parse(RecentCharIterator(in, handler.recentChars), RecentCharIterator(),
+    const bool ok = nlohmann::json::sax_parse(StreamReader::CharIterator(in, &handler.recentChars), StreamReader::CharIterator(),
                                               &handler, nlohmann::json::input_format_t::json, true);
     if (!ok || !handler.error.empty()) {
         fail(path, "bad JSON particle list: " + (handler.error.empty() ? "parse error" : handler.error));

@@ -22,6 +22,7 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <cstdint>
 #include <cstring>
 #include <iterator>
 #include <limits>
@@ -149,7 +150,8 @@ public:
     }
 
     /// An input iterator over the bytes (for nlohmann::json::sax_parse); a default-made one
-    /// is the end.
+    /// is the end. With @a recentChars, it keeps the last three bytes passed there (the
+    /// latest in the low byte): the JSON reader tells "-0" from "0" by them.
     class CharIterator
     {
     public:
@@ -160,10 +162,12 @@ public:
         using reference = const char&;
 
         CharIterator() = default;
-        explicit CharIterator(StreamReader& reader) : mReader(&reader) {}
+        explicit CharIterator(StreamReader& reader, uint32_t* recentChars = nullptr)
+            : mReader(&reader), mRecent(recentChars) {}
         const char& operator*() const { return *mReader->here(); }
         CharIterator& operator++()
         {
+            if (mRecent) *mRecent = ((*mRecent << 8) | static_cast<unsigned char>(*mReader->here())) & 0xffffff;
             ++mReader->mHead;
             return *this;
         }
@@ -176,6 +180,7 @@ public:
             return !mReader || (mReader->mHead == mReader->mTail && !mReader->ensure(1));
         }
         StreamReader* mReader = nullptr;
+        uint32_t* mRecent = nullptr;
     };
 
 private:
