@@ -73,6 +73,8 @@ std::string
 columnName(std::string_view field)
 {
     const std::string_view text = unpadded(field);
+    // Not in double quotes: trimmed twice, as before (splitLine() trimmed every field, and
+    // the header's names were trimmed again), so '"x"' still names x.
     if (text.size() < 2 || text.front() != '"' || text.back() != '"') return std::string(trimmed(trimmed(text)));
     std::string name;
     for (size_t i = 1; i + 1 < text.size(); ++i) {

@@ -95,10 +95,9 @@ NONBLOPPY_API void requireParticleOutputFile(const std::string& path);
 /// describes attributes in its leaves only; readParticles() gives them back, empty).
 /// @a voxelSize ≤ 0 picks one with about 8 points per voxel (points::computeVoxelSize),
 /// rounded to a power of two, which gives every position back bit for bit (but -0.0 as
-/// +0.0); another size may move some by a float step, as OpenVDB stores positions as float
-/// offsets within their voxel and scales their sum by the size.
-/// A @a voxelSize far above the particles' extent keeps their positions to about
-/// voxelSize·6e-8 only (OpenVDB stores them as float offsets within their voxel).
+/// +0.0). OpenVDB stores positions as float offsets within their voxel and scales their sum
+/// by the size: a given size that is not a power of two may move some by a float step, and
+/// one far above the particles' extent keeps them to about voxelSize·6e-8 only.
 /// @throw ParameterError for a NaN or infinite @a voxelSize or one below kMinCellSize, one
 ///        that puts a particle past 32-bit voxel coordinates ("particle coordinates up to
 ///        1e+09 are too far from the origin for a voxel size of 0.001 (32-bit index space)"), a uint64
