@@ -4,11 +4,12 @@
 ///        Only src/ and the tests include it.
 ///
 /// The library is built for the x86-64 baseline (SSE2), as Debian builds it. The inner
-/// loops of the rasterization and the relaxation also have a copy compiled for AVX2 (eight
-/// lanes in one register instead of two), taken when the CPU has AVX2. Both copies give the
-/// same bits, which keeps meshes identical across machines: each lane does the same IEEE
-/// additions, multiplications, divisions and square roots in the same order, and neither
-/// copy fuses a multiply-add (AVX2 alone does not enable FMA). tests/test_InstructionSet.cc
+/// loops of the rasterization, the relaxation and the smoothing's normal rounds also have a
+/// copy compiled for AVX2 (eight lanes in one register instead of two), taken when the CPU
+/// has AVX2. Both copies give the same bits, which keeps meshes identical across machines:
+/// each lane does the same IEEE additions, multiplications, divisions and square roots (and
+/// the smoothing's integer exponent arithmetic) in the same order, and neither copy fuses a
+/// multiply-add (AVX2 alone does not enable FMA). tests/test_InstructionSet.cc
 /// compares the two on a real frame.
 
 #ifndef NONBLOPPY_INSTRUCTION_SET_H
@@ -18,6 +19,7 @@
 #include <nonbloppy/ParticleIndex.h>
 #include <nonbloppy/RasterizeDensity.h>
 #include <nonbloppy/RelaxVertices.h>
+#include <nonbloppy/SmoothSurface.h>
 
 #include <openvdb/util/NullInterrupter.h>
 
@@ -62,6 +64,11 @@ openvdb::FloatGrid::Ptr rasterizeDensity(const ParticleIndex& particles, const D
 /// function passes Auto). Same checks, throws and thread-safety.
 void relaxVertices(SurfaceMesh& mesh, const ParticleIndex& particles, const RelaxSettings& settings,
                    openvdb::util::NullInterrupter* interrupter, InstructionSet set);
+
+/// smoothSurface() running the copy of its normal rounds' loop that @a set picks (the
+/// public function passes Auto). Same checks, throws and thread-safety.
+void smoothSurface(SurfaceMesh& mesh, const SmoothSettings& settings, openvdb::util::NullInterrupter* interrupter,
+                   InstructionSet set);
 
 } // namespace instruction_set_internal
 } // namespace nonbloppy

@@ -4,6 +4,8 @@
 #include <nonbloppy/Error.h>
 
 #include "Cancellation.h"
+#include "ExpNonPositive.h"
+#include "InstructionSet.h"
 #include "PolygonIndices.h"
 #include "SurfaceStages.h"
 #include "VectorArea.h"
@@ -16,6 +18,7 @@
 #include <cstdint>
 #include <sstream>
 #include <vector>
+
 
 namespace nonbloppy {
 
@@ -166,6 +169,122 @@ void measurePolygons(const Polygons& polygons, const std::vector<Vec3s>& points,
     poll.throwIfStopped();
 }
 
+
+/// One normal round: every polygon's filtered normal from the previous round's normals
+/// (see smoothSurface()). The same operations in the same order for every polygon, so the
+/// bits do not depend on the threads, the ranges, or which copy of the loop runs.
+struct NormalRoundOp
+{
+    const PolygonNeighbours& neighbours;
+    const std::vector<Vec3s>& normal;
+    std::vector<Vec3s>& filtered;
+    float normalScale;
+    CancelPoll& poll;
+    bool avx2;  ///< run the AVX2 copy of the loop (InstructionSet.h)
+
+    void operator()(const tbb::blocked_range<size_t>& range) const
+    {
+#if NONBLOPPY_HAS_AVX2_COPY
+        if (avx2) { filterAvx2(range); return; }
+#endif
+        for (size_t n = range.begin(); n < range.end(); ++n) {
+            if (poll.stoppedAt(n - range.begin())) return;
+            filterOne(n);
+        }
+    }
+
+    void filterOne(size_t n) const
+    {
+        const Vec3s own = normal[n];
+        float x = 0.0f, y = 0.0f, z = 0.0f;
+        for (uint64_t e = neighbours.start[n]; e < neighbours.start[n + 1]; ++e) {
+            const Vec3s other = normal[neighbours.polygon[e]];
+            const float dx = other[0] - own[0], dy = other[1] - own[1], dz = other[2] - own[2];
+            const float w = neighbours.weight[e] * exp_internal::expNonPositive(-normalScale * (dx * dx + dy * dy + dz * dz));
+            x += w * other[0];
+            y += w * other[1];
+            z += w * other[2];
+        }
+        const float length = std::sqrt(x * x + y * y + z * z);
+        filtered[n] = length > 0.0f ? Vec3s(x / length, y / length, z / length) : own;
+    }
+
+#if NONBLOPPY_HAS_AVX2_COPY
+    /// Eight polygons at a time, a lane each, their neighbours gathered; polygons left over,
+    /// and groups whose neighbour lists lie too far apart for 32-bit offsets, one by one.
+    NONBLOPPY_TARGET_AVX2 void filterAvx2(const tbb::blocked_range<size_t>& range) const
+    {
+        // Gathers take 32-bit offsets: a normal's three floats at 3·j.
+        const bool gatherable = normal.size() <= size_t(INT32_MAX / 3);
+        const uint32_t* polygonOf = neighbours.polygon.data();
+        const float* weightOf = neighbours.weight.data();
+        const float* normals = normal.empty() ? nullptr : normal[0].asPointer();
+        const __m256 negativeScale = _mm256_set1_ps(-normalScale);
+        size_t n = range.begin();
+        for (; gatherable && n + 8 <= range.end(); n += 8) {
+            if (poll.stoppedAt(n - range.begin())) return;  // a multiple of 8
+            const uint64_t first = neighbours.start[n];
+            if (neighbours.start[n + 8] - first > uint64_t(INT32_MAX)) {
+                for (size_t m = n; m < n + 8; ++m) filterOne(m);
+                continue;
+            }
+            alignas(32) int32_t offset[8], count[8];
+            alignas(32) float ownX[8], ownY[8], ownZ[8];
+            int32_t most = 0;
+            for (int l = 0; l < 8; ++l) {
+                offset[l] = int32_t(neighbours.start[n + size_t(l)] - first);
+                count[l] = int32_t(neighbours.start[n + size_t(l) + 1] - neighbours.start[n + size_t(l)]);
+                most = std::max(most, count[l]);
+                ownX[l] = normal[n + size_t(l)][0];
+                ownY[l] = normal[n + size_t(l)][1];
+                ownZ[l] = normal[n + size_t(l)][2];
+            }
+            const __m256 ox = _mm256_load_ps(ownX), oy = _mm256_load_ps(ownY), oz = _mm256_load_ps(ownZ);
+            const __m256i offsets = _mm256_load_si256(reinterpret_cast<const __m256i*>(offset));
+            const __m256i counts = _mm256_load_si256(reinterpret_cast<const __m256i*>(count));
+            const int* polygonBase = reinterpret_cast<const int*>(polygonOf + first);
+            const float* weightBase = weightOf + first;
+            __m256 x = _mm256_setzero_ps(), y = _mm256_setzero_ps(), z = _mm256_setzero_ps();
+            for (int32_t k = 0; k < most; ++k) {
+                const __m256i kk = _mm256_set1_epi32(k);
+                const __m256i activeBits = _mm256_cmpgt_epi32(counts, kk);  // k < count
+                const __m256 active = _mm256_castsi256_ps(activeBits);
+                const __m256i entry = _mm256_add_epi32(offsets, kk);
+                const __m256i other = _mm256_mask_i32gather_epi32(_mm256_setzero_si256(), polygonBase, entry, activeBits, 4);
+                const __m256 base = _mm256_mask_i32gather_ps(_mm256_setzero_ps(), weightBase, entry, active, 4);
+                const __m256i at = _mm256_add_epi32(_mm256_add_epi32(other, other), other);  // 3·j
+                const __m256 nx = _mm256_mask_i32gather_ps(_mm256_setzero_ps(), normals, at, active, 4);
+                const __m256 ny = _mm256_mask_i32gather_ps(_mm256_setzero_ps(), normals + 1, at, active, 4);
+                const __m256 nz = _mm256_mask_i32gather_ps(_mm256_setzero_ps(), normals + 2, at, active, 4);
+                const __m256 dx = _mm256_sub_ps(nx, ox), dy = _mm256_sub_ps(ny, oy), dz = _mm256_sub_ps(nz, oz);
+                const __m256 d2 = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(dx, dx), _mm256_mul_ps(dy, dy)),
+                                                _mm256_mul_ps(dz, dz));
+                const __m256 w = _mm256_mul_ps(base, exp_internal::expNonPositiveAvx2(_mm256_mul_ps(negativeScale, d2)));
+                // Lanes past their polygon's last neighbour keep their sums as they are.
+                x = _mm256_blendv_ps(x, _mm256_add_ps(x, _mm256_mul_ps(w, nx)), active);
+                y = _mm256_blendv_ps(y, _mm256_add_ps(y, _mm256_mul_ps(w, ny)), active);
+                z = _mm256_blendv_ps(z, _mm256_add_ps(z, _mm256_mul_ps(w, nz)), active);
+            }
+            const __m256 length = _mm256_sqrt_ps(
+                _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(x, x), _mm256_mul_ps(y, y)), _mm256_mul_ps(z, z)));
+            alignas(32) float sumX[8], sumY[8], sumZ[8], lengths[8];
+            _mm256_store_ps(sumX, _mm256_div_ps(x, length));
+            _mm256_store_ps(sumY, _mm256_div_ps(y, length));
+            _mm256_store_ps(sumZ, _mm256_div_ps(z, length));
+            _mm256_store_ps(lengths, length);
+            for (int l = 0; l < 8; ++l) {
+                filtered[n + size_t(l)] = lengths[l] > 0.0f ? Vec3s(sumX[l], sumY[l], sumZ[l])
+                                                            : normal[n + size_t(l)];
+            }
+        }
+        for (; n < range.end(); ++n) {
+            if (poll.stoppedAt(n - range.begin())) return;
+            filterOne(n);
+        }
+    }
+#endif
+};
+
 } // namespace
 
 void smoothSurface(SurfaceMesh& mesh, const SmoothSettings& settings, openvdb::util::NullInterrupter* interrupter)
@@ -174,8 +293,16 @@ void smoothSurface(SurfaceMesh& mesh, const SmoothSettings& settings, openvdb::u
     surface_stages_internal::smoothSurfaceUnchecked(mesh, settings, interrupter);
 }
 
+void instruction_set_internal::smoothSurface(SurfaceMesh& mesh, const SmoothSettings& settings,
+                                             openvdb::util::NullInterrupter* interrupter, InstructionSet set)
+{
+    polygon_indices_internal::requireValidIndices(mesh);
+    surface_stages_internal::smoothSurfaceUnchecked(mesh, settings, interrupter, set);
+}
+
 void surface_stages_internal::smoothSurfaceUnchecked(SurfaceMesh& mesh, const SmoothSettings& settings,
-                                                     openvdb::util::NullInterrupter* interrupter)
+                                                     openvdb::util::NullInterrupter* interrupter,
+                                                     instruction_set_internal::InstructionSet set)
 {
     std::ostringstream msg;
     if (!(settings.spatialWidth > 0.0) || !std::isfinite(settings.spatialWidth)) {
@@ -196,6 +323,7 @@ void surface_stages_internal::smoothSurfaceUnchecked(SurfaceMesh& mesh, const Sm
     if (polygons.size() > UINT32_MAX) throw ParameterError("cannot smooth more than 2^32 polygons");
 
     CancelPoll poll(interrupter, "smooth surface");
+    const bool avx2 = instruction_set_internal::useAvx2(set);
     const size_t polygonCount = polygons.size();
     const VertexPolygons around = vertexPolygons(polygons, mesh.points.size(), poll);
 
@@ -214,23 +342,7 @@ void surface_stages_internal::smoothSurfaceUnchecked(SurfaceMesh& mesh, const Sm
         std::vector<float>().swap(area);
         for (int round = 0; round < settings.normalRounds; ++round) {
             tbb::parallel_for(tbb::blocked_range<size_t>(0, polygonCount),
-                [&](const tbb::blocked_range<size_t>& range) {
-                    for (size_t n = range.begin(); n < range.end(); ++n) {
-                        if (poll.stoppedAt(n - range.begin())) return;
-                        const Vec3s own = normal[n];
-                        float x = 0.0f, y = 0.0f, z = 0.0f;
-                        for (uint64_t e = neighbours.start[n]; e < neighbours.start[n + 1]; ++e) {
-                            const Vec3s other = normal[neighbours.polygon[e]];
-                            const float dx = other[0] - own[0], dy = other[1] - own[1], dz = other[2] - own[2];
-                            const float w = neighbours.weight[e] * std::exp(-normalScale * (dx * dx + dy * dy + dz * dz));
-                            x += w * other[0];
-                            y += w * other[1];
-                            z += w * other[2];
-                        }
-                        const float length = std::sqrt(x * x + y * y + z * z);
-                        filtered[n] = length > 0.0f ? Vec3s(x / length, y / length, z / length) : own;
-                    }
-                });
+                              NormalRoundOp{neighbours, normal, filtered, normalScale, poll, avx2});
             poll.throwIfStopped();
             normal.swap(filtered);
         }

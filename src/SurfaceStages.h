@@ -8,6 +8,7 @@
 #define NONBLOPPY_SURFACE_STAGES_H
 
 #include "Cancellation.h"
+#include "InstructionSet.h"
 
 #include <nonbloppy/BuildSurface.h>
 #include <nonbloppy/CorrectSurface.h>
@@ -118,7 +119,8 @@ size_t repairFoldsUnchecked(SurfaceMesh& mesh, const openvdb::Vec3s* before, int
 double preserveVolumeUnchecked(SurfaceMesh& mesh, const VolumeSettings& settings,
                                openvdb::util::NullInterrupter* interrupter);
 void smoothSurfaceUnchecked(SurfaceMesh& mesh, const SmoothSettings& settings,
-                            openvdb::util::NullInterrupter* interrupter);
+                            openvdb::util::NullInterrupter* interrupter,
+                            instruction_set_internal::InstructionSet set = instruction_set_internal::InstructionSet::Auto);
 
 /// Leaf layers (8 voxels each) per region at least, along each axis it is cut on. Each region
 /// also meshes three voxel planes beyond each cut face, but volumeToMesh scans whole leaves,

@@ -6,6 +6,7 @@
 
 #include "TestUtil.h"
 
+#include "../src/ExpNonPositive.h"
 #include "../src/InstructionSet.h"
 
 #include <nonbloppy/ExtractSurface.h>
@@ -13,7 +14,10 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <cstdint>
 #include <cstring>
+#include <limits>
 #include <string>
 
 using namespace nonbloppy;
@@ -93,3 +97,64 @@ TEST_F(SameBitsTest, RelaxVerticesWithCappedSteps)
     for (size_t i = 0; i < extracted.points.size(); ++i) moved += automatic.points[i] != extracted.points[i];
     EXPECT_GT(moved, extracted.points.size() / 2);
 }
+
+TEST_F(SameBitsTest, SmoothSurfaceOfTheRelaxedFrame)
+{
+    // The frame's relaxed surface, as buildSurface() smooths it (spacing 0.05: its filter is
+    // 0.035 wide), triangles and quads both: the normal rounds take the AVX2 copy's lanes.
+    SurfaceMesh extracted = extractSurface(*rasterizeDensity(index, density), 3.6);
+    ASSERT_GT(extracted.quads.size(), 30000u);
+    for (size_t q = 0; q < 200; ++q) {  // some triangles too, as a quad's halves
+        const openvdb::Vec4I quad = extracted.quads.back();
+        extracted.quads.pop_back();
+        extracted.triangles.emplace_back(quad[0], quad[1], quad[2]);
+        extracted.triangles.emplace_back(quad[0], quad[2], quad[3]);
+    }
+    RelaxSettings relax;
+    relax.effectiveRadius = 0.1;
+    relaxVertices(extracted, index, relax);
+    SmoothSettings settings;
+    settings.spatialWidth = kDefaultSmoothWidthOverSpacing * 0.05;
+    SurfaceMesh automatic = extracted, baseline = extracted;
+    smoothSurface(automatic, settings, nullptr, InstructionSet::Auto);
+    smoothSurface(baseline, settings, nullptr, InstructionSet::Baseline);
+    EXPECT_EQ(std::memcmp(automatic.points.data(), baseline.points.data(),
+                          automatic.points.size() * sizeof(openvdb::Vec3s)), 0);
+    size_t moved = 0;
+    for (size_t i = 0; i < extracted.points.size(); ++i) moved += automatic.points[i] != extracted.points[i];
+    EXPECT_GT(moved, extracted.points.size() / 2);
+}
+
+#if NONBLOPPY_HAS_AVX2_COPY
+namespace {
+
+/// expNonPositiveAvx2() on eight values, and the scalar copy on each: whether all bits agree.
+NONBLOPPY_TARGET_AVX2 bool sameExponentials(const float* x)
+{
+    alignas(32) float lanes[8];
+    _mm256_store_ps(lanes, exp_internal::expNonPositiveAvx2(_mm256_loadu_ps(x)));
+    for (int l = 0; l < 8; ++l) {
+        const float scalar = exp_internal::expNonPositive(x[l]);
+        if (std::memcmp(&scalar, &lanes[l], sizeof(float)) != 0) return false;
+    }
+    return true;
+}
+
+} // namespace
+
+TEST_F(SameBitsTest, ExponentialOverItsWholeRange)
+{
+    // 2^23 arguments across [kExpLowest, 0] and the special ones: every lane gives the
+    // scalar copy's bits.
+    std::vector<float> x;
+    for (int i = 0; i <= (1 << 23); ++i) x.push_back(exp_internal::kExpLowest * float(i) / float(1 << 23));
+    for (float special : {0.0f, -0.0f, -87.34f, -88.0f, -1000.0f, -std::numeric_limits<float>::infinity(),
+                          std::numeric_limits<float>::quiet_NaN(), -std::numeric_limits<float>::denorm_min()}) {
+        x.push_back(special);
+    }
+    while (x.size() % 8) x.push_back(0.0f);
+    size_t differing = 0;
+    for (size_t i = 0; i < x.size(); i += 8) differing += !sameExponentials(&x[i]);
+    EXPECT_EQ(differing, 0u);
+}
+#endif

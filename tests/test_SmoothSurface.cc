@@ -1,6 +1,9 @@
 // SPDX-License-Identifier: Apache-2.0
 // smoothSurface(): jitter leaves flat faces, a 90° ridge stays sharp, flat meshes stay put,
-// the same bits for any thread count, and exact messages for bad settings.
+// the same bits for any thread count, and exact messages for bad settings; the exponential of
+// its normal filter is within 1 ulp of e^x.
+
+#include "../src/ExpNonPositive.h"
 
 #include <nonbloppy/Error.h>
 #include <nonbloppy/SmoothSurface.h>
@@ -9,6 +12,9 @@
 #include <tbb/global_control.h>
 
 #include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <limits>
 #include <random>
 
 using namespace nonbloppy;
@@ -181,4 +187,46 @@ TEST(SmoothSurface, BadSettingsNameThemselves)
     settings = settingsFor(0.5);
     settings.vertexRounds = -2;
     EXPECT_EQ(message(mesh, settings), "smoothing rounds must be >= 0, got 35 normal and -2 vertex rounds");
+}
+
+TEST(SmoothSurface, ExponentialIsWithinOneUlpOfTheTrueOne)
+{
+    using exp_internal::expNonPositive;
+    // The distance in floats between expNonPositive(x) and e^x rounded to float, which double
+    // precision gives exactly here (its error is 2^-29 float ulp).
+    const auto ulpsOff = [](float x) {
+        const float got = expNonPositive(x), want = float(std::exp(double(x)));
+        int32_t a, b;
+        std::memcpy(&a, &got, sizeof(float));
+        std::memcpy(&b, &want, sizeof(float));
+        return std::abs(int64_t(a) - int64_t(b));
+    };
+    int64_t worst = 0;
+    float worstAt = 0.0f;
+    // Every 7th float in [-1, -2^-24] (where |r| is smallest and the last bits count most),
+    // and 2^22 steps across the whole range.
+    uint32_t from, to;
+    const float minusOne = -1.0f, tiny = -0x1p-24f;
+    std::memcpy(&from, &tiny, sizeof(float));
+    std::memcpy(&to, &minusOne, sizeof(float));
+    for (uint32_t bits = from; bits <= to; bits += 7) {
+        float x;
+        std::memcpy(&x, &bits, sizeof(float));
+        const int64_t off = ulpsOff(x);
+        if (off > worst) worst = off, worstAt = x;
+    }
+    for (int i = 0; i <= (1 << 22); ++i) {
+        const float x = exp_internal::kExpLowest * float(i) / float(1 << 22);
+        const int64_t off = ulpsOff(x);
+        if (off > worst) worst = off, worstAt = x;
+    }
+    EXPECT_LE(worst, 1) << "at x = " << worstAt;
+    EXPECT_EQ(expNonPositive(0.0f), 1.0f);
+    EXPECT_EQ(expNonPositive(-0.0f), 1.0f);
+    EXPECT_EQ(expNonPositive(-1.0f), float(std::exp(-1.0)));
+    // Below the smallest normal result: +0; NaN stays NaN.
+    EXPECT_EQ(expNonPositive(-88.0f), 0.0f);
+    EXPECT_EQ(expNonPositive(-std::numeric_limits<float>::infinity()), 0.0f);
+    EXPECT_TRUE(std::isnan(expNonPositive(std::numeric_limits<float>::quiet_NaN())));
+    EXPECT_GT(expNonPositive(-87.3f), 0.0f);
 }
