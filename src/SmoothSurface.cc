@@ -146,29 +146,32 @@ PolygonNeighbours polygonNeighbours(const Polygons& polygons, const VertexPolygo
     return out;
 }
 
-/// Centroid of every polygon, and (when asked) its area and unit normal.
-void measurePolygons(const Polygons& polygons, const std::vector<Vec3s>& points,
-                     std::vector<Vec3s>& centroid, std::vector<float>* area, std::vector<Vec3s>* normal,
-                     CancelPoll& poll)
+/// The mean of @a t's corners.
+inline Vec3s centroidOf(const Corners& t, const std::vector<Vec3s>& points)
+{
+    const Vec3s a = points[t.vertex[0]], b = points[t.vertex[1]], c = points[t.vertex[2]];
+    return t.count == 4 ? (a + b + c + points[t.vertex[3]]) * 0.25f : (a + b + c) * (1.0f / 3.0f);
+}
+
+/// Centroid, area and unit normal of every polygon.
+void measurePolygons(const Polygons& polygons, const std::vector<Vec3s>& points, std::vector<Vec3s>& centroid,
+                     std::vector<float>& area, std::vector<Vec3s>& normal, CancelPoll& poll)
 {
     tbb::parallel_for(tbb::blocked_range<size_t>(0, polygons.size()),
         [&](const tbb::blocked_range<size_t>& range) {
             for (size_t n = range.begin(); n < range.end(); ++n) {
                 if (poll.stoppedAt(n - range.begin())) return;
                 const Corners t = polygons[n];
+                centroid[n] = centroidOf(t, points);
                 const Vec3s a = points[t.vertex[0]], b = points[t.vertex[1]], c = points[t.vertex[2]];
-                const Vec3s d = t.count == 4 ? points[t.vertex[3]] : Vec3s(0.0f);
-                centroid[n] = t.count == 4 ? (a + b + c + d) * 0.25f : (a + b + c) * (1.0f / 3.0f);
-                if (!area) continue;
-                const Vec3s cross = t.count == 4 ? twiceVectorArea(a, b, c, d) : twiceVectorArea(a, b, c);
+                const Vec3s cross = t.count == 4 ? twiceVectorArea(a, b, c, points[t.vertex[3]]) : twiceVectorArea(a, b, c);
                 const float length = cross.length();
-                (*area)[n] = 0.5f * length;
-                (*normal)[n] = length > 0.0f ? cross / length : Vec3s(0.0f);
+                area[n] = 0.5f * length;
+                normal[n] = length > 0.0f ? cross / length : Vec3s(0.0f);
             }
         });
     poll.throwIfStopped();
 }
-
 
 /// One normal round: every polygon's filtered normal from the previous round's normals
 /// (see smoothSurface()). The same operations in the same order for every polygon, so the
@@ -329,7 +332,7 @@ void surface_stages_internal::smoothSurfaceUnchecked(SurfaceMesh& mesh, const Sm
 
     std::vector<Vec3s> centroid(polygonCount), normal(polygonCount), filtered(polygonCount);
     std::vector<float> area(polygonCount);
-    measurePolygons(polygons, mesh.points, centroid, &area, &normal, poll);
+    measurePolygons(polygons, mesh.points, centroid, area, normal, poll);
 
     // Normal rounds: every polygon reads the previous round's normals only (double
     // buffered), in a fixed neighbour order, so the result does not depend on the threads.
@@ -349,9 +352,31 @@ void surface_stages_internal::smoothSurfaceUnchecked(SurfaceMesh& mesh, const Sm
     }
 
     // Vertex rounds: move each vertex along its polygons' filtered normals onto their planes.
+    // Each polygon's normal and centroid side by side: a vertex reads both for each of its
+    // polygons, from one cache line instead of two.
+    struct Plane
+    {
+        Vec3s normal, centroid;
+    };
+    std::vector<Plane> planes(polygonCount);
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, polygonCount), [&](const tbb::blocked_range<size_t>& range) {
+        for (size_t n = range.begin(); n < range.end(); ++n) planes[n] = Plane{normal[n], centroid[n]};
+    });
+    std::vector<Vec3s>().swap(normal);
+    std::vector<Vec3s>().swap(filtered);
+    std::vector<Vec3s>().swap(centroid);
     std::vector<Vec3s> next(mesh.points.size());
     for (int round = 0; round < settings.vertexRounds; ++round) {
-        if (round > 0) measurePolygons(polygons, mesh.points, centroid, nullptr, nullptr, poll);
+        if (round > 0) {
+            tbb::parallel_for(tbb::blocked_range<size_t>(0, polygonCount),
+                [&](const tbb::blocked_range<size_t>& range) {
+                    for (size_t n = range.begin(); n < range.end(); ++n) {
+                        if (poll.stoppedAt(n - range.begin())) return;
+                        planes[n].centroid = centroidOf(polygons[n], mesh.points);
+                    }
+                });
+            poll.throwIfStopped();
+        }
         tbb::parallel_for(tbb::blocked_range<size_t>(0, mesh.points.size()),
             [&](const tbb::blocked_range<size_t>& range) {
                 for (size_t v = range.begin(); v < range.end(); ++v) {
@@ -361,8 +386,8 @@ void surface_stages_internal::smoothSurfaceUnchecked(SurfaceMesh& mesh, const Sm
                     if (begin == end) { next[v] = p; continue; }
                     Vec3d move(0.0);
                     for (uint64_t e = begin; e < end; ++e) {
-                        const uint32_t m = around.polygonOf[e];
-                        move += Vec3d(normal[m]) * double(normal[m].dot(centroid[m] - p));
+                        const Plane& plane = planes[around.polygonOf[e]];
+                        move += Vec3d(plane.normal) * double(plane.normal.dot(plane.centroid - p));
                     }
                     next[v] = p + Vec3s(move / double(end - begin));
                 }
