@@ -9,9 +9,14 @@
 #include "PolygonIndices.h"
 
 #include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 #include <tbb/parallel_reduce.h>
+#include <tbb/parallel_sort.h>
 
 #include <algorithm>
+#include <atomic>
+#include <functional>
+#include <memory>
 #include <cmath>
 #include <cstdint>
 #include <string>
@@ -26,20 +31,24 @@ struct EdgeUse
 {
     uint64_t key;
     bool forward;  ///< used as low → high
-
-    bool operator<(const EdgeUse& other) const
-    {
-        return key < other.key || (key == other.key && forward < other.forward);
-    }
 };
 
-void
-addEdge(std::vector<EdgeUse>& edges, uint32_t from, uint32_t to)
+/// The key of no edge: a polygon's collapsed edge (both ends one vertex) bounds nothing.
+constexpr uint64_t kNoEdge = ~uint64_t(0);
+
+EdgeUse
+edgeOf(uint32_t from, uint32_t to)
 {
-    if (from == to) return;  // a collapsed edge of a degenerate polygon bounds nothing
+    if (from == to) return {kNoEdge, false};
     const uint32_t low = std::min(from, to), high = std::max(from, to);
-    edges.push_back({(uint64_t(low) << 32) | high, from < to});
+    return {(uint64_t(low) << 32) | high, from < to};
 }
+
+/// Edges by how many polygons use them, in a part of the sorted edge list.
+struct EdgeCounts
+{
+    size_t boundary = 0, nonManifold = 0, inconsistent = 0;
+};
 
 /// Adds the area and the signed volume of the tetrahedron (origin, p0, p1, p2); returns
 /// the triangle's area.
@@ -148,37 +157,78 @@ measureMesh(const SurfaceMesh& mesh)
     const AreaAndVolume sums = sumAreaAndVolume(mesh, m.zeroAreaPolygons);
     m.area = sums.area;
     m.volume = sums.volume;
-    for (const openvdb::Vec3s& p : mesh.points) {
-        m.nonFiniteVertices += !(std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2]));
-    }
+    const size_t vertexCount = mesh.points.size();
+    const size_t triangleCount = mesh.triangles.size(), polygonCount = m.polygons;
+    m.nonFiniteVertices = tbb::parallel_reduce(tbb::blocked_range<size_t>(0, vertexCount), size_t(0),
+        [&](const tbb::blocked_range<size_t>& range, size_t count) {
+            for (size_t i = range.begin(); i < range.end(); ++i) {
+                const openvdb::Vec3s& p = mesh.points[i];
+                count += !(std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2]));
+            }
+            return count;
+        },
+        std::plus<size_t>());
 
-    std::vector<bool> used(mesh.points.size(), false);
-    std::vector<EdgeUse> edges;
-    edges.reserve(3 * mesh.triangles.size() + 4 * mesh.quads.size());
-    for (const openvdb::Vec3I& t : mesh.triangles) {
-        for (int i = 0; i < 3; ++i) used[t[i]] = true;
-        for (int i = 0; i < 3; ++i) addEdge(edges, t[i], t[(i + 1) % 3]);
-    }
-    for (const openvdb::Vec4I& q : mesh.quads) {
-        for (int i = 0; i < 4; ++i) used[q[i]] = true;
-        for (int i = 0; i < 4; ++i) addEdge(edges, q[i], q[(i + 1) % 4]);
-    }
-    m.unusedVertices = size_t(std::count(used.begin(), used.end(), false));
-
-    std::sort(edges.begin(), edges.end());
-    for (size_t begin = 0; begin < edges.size();) {
-        size_t end = begin;
-        size_t forward = 0;
-        while (end < edges.size() && edges[end].key == edges[begin].key) {
-            forward += edges[end].forward ? 1 : 0;
-            ++end;
+    // Every polygon's edges at a fixed place (a triangle's three, then a quad's four, in
+    // polygon order), collapsed ones as kNoEdge, which sorts last; then sorted in parallel.
+    // Only counts come out of the sorted runs, so the order within a run does not matter.
+    const auto firstEdge = [&](size_t polygon) {
+        return polygon < triangleCount ? 3 * polygon : 3 * triangleCount + 4 * (polygon - triangleCount);
+    };
+    std::unique_ptr<std::atomic<uint8_t>[]> used(new std::atomic<uint8_t>[vertexCount]());
+    std::vector<EdgeUse> edges(firstEdge(polygonCount));
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, polygonCount), [&](const tbb::blocked_range<size_t>& range) {
+        for (size_t n = range.begin(); n < range.end(); ++n) {
+            const uint32_t* corners = n < triangleCount ? mesh.triangles[n].asPointer()
+                                                        : mesh.quads[n - triangleCount].asPointer();
+            const int count = n < triangleCount ? 3 : 4;
+            EdgeUse* out = edges.data() + firstEdge(n);
+            for (int i = 0; i < count; ++i) {
+                used[corners[i]].store(1, std::memory_order_relaxed);
+                out[i] = edgeOf(corners[i], corners[(i + 1) % count]);
+            }
         }
-        const size_t uses = end - begin;
-        const size_t backward = uses - forward;
-        if (uses == 1) ++m.boundaryEdges;
-        else if (uses >= 3) ++m.nonManifoldEdges;
-        else if (forward == 2 || backward == 2) ++m.inconsistentEdges;
-        begin = end;
+    });
+    size_t usedCount = 0;
+    for (size_t i = 0; i < vertexCount; ++i) usedCount += used[i].load(std::memory_order_relaxed);
+    m.unusedVertices = vertexCount - usedCount;
+    tbb::parallel_sort(edges.begin(), edges.end(),
+                       [](const EdgeUse& a, const EdgeUse& b) { return a.key < b.key; });
+    edges.erase(std::lower_bound(edges.begin(), edges.end(), EdgeUse{kNoEdge, false},
+                                 [](const EdgeUse& a, const EdgeUse& b) { return a.key < b.key; }),
+                edges.end());
+
+    // The runs of equal keys, counted in chunks that each start at a run's first element.
+    constexpr size_t kChunk = size_t(1) << 16;
+    const size_t chunks = (edges.size() + kChunk - 1) / kChunk;
+    std::vector<EdgeCounts> counted(chunks);
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, chunks), [&](const tbb::blocked_range<size_t>& range) {
+        for (size_t c = range.begin(); c < range.end(); ++c) {
+            // A run belongs to the chunk holding its first element.
+            size_t begin = c * kChunk;
+            const size_t chunkEnd = std::min(begin + kChunk, edges.size());
+            while (begin > 0 && begin < chunkEnd && edges[begin].key == edges[begin - 1].key) ++begin;
+            EdgeCounts& counts = counted[c];
+            while (begin < chunkEnd) {
+                size_t end = begin;
+                size_t forward = 0;
+                while (end < edges.size() && edges[end].key == edges[begin].key) {
+                    forward += edges[end].forward ? 1 : 0;
+                    ++end;
+                }
+                const size_t uses = end - begin;
+                const size_t backward = uses - forward;
+                if (uses == 1) ++counts.boundary;
+                else if (uses >= 3) ++counts.nonManifold;
+                else if (forward == 2 || backward == 2) ++counts.inconsistent;
+                begin = end;
+            }
+        }
+    });
+    for (const EdgeCounts& counts : counted) {
+        m.boundaryEdges += counts.boundary;
+        m.nonManifoldEdges += counts.nonManifold;
+        m.inconsistentEdges += counts.inconsistent;
     }
 
     m.closed = m.polygons > 0 && m.boundaryEdges == 0;

@@ -171,6 +171,41 @@ TEST(MeasureMesh, TwoCubesSharingAnEdgeAreClosedButNotManifold)
     EXPECT_DOUBLE_EQ(m.area, 12.0);
 }
 
+TEST(MeasureMesh, LargeGridCountsEveryEdgeOnce)
+{
+    // A flat n×n grid of quads has 4n boundary edges. With 300 cells a side its 360,000 edge
+    // uses span several of the chunks the sorted edges are counted in, and runs of one edge
+    // straddle chunk boundaries. Every 7th quad of row 100 is flipped: four inconsistent
+    // edges each, shared with unflipped neighbours.
+    constexpr uint32_t n = 300;
+    SurfaceMesh mesh;
+    for (uint32_t j = 0; j <= n; ++j)
+        for (uint32_t i = 0; i <= n; ++i) mesh.points.emplace_back(float(i), float(j), 0.0f);
+    const auto at = [&](uint32_t i, uint32_t j) { return j * (n + 1) + i; };
+    for (uint32_t j = 0; j < n; ++j) {
+        for (uint32_t i = 0; i < n; ++i) {
+            openvdb::Vec4I quad(at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1));
+            if (j == 100 && i % 7 == 3) std::swap(quad[1], quad[3]);
+            mesh.quads.push_back(quad);
+        }
+    }
+    size_t flipped = 0;
+    for (uint32_t i = 0; i < n; ++i) flipped += i % 7 == 3;
+    // A third polygon on each of row 200's bottom edges: a triangle (i, i+1, apex) with
+    // apexes off the plane, one new vertex each.
+    for (uint32_t i = 0; i < n; ++i) {
+        mesh.points.emplace_back(float(i) + 0.5f, 200.0f, 1.0f);
+        mesh.triangles.emplace_back(at(i, 200), at(i + 1, 200), uint32_t(mesh.points.size() - 1));
+    }
+    const MeshMeasures m = measureMesh(mesh);
+    EXPECT_EQ(m.boundaryEdges, 4 * n + 2 * n);  // the grid's rim, and the triangles' other two sides
+    EXPECT_EQ(m.inconsistentEdges, 4 * flipped);
+    EXPECT_EQ(m.nonManifoldEdges, n);
+    EXPECT_EQ(m.unusedVertices, 0u);
+    EXPECT_FALSE(m.closed);
+    EXPECT_FALSE(m.manifold);
+}
+
 TEST(MeasureMesh, CountsZeroAreaPolygonsAndNonFiniteVertices)
 {
     // Edges alone called a triangle with a corner repeated, or a droplet that -c 1 shrank to
