@@ -11,7 +11,6 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_reduce.h>
-#include <tbb/parallel_sort.h>
 
 #include <algorithm>
 #include <atomic>
@@ -26,25 +25,7 @@ namespace nonbloppy {
 
 namespace {
 
-/// An undirected edge (low, high) packed into one key, plus the direction it was used in.
-struct EdgeUse
-{
-    uint64_t key;
-    bool forward;  ///< used as low → high
-};
-
-/// The key of no edge: a polygon's collapsed edge (both ends one vertex) bounds nothing.
-constexpr uint64_t kNoEdge = ~uint64_t(0);
-
-EdgeUse
-edgeOf(uint32_t from, uint32_t to)
-{
-    if (from == to) return {kNoEdge, false};
-    const uint32_t low = std::min(from, to), high = std::max(from, to);
-    return {(uint64_t(low) << 32) | high, from < to};
-}
-
-/// Edges by how many polygons use them, in a part of the sorted edge list.
+/// Edges by how many polygons use them.
 struct EdgeCounts
 {
     size_t boundary = 0, nonManifold = 0, inconsistent = 0;
@@ -169,67 +150,75 @@ measureMesh(const SurfaceMesh& mesh)
         },
         std::plus<size_t>());
 
-    // Every polygon's edges at a fixed place (a triangle's three, then a quad's four, in
-    // polygon order), collapsed ones as kNoEdge, which sorts last; then sorted in parallel.
-    // Only counts come out of the sorted runs, so the order within a run does not matter.
-    const auto firstEdge = [&](size_t polygon) {
-        return polygon < triangleCount ? 3 * polygon : 3 * triangleCount + 4 * (polygon - triangleCount);
+    // Each edge is filed under its lower vertex (a counting sort: the edges per vertex, their
+    // prefix sums, then every edge put in one of its vertex's slots), as its other end and
+    // direction; then each vertex's few edges are sorted and their runs counted. Only counts
+    // come out, so the order in which the threads file the edges does not matter.
+    const auto forEachEdge = [&](size_t polygon, auto&& visit) {
+        const uint32_t* corners = polygon < triangleCount ? mesh.triangles[polygon].asPointer()
+                                                          : mesh.quads[polygon - triangleCount].asPointer();
+        const int count = polygon < triangleCount ? 3 : 4;
+        for (int i = 0; i < count; ++i) {
+            const uint32_t from = corners[i], to = corners[(i + 1) % count];
+            if (from != to) visit(from, to);  // a collapsed edge bounds nothing
+        }
     };
     std::unique_ptr<std::atomic<uint8_t>[]> used(new std::atomic<uint8_t>[vertexCount]());
-    std::vector<EdgeUse> edges(firstEdge(polygonCount));
+    std::unique_ptr<std::atomic<uint32_t>[]> filed(new std::atomic<uint32_t>[vertexCount]());
     tbb::parallel_for(tbb::blocked_range<size_t>(0, polygonCount), [&](const tbb::blocked_range<size_t>& range) {
         for (size_t n = range.begin(); n < range.end(); ++n) {
-            const uint32_t* corners = n < triangleCount ? mesh.triangles[n].asPointer()
-                                                        : mesh.quads[n - triangleCount].asPointer();
-            const int count = n < triangleCount ? 3 : 4;
-            EdgeUse* out = edges.data() + firstEdge(n);
-            for (int i = 0; i < count; ++i) {
-                used[corners[i]].store(1, std::memory_order_relaxed);
-                out[i] = edgeOf(corners[i], corners[(i + 1) % count]);
-            }
+            forEachEdge(n, [&](uint32_t from, uint32_t to) {
+                used[from].store(1, std::memory_order_relaxed);
+                filed[std::min(from, to)].fetch_add(1, std::memory_order_relaxed);
+            });
         }
     });
+    std::vector<uint64_t> start(vertexCount + 1, 0);
     size_t usedCount = 0;
-    for (size_t i = 0; i < vertexCount; ++i) usedCount += used[i].load(std::memory_order_relaxed);
+    for (size_t v = 0; v < vertexCount; ++v) {
+        usedCount += used[v].load(std::memory_order_relaxed);
+        start[v + 1] = start[v] + filed[v].load(std::memory_order_relaxed);
+        filed[v].store(0, std::memory_order_relaxed);
+    }
     m.unusedVertices = vertexCount - usedCount;
-    tbb::parallel_sort(edges.begin(), edges.end(),
-                       [](const EdgeUse& a, const EdgeUse& b) { return a.key < b.key; });
-    edges.erase(std::lower_bound(edges.begin(), edges.end(), EdgeUse{kNoEdge, false},
-                                 [](const EdgeUse& a, const EdgeUse& b) { return a.key < b.key; }),
-                edges.end());
-
-    // The runs of equal keys, counted in chunks that each start at a run's first element.
-    constexpr size_t kChunk = size_t(1) << 16;
-    const size_t chunks = (edges.size() + kChunk - 1) / kChunk;
-    std::vector<EdgeCounts> counted(chunks);
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, chunks), [&](const tbb::blocked_range<size_t>& range) {
-        for (size_t c = range.begin(); c < range.end(); ++c) {
-            // A run belongs to the chunk holding its first element.
-            size_t begin = c * kChunk;
-            const size_t chunkEnd = std::min(begin + kChunk, edges.size());
-            while (begin > 0 && begin < chunkEnd && edges[begin].key == edges[begin - 1].key) ++begin;
-            EdgeCounts& counts = counted[c];
-            while (begin < chunkEnd) {
-                size_t end = begin;
-                size_t forward = 0;
-                while (end < edges.size() && edges[end].key == edges[begin].key) {
-                    forward += edges[end].forward ? 1 : 0;
-                    ++end;
-                }
-                const size_t uses = end - begin;
-                const size_t backward = uses - forward;
-                if (uses == 1) ++counts.boundary;
-                else if (uses >= 3) ++counts.nonManifold;
-                else if (forward == 2 || backward == 2) ++counts.inconsistent;
-                begin = end;
-            }
+    // A vertex's edges: (other end << 1) | (used from the lower vertex to the other).
+    std::vector<uint64_t> edges(start[vertexCount]);
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, polygonCount), [&](const tbb::blocked_range<size_t>& range) {
+        for (size_t n = range.begin(); n < range.end(); ++n) {
+            forEachEdge(n, [&](uint32_t from, uint32_t to) {
+                const uint32_t low = std::min(from, to), high = std::max(from, to);
+                edges[start[low] + filed[low].fetch_add(1, std::memory_order_relaxed)] =
+                    (uint64_t(high) << 1) | uint64_t(from < to);
+            });
         }
     });
-    for (const EdgeCounts& counts : counted) {
-        m.boundaryEdges += counts.boundary;
-        m.nonManifoldEdges += counts.nonManifold;
-        m.inconsistentEdges += counts.inconsistent;
-    }
+    const EdgeCounts counted = tbb::parallel_reduce(tbb::blocked_range<size_t>(0, vertexCount), EdgeCounts(),
+        [&](const tbb::blocked_range<size_t>& range, EdgeCounts counts) {
+            for (size_t v = range.begin(); v < range.end(); ++v) {
+                const auto first = edges.begin() + ptrdiff_t(start[v]), last = edges.begin() + ptrdiff_t(start[v + 1]);
+                std::sort(first, last);
+                for (auto run = first; run != last;) {
+                    auto end = run;
+                    size_t forward = 0;
+                    while (end != last && (*end >> 1) == (*run >> 1)) forward += size_t(*end++ & 1);
+                    const size_t uses = size_t(end - run), backward = uses - forward;
+                    if (uses == 1) ++counts.boundary;
+                    else if (uses >= 3) ++counts.nonManifold;
+                    else if (forward == 2 || backward == 2) ++counts.inconsistent;
+                    run = end;
+                }
+            }
+            return counts;
+        },
+        [](EdgeCounts a, const EdgeCounts& b) {
+            a.boundary += b.boundary;
+            a.nonManifold += b.nonManifold;
+            a.inconsistent += b.inconsistent;
+            return a;
+        });
+    m.boundaryEdges = counted.boundary;
+    m.nonManifoldEdges = counted.nonManifold;
+    m.inconsistentEdges = counted.inconsistent;
 
     m.closed = m.polygons > 0 && m.boundaryEdges == 0;
     m.manifold = m.closed && m.nonManifoldEdges == 0 && m.inconsistentEdges == 0;

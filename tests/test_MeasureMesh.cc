@@ -173,10 +173,9 @@ TEST(MeasureMesh, TwoCubesSharingAnEdgeAreClosedButNotManifold)
 
 TEST(MeasureMesh, LargeGridCountsEveryEdgeOnce)
 {
-    // A flat n×n grid of quads has 4n boundary edges. With 300 cells a side its 360,000 edge
-    // uses span several of the chunks the sorted edges are counted in, and runs of one edge
-    // straddle chunk boundaries. Every 7th quad of row 100 is flipped: four inconsistent
-    // edges each, shared with unflipped neighbours.
+    // A flat n×n grid of quads has 4n boundary edges; with 300 cells a side, 360,000 edge
+    // uses, filed by many threads at once. Every 7th quad of row 100 is flipped: four
+    // inconsistent edges each, shared with unflipped neighbours.
     constexpr uint32_t n = 300;
     SurfaceMesh mesh;
     for (uint32_t j = 0; j <= n; ++j)
