@@ -36,8 +36,8 @@ constexpr float kLn2Low = -2.12194440e-4f;    // ln 2 − kLn2High
 constexpr float kExpP0 = 1.9875691500e-4f, kExpP1 = 1.3981999507e-3f, kExpP2 = 8.3334519073e-3f,
                 kExpP3 = 4.1665795894e-2f, kExpP4 = 1.6666665459e-1f, kExpP5 = 5.0000001201e-1f;
 
-/// e^x for x ≤ 0 (and NaN, which it returns); +0 below kExpLowest. Any x > 0 gives a wrong
-/// value: the normal filter's arguments, −|n_i − n_j|²/2σ_r², are never positive.
+/// e^x for x ≤ 0 (and NaN, which it returns); +0 below kExpLowest. Positive x are outside
+/// what it is tested for: the normal filter's arguments, −|n_i − n_j|²/2σ_r², never are.
 inline float expNonPositive(float x)
 {
     const float clamped = kExpLowest > x ? kExpLowest : x;
