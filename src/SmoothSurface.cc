@@ -19,7 +19,6 @@
 #include <sstream>
 #include <vector>
 
-
 namespace nonbloppy {
 
 namespace {
