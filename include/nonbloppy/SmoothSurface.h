@@ -69,7 +69,8 @@ struct SmoothSettings
 /// AVX2), per vertex round one pass over the faces around each vertex. Parallel over faces
 /// and vertices. Scratch about 140 bytes per quad. On the 64x benchmark input's surface
 /// (2.39M vertices, 2.37M quads, `--spacing 0.0467157`, two threads) the defaults take
-/// 3.3 s, 40% of it the normal rounds (4.3–4.5 s with glibc's expf one face at a time). Deterministic: each element reads only
+/// 3.15–3.28 s, about 40% of it the normal rounds (4.34–4.50 s with glibc's expf one face
+/// at a time and separate normal and centroid arrays). Deterministic: each element reads only
 /// the previous round, in a fixed order, so the result is the same bits for any thread count.
 /// @param mesh         vertices moved; polygon indices must be valid (see measureMesh())
 /// @param settings     the filter's widths and rounds; spatialWidth has no default
