@@ -15,6 +15,9 @@
 # The peer is `vdb_tool` from Debian's libopenvdb-tools:
 #   vdb_tool -read IN.ply -points2ls voxel=0.025 radius=2 width=3 -ls2mesh adapt=0 -write OUT.ply
 # nonbloppy runs with voxel size 0.025, r_e = 0.1, c = 0.3, t = 2 and writes binary PLY too.
+# On the 64x input the script also scans t (0, 1, 2, 4) and the thread count (1, 2), runs the
+# faithful method's volume correction and smoothing (`--spacing`, with and without
+# `--no-smooth`), and meshes a six-frame sequence.
 # Wall time, CPU time (user + system) and peak RSS come from GNU time. The report is markdown,
 # printed and written to DIR/benchmark.md.
 set -euo pipefail
