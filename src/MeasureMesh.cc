@@ -14,11 +14,12 @@
 
 #include <algorithm>
 #include <atomic>
-#include <functional>
-#include <memory>
 #include <cmath>
 #include <cstdint>
+#include <functional>
+#include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace nonbloppy {
@@ -154,10 +155,12 @@ measureMesh(const SurfaceMesh& mesh)
     // prefix sums, then every edge put in one of its vertex's slots), as its other end and
     // direction; then each vertex's few edges are sorted and their runs counted. Only counts
     // come out, so the order in which the threads file the edges does not matter.
+    const auto cornersOf = [&](size_t polygon) {
+        return polygon < triangleCount ? std::make_pair(mesh.triangles[polygon].asPointer(), 3)
+                                       : std::make_pair(mesh.quads[polygon - triangleCount].asPointer(), 4);
+    };
     const auto forEachEdge = [&](size_t polygon, auto&& visit) {
-        const uint32_t* corners = polygon < triangleCount ? mesh.triangles[polygon].asPointer()
-                                                          : mesh.quads[polygon - triangleCount].asPointer();
-        const int count = polygon < triangleCount ? 3 : 4;
+        const auto [corners, count] = cornersOf(polygon);
         for (int i = 0; i < count; ++i) {
             const uint32_t from = corners[i], to = corners[(i + 1) % count];
             if (from != to) visit(from, to);  // a collapsed edge bounds nothing
@@ -167,8 +170,10 @@ measureMesh(const SurfaceMesh& mesh)
     std::unique_ptr<std::atomic<uint32_t>[]> filed(new std::atomic<uint32_t>[vertexCount]());
     tbb::parallel_for(tbb::blocked_range<size_t>(0, polygonCount), [&](const tbb::blocked_range<size_t>& range) {
         for (size_t n = range.begin(); n < range.end(); ++n) {
+            // Every corner is used, those of a polygon collapsed to one point too.
+            const auto [corners, count] = cornersOf(n);
+            for (int i = 0; i < count; ++i) used[corners[i]].store(1, std::memory_order_relaxed);
             forEachEdge(n, [&](uint32_t from, uint32_t to) {
-                used[from].store(1, std::memory_order_relaxed);
                 filed[std::min(from, to)].fetch_add(1, std::memory_order_relaxed);
             });
         }

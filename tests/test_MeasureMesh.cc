@@ -205,6 +205,20 @@ TEST(MeasureMesh, LargeGridCountsEveryEdgeOnce)
     EXPECT_FALSE(m.manifold);
 }
 
+TEST(MeasureMesh, APolygonCollapsedToOnePointStillUsesItsVertex)
+{
+    // All its edges collapse, so none of them files the vertex: it is used all the same.
+    SurfaceMesh mesh = cube();
+    mesh.points.push_back(openvdb::Vec3s(5.0f, 5.0f, 5.0f));  // 8
+    mesh.points.push_back(openvdb::Vec3s(6.0f, 5.0f, 5.0f));  // 9, in no polygon
+    mesh.triangles = {{8, 8, 8}};
+    const MeshMeasures m = measureMesh(mesh);
+    EXPECT_EQ(m.unusedVertices, 1u);
+    EXPECT_EQ(m.zeroAreaPolygons, 1u);
+    EXPECT_EQ(m.boundaryEdges, 0u);
+    EXPECT_TRUE(m.manifold);
+}
+
 TEST(MeasureMesh, CountsZeroAreaPolygonsAndNonFiniteVertices)
 {
     // Edges alone called a triangle with a corner repeated, or a droplet that -c 1 shrank to
