@@ -291,8 +291,7 @@ struct NormalRoundOp
 
 void smoothSurface(SurfaceMesh& mesh, const SmoothSettings& settings, openvdb::util::NullInterrupter* interrupter)
 {
-    polygon_indices_internal::requireValidIndices(mesh);
-    surface_stages_internal::smoothSurfaceUnchecked(mesh, settings, interrupter);
+    instruction_set_internal::smoothSurface(mesh, settings, interrupter, instruction_set_internal::InstructionSet::Auto);
 }
 
 void instruction_set_internal::smoothSurface(SurfaceMesh& mesh, const SmoothSettings& settings,
