@@ -176,6 +176,45 @@ TEST_F(CliTest, ADensityGridLargerThanTheMemoryIsRefusedBeforeItIsAllocated)
 #endif
 }
 
+TEST_F(CliTest, ASmoothingLargerThanTheMemoryIsRefusedBeforeItIsAllocated)
+{
+#if defined(NONBLOPPY_TEST_ASAN)
+    GTEST_SKIP() << "AddressSanitizer reserves more address space than the limit this test sets";
+#else
+    // A sheet of 500 x 500 particles one layer thick: 2.0M polygons, whose smoothing takes
+    // more memory than the density grid, the mesh and the relaxation before it (146 MB of
+    // scratch on top of a 141 MB peak). Under a 550 MB limit of address space every stage
+    // before it fits (from about 430 MB: "out of memory" below) and the smoothing does not
+    // (up to about 680 MB); without the check the kernel's OOM killer ends such a run on a
+    // farm node with nothing said.
+    std::string xyz;
+    for (int i = 0; i < 500; ++i) {
+        for (int j = 0; j < 500; ++j) {
+            const float position[3] = {float(i), float(j), 0.0f};
+            xyz.append(reinterpret_cast<const char*>(position), sizeof(position));
+        }
+    }
+    const std::string input = dir() + "/in/sheet.xyz", err = dir() + "/err.txt";
+    writeText(input, xyz);
+    const std::string command = "ulimit -v 550000 && " + quote(kCli) + " mesh " + quote(input) + " -o "
+                                + quote(out("sheet.ply")) + " --spacing 1 --threads 2 -q 2>" + quote(err);
+    const int status = std::system(("sh -c " + quote(command)).c_str());
+    ASSERT_TRUE(WIFEXITED(status));
+    EXPECT_EQ(WEXITSTATUS(status), 1);
+    const std::string message = readText(err);
+    const std::string head = "nonbloppy: " + input + ": smoothing the surface (2023982 polygons) would take another ";
+    const std::string tail = " this process can still take: give --no-smooth to skip it\n";
+    ASSERT_EQ(message.rfind(head, 0), 0u) << message;
+    ASSERT_GT(message.size(), head.size() + tail.size());
+    EXPECT_EQ(message.substr(message.size() - tail.size()), tail) << message;
+    EXPECT_TRUE(listDir(dir() + "/out").empty());
+    // The same sheet without the smoothing fits.
+    const std::string unsmoothed = "ulimit -v 550000 && " + quote(kCli) + " mesh " + quote(input) + " -o "
+                                   + quote(out("sheet.ply")) + " --spacing 1 --threads 2 --no-smooth -q";
+    EXPECT_EQ(std::system(("sh -c " + quote(unsmoothed)).c_str()), 0);
+#endif
+}
+
 TEST_F(CliTest, VerbosePrintsStagesOnStderr)
 {
     const RunResult r = meshCube("cube", "-v");

@@ -81,8 +81,11 @@ struct SmoothSettings
 /// @throw ParameterError("polygon P references vertex I but the mesh has N vertices") for
 ///        the first polygon with a corner out of range (triangles first, then quads; checked
 ///        before anything moves), or naming the setting if a width is not > 0 or finite,
-///        or a round count is < 0; CancelledError("interrupted during smooth surface")
-///        when @a interrupter says stop.
+///        or a round count is < 0; ParameterError("smoothing the surface (N polygons) would
+///        take another X, more than the Y this process can still take: give --no-smooth to
+///        skip it"), before the scratch is allocated, where it would not fit in what the
+///        machine, ulimit -v or -d, or the memory cgroup still allow; CancelledError
+///        ("interrupted during smooth surface") when @a interrupter says stop.
 NONBLOPPY_API void smoothSurface(SurfaceMesh& mesh, const SmoothSettings& settings,
                                  openvdb::util::NullInterrupter* interrupter = nullptr);
 
