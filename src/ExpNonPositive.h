@@ -1,12 +1,13 @@
 // SPDX-License-Identifier: Apache-2.0
 /// @file ExpNonPositive.h
-/// @brief Private: e^x for x <= 0, the same bits from a scalar and an eight-lane AVX2 copy,
-///        for the smoothing's normal filter. Only src/ and the tests include it.
+/// @brief Private: e^x for x <= 0, the same bits from a scalar, an eight-lane AVX2 and a
+///        sixteen-lane AVX-512F copy, for the smoothing's normal filter. Only src/ and the
+///        tests include it.
 ///
 /// e^x from IEEE additions, multiplications and integer bit operations alone (Cephes' expf:
 /// x = k ln 2 + r, |r| ≤ ln 2 / 2, a degree-7 polynomial for e^r, then 2^k into the exponent),
-/// in a scalar copy and an eight-lane AVX2 copy that does the same operations lane by lane,
-/// so both give the same bits (tests/test_InstructionSet.cc), within 1 ulp of e^x
+/// in a scalar copy and eight- and sixteen-lane copies that do the same operations lane by
+/// lane, so all give the same bits (tests/test_InstructionSet.cc), within 1 ulp of e^x
 /// (tests/test_SmoothSurface.cc). glibc's expf, a table lookup per call that no loop can
 /// vectorize, took most of the smoothing's normal rounds.
 
@@ -85,6 +86,34 @@ NONBLOPPY_TARGET_AVX2 inline __m256 expNonPositiveAvx2(__m256 x)
         23);
     const __m256 underflow = _mm256_cmp_ps(x, lowest, _CMP_LT_OQ);
     return _mm256_andnot_ps(underflow, _mm256_mul_ps(y, _mm256_castsi256_ps(scaleBits)));
+}
+
+/// expNonPositive() on sixteen lanes (AVX-512F). The full-mask maskz forms of max, shift and
+/// (in the caller) square root are the plain instructions: GCC 12's plain intrinsics merge
+/// into an uninitialized register and warn (-Wmaybe-uninitialized).
+NONBLOPPY_TARGET_AVX512 inline __m512 expNonPositiveAvx512(__m512 x)
+{
+    const __mmask16 all = 0xFFFF;
+    const __m512 lowest = _mm512_set1_ps(kExpLowest), roundToInteger = _mm512_set1_ps(kRoundToInteger);
+    const __m512 clamped = _mm512_maskz_max_ps(all, lowest, x);  // lowest > x ? lowest : x, NaN kept
+    const __m512 shifted = _mm512_add_ps(_mm512_mul_ps(clamped, _mm512_set1_ps(kLog2e)), roundToInteger);
+    const __m512 k = _mm512_sub_ps(shifted, roundToInteger);
+    __m512 r = _mm512_sub_ps(clamped, _mm512_mul_ps(k, _mm512_set1_ps(kLn2High)));
+    r = _mm512_sub_ps(r, _mm512_mul_ps(k, _mm512_set1_ps(kLn2Low)));
+    __m512 p = _mm512_set1_ps(kExpP0);
+    p = _mm512_add_ps(_mm512_mul_ps(p, r), _mm512_set1_ps(kExpP1));
+    p = _mm512_add_ps(_mm512_mul_ps(p, r), _mm512_set1_ps(kExpP2));
+    p = _mm512_add_ps(_mm512_mul_ps(p, r), _mm512_set1_ps(kExpP3));
+    p = _mm512_add_ps(_mm512_mul_ps(p, r), _mm512_set1_ps(kExpP4));
+    p = _mm512_add_ps(_mm512_mul_ps(p, r), _mm512_set1_ps(kExpP5));
+    const __m512 y = _mm512_add_ps(_mm512_add_ps(_mm512_mul_ps(p, _mm512_mul_ps(r, r)), r), _mm512_set1_ps(1.0f));
+    const __m512i scaleBits = _mm512_maskz_slli_epi32(
+        all,
+        _mm512_add_epi32(_mm512_sub_epi32(_mm512_castps_si512(shifted), _mm512_castps_si512(roundToInteger)),
+                         _mm512_set1_epi32(127)),
+        23);
+    const __mmask16 underflow = _mm512_cmp_ps_mask(x, lowest, _CMP_LT_OQ);
+    return _mm512_maskz_mov_ps(__mmask16(~underflow), _mm512_mul_ps(y, _mm512_castsi512_ps(scaleBits)));
 }
 #endif
 

@@ -6,11 +6,14 @@
 /// The library is built for the x86-64 baseline (SSE2), as Debian builds it. The inner
 /// loops of the rasterization, the relaxation and the smoothing's normal rounds also have a
 /// copy compiled for AVX2 (eight lanes in one register instead of two), taken when the CPU
-/// has AVX2. Both copies give the same bits, which keeps meshes identical across machines:
-/// each lane does the same IEEE additions, multiplications, divisions and square roots (and
-/// the smoothing's integer exponent arithmetic) in the same order, and neither copy fuses a
-/// multiply-add (AVX2 alone does not enable FMA). tests/test_InstructionSet.cc
-/// compares the two on a real frame.
+/// has AVX2, and the normal rounds a third for AVX-512F (sixteen lanes), taken when it has
+/// that: their exponentials are multiplies and adds, which AVX-512 does twice as many of per
+/// instruction, while the rasterization and the relaxation wait on the divider, which it
+/// does not speed up. Every copy gives the same bits, which keeps meshes identical across
+/// machines: each lane does the same IEEE additions, multiplications, divisions and square
+/// roots (and the smoothing's integer exponent arithmetic) in the same order, and no copy
+/// fuses a multiply-add (the library is compiled with -ffp-contract=off).
+/// tests/test_InstructionSet.cc compares them on a real frame.
 
 #ifndef NONBLOPPY_INSTRUCTION_SET_H
 #define NONBLOPPY_INSTRUCTION_SET_H
@@ -28,9 +31,11 @@
 #if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
 #define NONBLOPPY_HAS_AVX2_COPY 1
 #define NONBLOPPY_TARGET_AVX2 __attribute__((target("avx2")))
+#define NONBLOPPY_TARGET_AVX512 __attribute__((target("avx512f")))
 #else
 #define NONBLOPPY_HAS_AVX2_COPY 0
 #define NONBLOPPY_TARGET_AVX2
+#define NONBLOPPY_TARGET_AVX512
 #endif
 
 namespace nonbloppy {
@@ -39,7 +44,8 @@ namespace instruction_set_internal {
 /// Which copy of a hot loop runs.
 enum class InstructionSet
 {
-    Auto,      ///< AVX2 when the CPU has it, else the baseline
+    Auto,      ///< the widest copy the CPU can run: AVX-512F, AVX2, else the baseline
+    Avx2,      ///< the AVX2 copy where the CPU has AVX2 (also where it has AVX-512), else the baseline
     Baseline,  ///< the x86-64 baseline (SSE2) copy, whatever the CPU
 };
 
@@ -48,7 +54,18 @@ enum class InstructionSet
 inline bool useAvx2(InstructionSet set)
 {
 #if NONBLOPPY_HAS_AVX2_COPY
-    return set == InstructionSet::Auto && __builtin_cpu_supports("avx2");
+    return set != InstructionSet::Baseline && __builtin_cpu_supports("avx2");
+#else
+    (void)set;
+    return false;
+#endif
+}
+
+/// Whether a loop's AVX-512F copy, where it has one, runs for @a set. Cost: as useAvx2().
+inline bool useAvx512(InstructionSet set)
+{
+#if NONBLOPPY_HAS_AVX2_COPY
+    return set == InstructionSet::Auto && __builtin_cpu_supports("avx512f");
 #else
     (void)set;
     return false;

@@ -1,8 +1,9 @@
 // SPDX-License-Identifier: Apache-2.0
 /// @file test_InstructionSet.cc
-/// @brief The AVX2 copies of the hot loops (src/InstructionSet.h) give the baseline copies'
-///        bits, so meshes are the same on every machine. On a CPU without AVX2 both runs
-///        take the baseline copy and the tests are skipped.
+/// @brief The AVX2 and AVX-512F copies of the hot loops (src/InstructionSet.h) give the
+///        baseline copies' bits, so meshes are the same on every machine. On a CPU without
+///        AVX2 every run takes the baseline copy and the tests are skipped; without AVX-512F,
+///        Auto takes the AVX2 copy and the AVX-512F exponential's test is skipped.
 
 #include "TestUtil.h"
 
@@ -115,11 +116,15 @@ TEST_F(SameBitsTest, SmoothSurfaceOfTheRelaxedFrame)
     relaxVertices(extracted, index, relax);
     SmoothSettings settings;
     settings.spatialWidth = kDefaultSmoothWidthOverSpacing * 0.05;
-    SurfaceMesh automatic = extracted, baseline = extracted;
+    // Auto takes the AVX-512F copy where the CPU has AVX-512F; Avx2 the AVX2 copy.
+    SurfaceMesh automatic = extracted, avx2 = extracted, baseline = extracted;
     smoothSurface(automatic, settings, nullptr, InstructionSet::Auto);
+    smoothSurface(avx2, settings, nullptr, InstructionSet::Avx2);
     smoothSurface(baseline, settings, nullptr, InstructionSet::Baseline);
     EXPECT_EQ(std::memcmp(automatic.points.data(), baseline.points.data(),
                           automatic.points.size() * sizeof(openvdb::Vec3s)), 0);
+    EXPECT_EQ(std::memcmp(avx2.points.data(), baseline.points.data(), avx2.points.size() * sizeof(openvdb::Vec3s)),
+              0);
     size_t moved = 0;
     for (size_t i = 0; i < extracted.points.size(); ++i) moved += automatic.points[i] != extracted.points[i];
     EXPECT_GT(moved, extracted.points.size() / 2);
@@ -127,6 +132,32 @@ TEST_F(SameBitsTest, SmoothSurfaceOfTheRelaxedFrame)
 
 #if NONBLOPPY_HAS_AVX2_COPY
 namespace {
+
+/// expNonPositiveAvx512() on sixteen values, and the scalar copy on each: whether all bits agree.
+NONBLOPPY_TARGET_AVX512 bool sameExponentials16(const float* x)
+{
+    alignas(64) float lanes[16];
+    _mm512_store_ps(lanes, exp_internal::expNonPositiveAvx512(_mm512_loadu_ps(x)));
+    for (int l = 0; l < 16; ++l) {
+        const float scalar = exp_internal::expNonPositive(x[l]);
+        if (std::memcmp(&scalar, &lanes[l], sizeof(float)) != 0) return false;
+    }
+    return true;
+}
+
+/// 2^23 arguments across [kExpLowest, 0] and the special ones, padded with zeros to a
+/// multiple of 16.
+std::vector<float> exponentialArguments()
+{
+    std::vector<float> x;
+    for (int i = 0; i <= (1 << 23); ++i) x.push_back(exp_internal::kExpLowest * float(i) / float(1 << 23));
+    for (float special : {0.0f, -0.0f, -87.34f, -88.0f, -1000.0f, -std::numeric_limits<float>::infinity(),
+                          std::numeric_limits<float>::quiet_NaN(), -std::numeric_limits<float>::denorm_min()}) {
+        x.push_back(special);
+    }
+    while (x.size() % 16) x.push_back(0.0f);
+    return x;
+}
 
 /// expNonPositiveAvx2() on eight values, and the scalar copy on each: whether all bits agree.
 NONBLOPPY_TARGET_AVX2 bool sameExponentials(const float* x)
@@ -144,17 +175,19 @@ NONBLOPPY_TARGET_AVX2 bool sameExponentials(const float* x)
 
 TEST_F(SameBitsTest, ExponentialOverItsWholeRange)
 {
-    // 2^23 arguments across [kExpLowest, 0] and the special ones: every lane gives the
-    // scalar copy's bits.
-    std::vector<float> x;
-    for (int i = 0; i <= (1 << 23); ++i) x.push_back(exp_internal::kExpLowest * float(i) / float(1 << 23));
-    for (float special : {0.0f, -0.0f, -87.34f, -88.0f, -1000.0f, -std::numeric_limits<float>::infinity(),
-                          std::numeric_limits<float>::quiet_NaN(), -std::numeric_limits<float>::denorm_min()}) {
-        x.push_back(special);
-    }
-    while (x.size() % 8) x.push_back(0.0f);
+    // Every lane gives the scalar copy's bits.
+    const std::vector<float> x = exponentialArguments();
     size_t differing = 0;
     for (size_t i = 0; i < x.size(); i += 8) differing += !sameExponentials(&x[i]);
+    EXPECT_EQ(differing, 0u);
+}
+
+TEST_F(SameBitsTest, SixteenLaneExponentialOverItsWholeRange)
+{
+    if (!useAvx512(InstructionSet::Auto)) GTEST_SKIP() << "no AVX-512F here";
+    const std::vector<float> x = exponentialArguments();
+    size_t differing = 0;
+    for (size_t i = 0; i < x.size(); i += 16) differing += !sameExponentials16(&x[i]);
     EXPECT_EQ(differing, 0u);
 }
 #endif

@@ -66,11 +66,12 @@ struct SmoothSettings
 /// Cost: once, the list of each face's neighbours (9 for a quad of a regular grid, found by
 /// sorting the faces around its corners) with the spatial part of their weights; then per
 /// normal round one exponential per neighbour (eight faces at a time where the CPU has
-/// AVX2), per vertex round one pass over the faces around each vertex. Parallel over faces
-/// and vertices. Scratch about 140 bytes per quad. On the 64x benchmark input's surface
-/// (2.39M vertices, 2.37M quads, `--spacing 0.0467157`, two threads) the defaults take
-/// 3.15–3.28 s, about 40% of it the normal rounds (4.34–4.50 s with glibc's expf one face
-/// at a time and separate normal and centroid arrays). Deterministic: each element reads only
+/// AVX2, sixteen where it has AVX-512F), per vertex round one pass over the faces around each
+/// vertex. Parallel over faces and vertices. Scratch about 140 bytes per quad. On the 64x
+/// benchmark input's surface (2.39M vertices, 2.37M quads, `--spacing 0.0467157`, two
+/// threads, an AVX-512 Xeon) the defaults take 2.82–2.86 s, about a third of it the normal
+/// rounds (3.15–3.17 s eight faces at a time; 4.34–4.50 s with glibc's expf one face at a
+/// time and separate normal and centroid arrays). Deterministic: each element reads only
 /// the previous round, in a fixed order, so the result is the same bits for any thread count.
 /// @param mesh         vertices moved; polygon indices must be valid (see measureMesh())
 /// @param settings     the filter's widths and rounds; spatialWidth has no default
