@@ -57,10 +57,6 @@ void computeNormals(SurfaceMesh& mesh, CancelPoll& poll)
     const size_t polygonCount = triangleCount + mesh.quads.size();
     const size_t blockCount = (polygonCount + kPolygonsPerBlock - 1) / kPolygonsPerBlock;
     const auto blockEnd = [&](size_t block) { return std::min(polygonCount, (block + 1) * kPolygonsPerBlock); };
-    const auto cornersOf = [&](size_t polygon) {
-        return polygon < triangleCount ? std::make_pair(mesh.triangles[polygon].asPointer(), 3)
-                                       : std::make_pair(mesh.quads[polygon - triangleCount].asPointer(), 4);
-    };
 
     // The ranges of each block, in parallel with allocating the normals where mesh.normals
     // cannot hold them: resize() zero-fills in one thread (29 MB and 7,000 page faults for the
@@ -79,7 +75,7 @@ void computeNormals(SurfaceMesh& mesh, CancelPoll& poll)
                         b.lowest = std::numeric_limits<uint32_t>::max();
                         uint32_t lastRange = std::numeric_limits<uint32_t>::max();  // most corners repeat it
                         for (size_t n = block * kPolygonsPerBlock; n < blockEnd(block); ++n) {
-                            const auto [corners, cornerCount] = cornersOf(n);
+                            const auto [corners, cornerCount] = polygon_indices_internal::cornersOf(mesh, n);
                             for (int k = 0; k < cornerCount; ++k) {
                                 b.highestCorner = std::max(b.highestCorner, corners[k]);
                                 const uint32_t r = uint32_t(corners[k] / kVerticesPerRange);

@@ -64,24 +64,19 @@ std::string
 polygon_indices_internal::firstBadIndex(const SurfaceMesh& mesh)
 {
     const size_t vertexCount = mesh.points.size();
-    const size_t triangleCount = mesh.triangles.size(), polygonCount = triangleCount + mesh.quads.size();
-    const auto cornersOf = [&](size_t polygon) {
-        return polygon < triangleCount
-            ? std::make_pair(mesh.triangles[polygon].asPointer(), 3)
-            : std::make_pair(mesh.quads[polygon - triangleCount].asPointer(), 4);
-    };
+    const size_t polygonCount = mesh.triangles.size() + mesh.quads.size();
     const auto outOfRange = [&](uint32_t index) { return index >= vertexCount; };
     const size_t bad = tbb::parallel_reduce(tbb::blocked_range<size_t>(0, polygonCount), polygonCount,
         [&](const tbb::blocked_range<size_t>& range, size_t found) {
             for (size_t n = range.begin(); n < range.end() && n < found; ++n) {
-                const auto [corners, count] = cornersOf(n);
+                const auto [corners, count] = cornersOf(mesh, n);
                 if (std::any_of(corners, corners + count, outOfRange)) return n;
             }
             return found;
         },
         [](size_t a, size_t b) { return std::min(a, b); });
     if (bad == polygonCount) return std::string();
-    const auto [corners, count] = cornersOf(bad);
+    const auto [corners, count] = cornersOf(mesh, bad);
     return badIndexMessage(bad, *std::find_if(corners, corners + count, outOfRange), vertexCount);
 }
 
@@ -140,7 +135,7 @@ measureMesh(const SurfaceMesh& mesh)
     m.area = sums.area;
     m.volume = sums.volume;
     const size_t vertexCount = mesh.points.size();
-    const size_t triangleCount = mesh.triangles.size(), polygonCount = m.polygons;
+    const size_t polygonCount = m.polygons;
     m.nonFiniteVertices = tbb::parallel_reduce(tbb::blocked_range<size_t>(0, vertexCount), size_t(0),
         [&](const tbb::blocked_range<size_t>& range, size_t count) {
             for (size_t i = range.begin(); i < range.end(); ++i) {
@@ -155,12 +150,8 @@ measureMesh(const SurfaceMesh& mesh)
     // prefix sums, then every edge put in one of its vertex's slots), as its other end and
     // direction; then each vertex's few edges are sorted and their runs counted. Only counts
     // come out, so the order in which the threads file the edges does not matter.
-    const auto cornersOf = [&](size_t polygon) {
-        return polygon < triangleCount ? std::make_pair(mesh.triangles[polygon].asPointer(), 3)
-                                       : std::make_pair(mesh.quads[polygon - triangleCount].asPointer(), 4);
-    };
     const auto forEachEdge = [&](size_t polygon, auto&& visit) {
-        const auto [corners, count] = cornersOf(polygon);
+        const auto [corners, count] = polygon_indices_internal::cornersOf(mesh, polygon);
         for (int i = 0; i < count; ++i) {
             const uint32_t from = corners[i], to = corners[(i + 1) % count];
             if (from != to) visit(from, to);  // a collapsed edge bounds nothing
@@ -171,7 +162,7 @@ measureMesh(const SurfaceMesh& mesh)
     tbb::parallel_for(tbb::blocked_range<size_t>(0, polygonCount), [&](const tbb::blocked_range<size_t>& range) {
         for (size_t n = range.begin(); n < range.end(); ++n) {
             // Every corner is used, those of a polygon collapsed to one point too.
-            const auto [corners, count] = cornersOf(n);
+            const auto [corners, count] = polygon_indices_internal::cornersOf(mesh, n);
             for (int i = 0; i < count; ++i) used[corners[i]].store(1, std::memory_order_relaxed);
             forEachEdge(n, [&](uint32_t from, uint32_t to) {
                 filed[std::min(from, to)].fetch_add(1, std::memory_order_relaxed);

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 /// @file PolygonIndices.h
-/// @brief Private: the one check that a mesh's polygons reference only its vertices, and its
-///        message. Only src/ includes it.
+/// @brief Private: a polygon's corners by its number, and the one check that a mesh's
+///        polygons reference only its vertices, with its message. Only src/ includes it.
 
 #ifndef NONBLOPPY_POLYGON_INDICES_H
 #define NONBLOPPY_POLYGON_INDICES_H
@@ -10,9 +10,19 @@
 
 #include <cstdint>
 #include <string>
+#include <utility>
 
 namespace nonbloppy {
 namespace polygon_indices_internal {
+
+/// The corners of polygon @a polygon of @a mesh, numbered as the writers number them
+/// (triangles first, then quads): a pointer to its vertex indices and their count, 3 or 4.
+inline std::pair<const uint32_t*, int> cornersOf(const SurfaceMesh& mesh, size_t polygon)
+{
+    const size_t triangleCount = mesh.triangles.size();
+    return polygon < triangleCount ? std::make_pair(mesh.triangles[polygon].asPointer(), 3)
+                                   : std::make_pair(mesh.quads[polygon - triangleCount].asPointer(), 4);
+}
 
 /// "polygon P references vertex I but the mesh has N vertices".
 std::string badIndexMessage(size_t polygon, uint32_t index, size_t vertexCount);
