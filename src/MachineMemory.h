@@ -7,6 +7,8 @@
 #ifndef NONBLOPPY_MACHINE_MEMORY_H
 #define NONBLOPPY_MACHINE_MEMORY_H
 
+#include <nonbloppy/Error.h>
+
 #include <sys/resource.h>
 #include <unistd.h>
 
@@ -134,6 +136,21 @@ inline double memoryHeadroomBytes()
     const double cgroup = cgroupHeadroomBytes();
     if (cgroup >= 0.0) headroom = headroom >= 0.0 ? std::min(headroom, cgroup) : cgroup;
     return headroom;
+}
+
+/// Throw ParameterError("<need>, more than the 2.7 GB this process can still take: <advice>")
+/// if @a bytes exceed memoryHeadroomBytes(); nothing where the headroom is unknown. The check
+/// of every stage whose memory grows with its input, made before it allocates.
+/// @a describe() is called only then, and returns {need, advice}: what would take the bytes
+/// ("smoothing the surface (N polygons) would take another 146 MB") and what to give instead.
+template<typename DescribeT>
+void requireHeadroom(double bytes, DescribeT&& describe)
+{
+    const double headroom = memoryHeadroomBytes();
+    if (!(headroom >= 0.0) || !(bytes > headroom)) return;
+    const std::pair<std::string, std::string> needAndAdvice = describe();
+    throw ParameterError(needAndAdvice.first + ", more than the " + formatBytes(headroom)
+                         + " this process can still take: " + needAndAdvice.second);
 }
 
 } // namespace machine_memory_internal

@@ -69,17 +69,16 @@ double bandVoxelsOf(double area, const openvdb::BBoxd& bounds, double voxelSize,
 void requireBandFitsInMemory(double area, const openvdb::BBoxd& bounds, double voxelSize, float halfWidth)
 {
     const double bandVoxels = bandVoxelsOf(area, bounds, voxelSize, halfWidth);
-    const double needed = bandVoxels * kPeakBytesPerBandVoxel, available = machine_memory_internal::memoryHeadroomBytes();
-    if (available >= 0.0 && needed > available) {
-        std::ostringstream msg;
-        msg.precision(2);
-        msg << "the level set's narrow band would hold about " << bandVoxels << " voxels, about "
-            << machine_memory_internal::formatBytes(needed) << " at its peak, more than the "
-            << machine_memory_internal::formatBytes(available)
-            << " this process can still take: use a voxel size larger than " << voxelSize
-            << " or a half width below " << halfWidth;
-        throw ParameterError(msg.str());
-    }
+    const double needed = bandVoxels * kPeakBytesPerBandVoxel;
+    machine_memory_internal::requireHeadroom(needed, [&] {
+        std::ostringstream need, advice;
+        need.precision(2);
+        advice.precision(2);
+        need << "the level set's narrow band would hold about " << bandVoxels << " voxels, about "
+             << machine_memory_internal::formatBytes(needed) << " at its peak";
+        advice << "use a voxel size larger than " << voxelSize << " or a half width below " << halfWidth;
+        return std::make_pair(need.str(), advice.str());
+    });
 }
 
 } // namespace

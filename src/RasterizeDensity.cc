@@ -54,17 +54,15 @@ constexpr double kBytesPerDensityLeaf = double(sizeof(FloatLeaf)) + double(Float
 void requireMemoryFor(double fewestBytes, double mostBytes, const std::string& what, double voxelSize,
                       double effectiveRadius)
 {
-    const double headroom = machine_memory_internal::memoryHeadroomBytes();
-    if (!(headroom >= 0.0) || !(fewestBytes > headroom)) return;
-    using machine_memory_internal::formatBytes;
-    std::ostringstream msg;
-    msg.precision(3);
-    msg << what << " of these particles at --voxel-size " << voxelSize << " and --radius " << effectiveRadius
-        << " would take " << formatBytes(fewestBytes);
-    if (mostBytes > fewestBytes) msg << " to " << formatBytes(mostBytes);
-    msg << ", more than the " << formatBytes(headroom)
-        << " this process can still take: give a larger --voxel-size or a smaller --radius";
-    throw ParameterError(msg.str());
+    machine_memory_internal::requireHeadroom(fewestBytes, [&] {
+        using machine_memory_internal::formatBytes;
+        std::ostringstream need;
+        need.precision(3);
+        need << what << " of these particles at --voxel-size " << voxelSize << " and --radius " << effectiveRadius
+             << " would take " << formatBytes(fewestBytes);
+        if (mostBytes > fewestBytes) need << " to " << formatBytes(mostBytes);
+        return std::make_pair(need.str(), std::string("give a larger --voxel-size or a smaller --radius"));
+    });
 }
 
 /// Bytes of the density grid whose leaves have @a origins (sorted, distinct): the leaves,

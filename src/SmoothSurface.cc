@@ -18,6 +18,8 @@
 #include <cstddef>
 #include <cstdint>
 #include <sstream>
+#include <string>
+#include <utility>
 #include <vector>
 
 namespace nonbloppy {
@@ -31,22 +33,19 @@ using openvdb::Vec3s;
 
 /// @throw ParameterError("smoothing the surface (N polygons) would take another 176 MB, more
 ///        than the 100 MB this process can still take: give --no-smooth to skip it") if
-///        @a bytes more do not fit in what the process can still allocate
-///        (memoryHeadroomBytes(): the machine, ulimit -v and -d, the memory cgroup). The
+///        @a bytes more do not fit in what the process can still allocate (requireHeadroom():
+///        the machine, ulimit -v and -d, the memory cgroup). The
 ///        smoothing's scratch is larger than the density grid's on the same particles (on
 ///        the 64x benchmark input 552 MiB peak against 314 without it), so the density's
 ///        check before rasterizing does not cover it; past a batch scheduler's limit the
 ///        kernel ends the process without a word.
 void requireMemoryForSmoothing(double bytes, size_t polygonCount)
 {
-    const double headroom = machine_memory_internal::memoryHeadroomBytes();
-    if (!(headroom >= 0.0) || !(bytes > headroom)) return;
-    std::ostringstream msg;
-    msg << "smoothing the surface (" << polygonCount << " polygons) would take another "
-        << machine_memory_internal::formatBytes(bytes) << ", more than the "
-        << machine_memory_internal::formatBytes(headroom)
-        << " this process can still take: give --no-smooth to skip it";
-    throw ParameterError(msg.str());
+    machine_memory_internal::requireHeadroom(bytes, [&] {
+        return std::make_pair("smoothing the surface (" + std::to_string(polygonCount) + " polygons) would take another "
+                                  + machine_memory_internal::formatBytes(bytes),
+                              std::string("give --no-smooth to skip it"));
+    });
 }
 
 /// One polygon's corners: three for a triangle, four for a quad.
