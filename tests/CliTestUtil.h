@@ -125,10 +125,21 @@ protected:
     std::string out(const std::string& name) const { return mDir + "/out/" + name; }
 
     /// Run `nonbloppy ARGS` (ARGS already shell-quoted) with stdout and stderr in files.
-    RunResult run(const std::string& args) const
+    RunResult run(const std::string& args) const { return runAfter("", args); }
+
+    /// run() under `ulimit -v @a kilobytes`, a limit on the address space as a batch
+    /// scheduler sets it.
+    RunResult runWithAddressLimit(size_t kilobytes, const std::string& args) const
+    {
+        return runAfter("ulimit -v " + std::to_string(kilobytes) + " && ", args);
+    }
+
+private:
+    /// run() with the shell command @a prefix before it.
+    RunResult runAfter(const std::string& prefix, const std::string& args) const
     {
         const std::string outFile = mDir + "/stdout.txt", errFile = mDir + "/stderr.txt";
-        const std::string command = quote(kCli) + " " + args + " >" + quote(outFile) + " 2>"
+        const std::string command = prefix + quote(kCli) + " " + args + " >" + quote(outFile) + " 2>"
                                     + quote(errFile) + " </dev/null";
         const int status = std::system(command.c_str());
         RunResult result;
@@ -138,6 +149,7 @@ protected:
         return result;
     }
 
+protected:
     /// The failure contract: exit @a exitCode (1: an error, 2: a bad command line), exactly
     /// one stderr line, equal to "nonbloppy: " + @a message, and nothing (not even a
     /// temporary file) in out/.

@@ -135,6 +135,20 @@ TEST_F(CliTest, WarnsWhenRelaxationIsTooStrongForTheCalibration)
     EXPECT_TRUE(given.err.empty()) << given.err;
 }
 
+/// A memory check's refusal: exit 1, stderr one line from @a head to @a tail, what the process
+/// can still take between them (it depends on the machine), and nothing in @a outDir.
+/// Returns stderr.
+std::string expectMemoryRefusal(const RunResult& r, const std::string& head, const std::string& tail,
+                                const std::string& outDir)
+{
+    EXPECT_EQ(r.exitCode, 1);
+    EXPECT_EQ(r.err.rfind(head, 0), 0u) << r.err;
+    EXPECT_GT(r.err.size(), head.size() + tail.size());
+    if (r.err.size() >= tail.size()) EXPECT_EQ(r.err.substr(r.err.size() - tail.size()), tail) << r.err;
+    EXPECT_TRUE(listDir(outDir).empty());
+    return r.err;
+}
+
 TEST_F(CliTest, ADensityGridLargerThanTheMemoryIsRefusedBeforeItIsAllocated)
 {
 #if defined(NONBLOPPY_TEST_ASAN)
@@ -148,23 +162,19 @@ TEST_F(CliTest, ADensityGridLargerThanTheMemoryIsRefusedBeforeItIsAllocated)
         csv += std::to_string(3 * (i % 16)) + "," + std::to_string(3 * (i / 16 % 16)) + "," + std::to_string(3 * (i / 256))
                + "\n";
     }
-    const std::string input = dir() + "/in/sparse.csv", err = dir() + "/err.txt";
+    const std::string input = in("sparse.csv");
     writeText(input, csv);
-    const std::string command = "ulimit -v 1500000 && " + quote(kCli) + " mesh " + quote(input) + " -o "
-                                + quote(out("s.ply")) + " --radius 1 --voxel-size 0.0325 --threshold 2 2>" + quote(err);
-    const int status = std::system(("sh -c " + quote(command)).c_str());
-    ASSERT_TRUE(WIFEXITED(status));
-    EXPECT_EQ(WEXITSTATUS(status), 1);
+    const RunResult r = runWithAddressLimit(
+        1500000, "mesh " + quote(input) + " -o " + quote(out("s.ply")) + " --radius 1 --voxel-size 0.0325 --threshold 2");
     // What the process can still take is the limit less what it holds by then (libraries,
     // thread stacks, the particles and their index): below 1.54 GB.
-    const std::string message = readText(err);
     const std::string head = "nonbloppy: " + input + ": the density grid (up to 5088448 leaves of 8^3 voxels) of "
                              "these particles at --voxel-size 0.0325 and --radius 1 would take 5.57 GB to 11.1 GB, more "
                              "than the ";
     const std::string tail = " this process can still take: give a larger --voxel-size or a smaller --radius\n";
-    ASSERT_EQ(message.rfind(head, 0), 0u) << message;
+    const std::string message = expectMemoryRefusal(r, head, tail, dir() + "/out");
+    ASSERT_EQ(message.rfind(head, 0), 0u);
     ASSERT_GT(message.size(), head.size() + tail.size());
-    EXPECT_EQ(message.substr(message.size() - tail.size()), tail) << message;
     size_t digits = 0;
     double headroom = std::stod(message.substr(head.size()), &digits);  // in GB, or MB below 1 GB
     const std::string unit = message.substr(head.size() + digits, 3);
@@ -172,7 +182,6 @@ TEST_F(CliTest, ADensityGridLargerThanTheMemoryIsRefusedBeforeItIsAllocated)
     else EXPECT_EQ(unit, " GB") << message;
     EXPECT_GT(headroom, 0.5);
     EXPECT_LT(headroom, 1.54);
-    EXPECT_TRUE(listDir(dir() + "/out").empty());
 #endif
 }
 
@@ -185,8 +194,8 @@ TEST_F(CliTest, ASmoothingLargerThanTheMemoryIsRefusedBeforeItIsAllocated)
     // more memory than the density grid, the mesh and the relaxation before it (146 MB of
     // scratch on top of a 141 MB peak). Under a 550 MB limit of address space every stage
     // before it fits (from about 430 MB: "out of memory" below) and the smoothing does not
-    // (up to about 680 MB); without the check the kernel's OOM killer ends such a run on a
-    // farm node with nothing said.
+    // (up to 700-720 MB, where a build without the check fails too); without the check the
+    // kernel's OOM killer ends such a run on a farm node with nothing said.
     std::string xyz;
     for (int i = 0; i < 500; ++i) {
         for (int j = 0; j < 500; ++j) {
@@ -194,24 +203,15 @@ TEST_F(CliTest, ASmoothingLargerThanTheMemoryIsRefusedBeforeItIsAllocated)
             xyz.append(reinterpret_cast<const char*>(position), sizeof(position));
         }
     }
-    const std::string input = dir() + "/in/sheet.xyz", err = dir() + "/err.txt";
+    const std::string input = in("sheet.xyz");
     writeText(input, xyz);
-    const std::string command = "ulimit -v 550000 && " + quote(kCli) + " mesh " + quote(input) + " -o "
-                                + quote(out("sheet.ply")) + " --spacing 1 --threads 2 -q 2>" + quote(err);
-    const int status = std::system(("sh -c " + quote(command)).c_str());
-    ASSERT_TRUE(WIFEXITED(status));
-    EXPECT_EQ(WEXITSTATUS(status), 1);
-    const std::string message = readText(err);
-    const std::string head = "nonbloppy: " + input + ": smoothing the surface (2023982 polygons) would take another ";
-    const std::string tail = " this process can still take: give --no-smooth to skip it\n";
-    ASSERT_EQ(message.rfind(head, 0), 0u) << message;
-    ASSERT_GT(message.size(), head.size() + tail.size());
-    EXPECT_EQ(message.substr(message.size() - tail.size()), tail) << message;
-    EXPECT_TRUE(listDir(dir() + "/out").empty());
+    const std::string args = "mesh " + quote(input) + " -o " + quote(out("sheet.ply")) + " --spacing 1 --threads 2 -q";
+    expectMemoryRefusal(runWithAddressLimit(550000, args),
+                        "nonbloppy: " + input + ": smoothing the surface (2023982 polygons) would take another ",
+                        " this process can still take: give --no-smooth to skip it\n", dir() + "/out");
     // The same sheet without the smoothing fits.
-    const std::string unsmoothed = "ulimit -v 550000 && " + quote(kCli) + " mesh " + quote(input) + " -o "
-                                   + quote(out("sheet.ply")) + " --spacing 1 --threads 2 --no-smooth -q";
-    EXPECT_EQ(std::system(("sh -c " + quote(unsmoothed)).c_str()), 0);
+    const RunResult unsmoothed = runWithAddressLimit(550000, args + " --no-smooth");
+    EXPECT_EQ(unsmoothed.exitCode, 0) << unsmoothed.err;
 #endif
 }
 
