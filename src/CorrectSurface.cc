@@ -17,9 +17,12 @@
 
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_pipeline.h>
+#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
 #include <sstream>
 #include <string>
 
@@ -123,26 +126,27 @@ inline openvdb::Vec3d triangleNormal(const openvdb::Vec3s& a, const openvdb::Vec
     return twiceVectorArea(openvdb::Vec3d(a), openvdb::Vec3d(b), openvdb::Vec3d(c));
 }
 
-/// Call @a op(i, j, k) for every triangle of the mesh (quads split along 0–2); asks @a poll
-/// every kItemsPerPoll polygons and throws its CancelledError on a stop.
+/// Call @a op(i, j, k) for every triangle of polygons [first, end) of the mesh (triangles,
+/// then quads; quads split along 0–2), in that order.
 template<typename OpT>
-void forEachTriangle(const SurfaceMesh& mesh, CancelPoll& poll, OpT&& op)
+void forEachTriangleOf(const SurfaceMesh& mesh, size_t first, size_t end, OpT&& op)
 {
-    for (size_t n = 0; n < mesh.triangles.size(); ++n) {
-        if (poll.stoppedAt(n)) poll.throwIfStopped();
-        const openvdb::Vec3I& t = mesh.triangles[n];
-        op(t[0], t[1], t[2]);
-    }
-    for (size_t n = 0; n < mesh.quads.size(); ++n) {
-        if (poll.stoppedAt(n)) poll.throwIfStopped();
-        const openvdb::Vec4I& q = mesh.quads[n];
-        op(q[0], q[1], q[2]);
-        op(q[0], q[2], q[3]);
+    const size_t triangleCount = mesh.triangles.size();
+    for (size_t n = first; n < end; ++n) {
+        if (n < triangleCount) {
+            const openvdb::Vec3I& t = mesh.triangles[n];
+            op(t[0], t[1], t[2]);
+        } else {
+            const openvdb::Vec4I& q = mesh.quads[n - triangleCount];
+            op(q[0], q[1], q[2]);
+            op(q[0], q[2], q[3]);
+        }
     }
 }
 
 /// Call @a op(a, b) for every edge of every polygon, in polygon order (triangles, then
-/// quads), each polygon's edges in its winding; asks @a poll as forEachTriangle().
+/// quads), each polygon's edges in its winding; asks @a poll every kItemsPerPoll polygons
+/// and throws its CancelledError on a stop.
 template<typename OpT>
 void forEachPolygonEdge(const SurfaceMesh& mesh, CancelPoll& poll, OpT&& op)
 {
@@ -233,18 +237,87 @@ std::vector<double> vertexConvexity(const SurfaceMesh& mesh, CancelPoll& poll)
     return convexity;
 }
 
-/// A third of the area of every triangle around each vertex (quads split along 0–2): the
-/// volume the surface sweeps when vertex i moves by δ along its normal is about Σ δ·area_i.
-std::vector<double> vertexAreas(const SurfaceMesh& mesh, CancelPoll& poll)
+/// What a volume-correction pass measures of the mesh (quads split along 0–2).
+struct PassMeasures
 {
-    std::vector<double> area(mesh.points.size(), 0.0);
-    forEachTriangle(mesh, poll, [&](unsigned i, unsigned j, unsigned k) {
-        const double third = triangleNormal(mesh.points[i], mesh.points[j], mesh.points[k]).length() / 6.0;
-        area[i] += third;
-        area[j] += third;
-        area[k] += third;
-    });
-    return area;
+    AreaAndVolume total;             ///< measureAreaAndVolume()'s, to the last bit
+    /// A third of the area of every triangle around each vertex: the volume the surface
+    /// sweeps when vertex i moves by δ along its normal is about Σ δ·vertexArea_i.
+    std::vector<double> vertexArea;
+};
+
+/// The mesh's area and volume, summed triangle by triangle in polygon order as
+/// measureAreaAndVolume() sums them, and every vertex's area, each vertex's thirds added in
+/// the same order: the same bits as the serial loops that did this before. The per-triangle
+/// terms (a cross product, its length, a triple product) are computed in parallel, a block of
+/// polygons at a time, while one thread adds up the blocks before, in order (a pipeline).
+/// 64x benchmark input, --spacing, two threads: a pass took 0.034 s for the area and volume
+/// plus 0.033 s for the vertex areas as two serial loops, 0.027–0.033 s this way (0.044–0.049
+/// s at one thread). Scratch: 24 bytes per triangle of the blocks in flight. Asks @a poll
+/// between blocks.
+PassMeasures measurePass(const SurfaceMesh& mesh, CancelPoll& poll)
+{
+    constexpr size_t kBlockPolygons = 16384;
+    const size_t triangleCount = mesh.triangles.size();
+    const size_t polygonCount = triangleCount + mesh.quads.size();
+    const size_t blockCount = (polygonCount + kBlockPolygons - 1) / kBlockPolygons;
+    /// Per triangle of a block, in order (a quad's two after each other): its area, six
+    /// times its signed volume, and a third of its area.
+    struct BlockTerms
+    {
+        size_t first = 0, end = 0;  ///< polygons [first, end)
+        std::vector<double> area, sixVolume, third;
+    };
+    PassMeasures out;
+    out.vertexArea.assign(mesh.points.size(), 0.0);
+    size_t nextBlock = 0;
+    const size_t threads = size_t(std::max(1, tbb::this_task_arena::max_concurrency()));
+    tbb::parallel_pipeline(threads + 1,
+        tbb::make_filter<void, std::shared_ptr<BlockTerms>>(tbb::filter_mode::serial_in_order,
+            [&](tbb::flow_control& control) {
+                if (nextBlock == blockCount || poll.stopped()) {
+                    control.stop();
+                    return std::shared_ptr<BlockTerms>();
+                }
+                auto block = std::make_shared<BlockTerms>();
+                block->first = nextBlock * kBlockPolygons;
+                block->end = std::min(polygonCount, block->first + kBlockPolygons);
+                ++nextBlock;
+                return block;
+            })
+        & tbb::make_filter<std::shared_ptr<BlockTerms>, std::shared_ptr<BlockTerms>>(tbb::filter_mode::parallel,
+            [&](std::shared_ptr<BlockTerms> block) {
+                size_t triangles = 0;
+                for (size_t n = block->first; n < block->end; ++n) triangles += n < triangleCount ? 1 : 2;
+                block->area.resize(triangles);
+                block->sixVolume.resize(triangles);
+                block->third.resize(triangles);
+                size_t slot = 0;
+                forEachTriangleOf(mesh, block->first, block->end, [&](unsigned i, unsigned j, unsigned k) {
+                    const openvdb::Vec3d a(mesh.points[i]), b(mesh.points[j]), c(mesh.points[k]);
+                    const double length = twiceVectorArea(a, b, c).length();
+                    block->area[slot] = 0.5 * length;
+                    block->sixVolume[slot] = sixTimesSignedVolume(a, b, c);
+                    block->third[slot] = length / 6.0;
+                    ++slot;
+                });
+                return block;
+            })
+        & tbb::make_filter<std::shared_ptr<BlockTerms>, void>(tbb::filter_mode::serial_in_order,
+            [&](std::shared_ptr<BlockTerms> block) {
+                size_t slot = 0;
+                forEachTriangleOf(mesh, block->first, block->end, [&](unsigned i, unsigned j, unsigned k) {
+                    out.total.area += block->area[slot];
+                    out.total.volume += block->sixVolume[slot] / 6.0;
+                    const double third = block->third[slot];
+                    out.vertexArea[i] += third;
+                    out.vertexArea[j] += third;
+                    out.vertexArea[k] += third;
+                    ++slot;
+                });
+            }));
+    poll.throwIfStopped();
+    return out;
 }
 
 void requireTargetVolume(double targetVolume)
@@ -448,8 +521,9 @@ double surface_stages_internal::preserveVolumeUnchecked(SurfaceMesh& mesh, const
     std::vector<double> moved(mesh.points.size(), 0.0);
     for (int pass = 0; pass < kPasses; ++pass) {
         poll.throwIfStopped();
-        const AreaAndVolume measures = measureAreaAndVolume(mesh);  // serial, O(P)
-        const std::vector<double> area = vertexAreas(mesh, poll);
+        const PassMeasures measured = measurePass(mesh, poll);
+        const AreaAndVolume& measures = measured.total;
+        const std::vector<double>& area = measured.vertexArea;
         double sweptPerUnit = 0.0;
         for (size_t i = 0; i < share.size(); ++i) sweptPerUnit += share[i] * area[i];
         if (!(sweptPerUnit > 0.0)) break;

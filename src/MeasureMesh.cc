@@ -7,6 +7,7 @@
 #include <nonbloppy/Error.h>
 
 #include "PolygonIndices.h"
+#include "VectorArea.h"
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -38,10 +39,9 @@ double
 addTriangle(const SurfaceMesh& mesh, uint32_t i0, uint32_t i1, uint32_t i2, AreaAndVolume& m)
 {
     const openvdb::Vec3d p0(mesh.points[i0]), p1(mesh.points[i1]), p2(mesh.points[i2]);
-    const double area = 0.5 * (p1 - p0).cross(p2 - p0).length();
+    const double area = 0.5 * twiceVectorArea(p0, p1, p2).length();
     m.area += area;
-    // Divergence theorem: the volume is the sum over faces of p0 · (p1 × p2) / 6.
-    m.volume += p0.dot(p1.cross(p2)) / 6.0;
+    m.volume += sixTimesSignedVolume(p0, p1, p2) / 6.0;
     return area;
 }
 
