@@ -158,11 +158,15 @@ NONBLOPPY_API double preserveVolume(SurfaceMesh& mesh, double targetVolume,
 ///        the offset is not a VolumeOffset enumerator, normals are missing or a polygon has
 ///        a corner out of range (as countFoldedTriangles(); checked before anything moves);
 ///        CancelledError("interrupted during correct surface") when @a interrupter says
-///        stop (asked every 4096 polygons of each serial pass and inside
-///        computeNormals(); a stop leaves the mesh partly offset).
-/// Cost: Convex: one serial pass over the polygons for the convexity, then per pass
-/// measureAreaAndVolume() and vertex areas (serial, O(P)), the offset and computeNormals(); scratch
-/// up to 36 bytes per vertex (while the convexity is measured), 24 after. Deterministic. Thread-safety: reentrant; the mesh is written.
+///        stop (asked every 4096 polygons of the convexity pass, between blocks of 16,384
+///        polygons of each measuring pass and inside computeNormals(); a stop leaves the
+///        mesh partly offset).
+/// Cost: Convex: one serial pass over the polygons for the convexity, then per pass the
+/// area, volume and vertex areas (O(P): the per-triangle terms in parallel, their sums in
+/// polygon order, so the same bits as measureAreaAndVolume()), the offset and
+/// computeNormals(); scratch up to 36 bytes per vertex (while the convexity is measured), 24
+/// after, plus 24 bytes per triangle of the blocks in flight. Deterministic. Thread-safety:
+/// reentrant; the mesh is written.
 NONBLOPPY_API double preserveVolume(SurfaceMesh& mesh, const VolumeSettings& settings,
                                     openvdb::util::NullInterrupter* interrupter = nullptr);
 
