@@ -56,8 +56,11 @@ NONBLOPPY_API std::vector<const ParticleAttribute*> checkAttributes(const Partic
 /// interpolated independently. An attribute already on the mesh under the same name is
 /// replaced (also on a mesh without vertices).
 /// Cost: a ParticleIndex of the particles with cells of r_e (O(N), not interruptible), then
-/// V · (particles within r_e) kernel evaluations, parallel over vertices; sums run in a
-/// fixed order in double, so the result does not depend on the thread count.
+/// per vertex the distances to the particles of its 3³ cells (about 260 at r_e = 2 s, four at
+/// a time) and the kernel at the ones within r_e (about 40), parallel over vertices; sums
+/// run in a fixed order in double, so the result does not depend on the thread count. The
+/// 64x benchmark input with the dam-break frame's id and velocity: 0.47 s for 2.4M vertices
+/// (two threads), against 0.22 s for the two relaxation steps before it.
 /// @param mesh         vertices to sample at; gets (or has replaced) one attribute per name
 /// @param particles    positions and attributes, world units; only read
 /// @param names        attribute names, as resolveAttributeNames() takes them ("all" for every one)
