@@ -131,16 +131,10 @@ inline openvdb::Vec3d triangleNormal(const openvdb::Vec3s& a, const openvdb::Vec
 template<typename OpT>
 void forEachTriangleOf(const SurfaceMesh& mesh, size_t first, size_t end, OpT&& op)
 {
-    const size_t triangleCount = mesh.triangles.size();
     for (size_t n = first; n < end; ++n) {
-        if (n < triangleCount) {
-            const openvdb::Vec3I& t = mesh.triangles[n];
-            op(t[0], t[1], t[2]);
-        } else {
-            const openvdb::Vec4I& q = mesh.quads[n - triangleCount];
-            op(q[0], q[1], q[2]);
-            op(q[0], q[2], q[3]);
-        }
+        const auto [corners, count] = polygon_indices_internal::cornersOf(mesh, n);
+        op(corners[0], corners[1], corners[2]);
+        if (count == 4) op(corners[0], corners[2], corners[3]);
     }
 }
 
@@ -287,8 +281,9 @@ PassMeasures measurePass(const SurfaceMesh& mesh, CancelPoll& poll)
             })
         & tbb::make_filter<std::shared_ptr<BlockTerms>, std::shared_ptr<BlockTerms>>(tbb::filter_mode::parallel,
             [&](std::shared_ptr<BlockTerms> block) {
-                size_t triangles = 0;
-                for (size_t n = block->first; n < block->end; ++n) triangles += n < triangleCount ? 1 : 2;
+                // A polygon each, and a second triangle for each quad (quads follow the triangles).
+                const size_t triangles = (block->end - block->first)
+                                         + (block->end > triangleCount ? block->end - std::max(block->first, triangleCount) : 0);
                 block->area.resize(triangles);
                 block->sixVolume.resize(triangles);
                 block->third.resize(triangles);
