@@ -44,69 +44,8 @@ constexpr int kStepsPerPoll = 16;
 /// 5 cells 0.68-0.71 / 0.39-0.44 s.
 constexpr double kGroupCells = 3.0;
 
-/// Candidate particles of one group of vertices, as separate x, y, z arrays padded to a
-/// multiple of kLanes with particles far outside every support (weight 0).
-struct CandidateBuffer
-{
-    std::vector<float> x, y, z;
-    size_t count = 0;
-
-    void clear() { count = 0; }
-
-    /// Append the particles of slots [first, end) that lie within @a radius of the box
-    /// [boxMin, boxMax]: only they can reach a vertex inside the box. Skipping the others
-    /// (the corners and edges of the grown box) halves the work of every vertex. Written
-    /// without branches (store, then advance only if kept): half the particles are
-    /// dropped at random, which a branch would mispredict. The distance to the box is the
-    /// distance to the particle clamped into it (min and max, no branch either: the same
-    /// value as the largest of 0, min - p and p - max, which GCC compiled to a branch per
-    /// axis). 64x benchmark input, relax stage, 4 paired runs at one thread: 0.56-0.63 s
-    /// with the branches, 0.47-0.54 s without.
-    void gather(const std::vector<openvdb::Vec3f>& positions, uint32_t first, uint32_t end,
-                const openvdb::Vec3f& boxMin, const openvdb::Vec3f& boxMax, float radius2)
-    {
-        reserve(count + (end - first) + kLanes);
-        float* __restrict px = x.data();
-        float* __restrict py = y.data();
-        float* __restrict pz = z.data();
-        // Locals, so the stores through px, py, pz cannot be taken to change them.
-        const float minX = boxMin[0], minY = boxMin[1], minZ = boxMin[2];
-        const float maxX = boxMax[0], maxY = boxMax[1], maxZ = boxMax[2];
-        size_t n = count;
-        for (uint32_t k = first; k < end; ++k) {
-            const openvdb::Vec3f& p = positions[k];
-            const float dx = p[0] - std::min(std::max(p[0], minX), maxX);
-            const float dy = p[1] - std::min(std::max(p[1], minY), maxY);
-            const float dz = p[2] - std::min(std::max(p[2], minZ), maxZ);
-            const float outside2 = dx * dx + dy * dy + dz * dz;
-            px[n] = p[0];
-            py[n] = p[1];
-            pz[n] = p[2];
-            n += outside2 < radius2 ? 1 : 0;
-        }
-        count = n;
-    }
-
-    /// Pad to a multiple of kLanes with a position at least r_e away from every vertex.
-    void pad(float farAway)
-    {
-        reserve(count + kLanes);
-        while (count % kLanes != 0) {
-            x[count] = y[count] = z[count] = farAway;
-            ++count;
-        }
-    }
-
-private:
-    void reserve(size_t size)
-    {
-        if (x.size() < size) {
-            x.resize(2 * size);
-            y.resize(2 * size);
-            z.resize(2 * size);
-        }
-    }
-};
+/// The particles within r_e of a vertex group's box, in x, y, z arrays.
+using CandidateBuffer = vertex_groups_internal::GroupCandidates<kLanes, /*kWithSlots=*/false>;
 
 /// Every relaxation step for a range of vertex groups, group after group: a vertex's step
 /// depends only on its own position and the particles, so a group can take all its steps
