@@ -25,6 +25,9 @@
 #include "ReadVtu.h"
 #include "StreamReader.h"
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
@@ -439,36 +442,71 @@ private:
             p[2].type == ScalarType::Float32;
     }
 
-    /// Binary records of one size: decoded a buffered block of whole records at a time.
+    /// Binary records of one size: decoded a buffered block (up to kChunkBytes) of whole
+    /// records at a time, the block's records in parallel (each writes its own particle's
+    /// values only), every value copied at its width known at compile time. 64x benchmark
+    /// input with the dam-break frame's id and velocity (28-byte records, 44 MB): 0.079 s
+    /// with a memcpy of run-time width per value, one record after the other.
     void readFixedRecords(const PlyElement& element, const std::vector<PlyColumn>& columns,
                           const std::string& section)
     {
         size_t recordSize = 0;
-        for (const PlyColumn& column : columns) recordSize += column.width;
+        std::vector<size_t> offsets;  // of each column's value in a record
+        for (const PlyColumn& column : columns) {
+            offsets.push_back(recordSize);
+            recordSize += column.width;
+        }
         const bool swap = mReader->swaps();
         const size_t count = size_t(element.count);
+        std::vector<openvdb::Vec3f>& positions = mData.positions;
         for (size_t i = 0; i < count;) {
             if (!mStream.ensure(recordSize)) fail(mPath, "truncated " + section);
             const size_t block = std::min(count - i, mStream.available() / recordSize);
-            const unsigned char* record = reinterpret_cast<const unsigned char*>(mStream.here());
-            for (size_t r = 0; r < block; ++r, ++i) {
-                for (size_t p = 0; p < columns.size(); ++p) {
-                    const PlyColumn& column = columns[p];
-                    unsigned char value[8];
-                    std::memcpy(value, record, column.width);
-                    // Inline: a call per value would cost a quarter of the read time.
-                    if (swap) std::reverse(value, value + column.width);
-                    if (column.axis >= 0) {
-                        mData.positions[i][column.axis] =
-                            floatValue(value, element.properties[p].type);
-                    } else {
-                        std::memcpy(column.destination(i), value, column.width);
+            const unsigned char* records = reinterpret_cast<const unsigned char*>(mStream.here());
+            tbb::parallel_for(tbb::blocked_range<size_t>(0, block, 4096), [&](const tbb::blocked_range<size_t>& range) {
+                for (size_t r = range.begin(); r < range.end(); ++r) {
+                    const unsigned char* record = records + r * recordSize;
+                    for (size_t p = 0; p < columns.size(); ++p) {
+                        const PlyColumn& column = columns[p];
+                        const unsigned char* from = record + offsets[p];
+                        switch (column.width) {
+                        case 1: decodeValue<1>(column, from, i + r, swap, positions); break;
+                        case 2: decodeValue<2>(column, from, i + r, swap, positions); break;
+                        case 4: decodeValue<4>(column, from, i + r, swap, positions); break;
+                        default: decodeValue<8>(column, from, i + r, swap, positions); break;
+                        }
                     }
-                    record += column.width;
                 }
-            }
+            });
+            i += block;
             mStream.advance(block * recordSize);
         }
+    }
+
+    /// Particle @a i's value of @a column, @a kWidth bytes at @a from (byte-swapped if
+    /// @a swap), into its position or attribute.
+    template<size_t kWidth>
+    static void decodeValue(const PlyColumn& column, const unsigned char* from, size_t i,
+                            bool swap, std::vector<openvdb::Vec3f>& positions)
+    {
+        unsigned char value[kWidth];
+        std::memcpy(value, from, kWidth);
+        if (swap) std::reverse(value, value + kWidth);
+        // Positions are float or double (checked), so their width tells their type.
+        if constexpr (kWidth == 4) {
+            if (column.axis >= 0) {
+                std::memcpy(&positions[i][column.axis], value, 4);
+                return;
+            }
+        } else if constexpr (kWidth == 8) {
+            if (column.axis >= 0) {
+                double position;
+                std::memcpy(&position, value, 8);
+                positions[i][column.axis] = float(position);
+                return;
+            }
+        }
+        std::memcpy(column.destination(i), value, kWidth);
     }
 
     /// Text records, or binary ones with list properties: one value at a time.
