@@ -15,6 +15,8 @@
 
 #include <gtest/gtest.h>
 
+#include <charconv>
+
 #include <csignal>
 #include <sys/resource.h>
 
@@ -257,6 +259,81 @@ TEST_F(WriteMeshTest, BatchedParallelEncodingMatchesTheFormatAtAnyThreadCount)
     ASSERT_EQ(back.triangles.size(), mesh.triangles.size() + 2 * mesh.quads.size());
     EXPECT_EQ(back.points.back(), mesh.points.back());
     EXPECT_EQ(back.triangles.back(), openvdb::Vec3I(mesh.quads.back()[0], mesh.quads.back()[2], mesh.quads.back()[3]));
+}
+
+/// The OBJ text writeMesh() documents for @a mesh, one value at a time: shortest round-trip
+/// numbers, faces with 1-based "i//i" corners where the mesh has normals.
+std::string
+referenceObj(const SurfaceMesh& mesh, bool keepQuads)
+{
+    std::string text = "# nonbloppy surface mesh\n";
+    auto number = [&](auto value) {
+        char digits[32];
+        text.append(digits, size_t(std::to_chars(digits, digits + sizeof(digits), value).ptr - digits));
+    };
+    auto vector = [&](const char* tag, const openvdb::Vec3s& v) {
+        text += tag;
+        for (int a = 0; a < 3; ++a) {
+            text += ' ';
+            number(v[a]);
+        }
+        text += '\n';
+    };
+    for (const openvdb::Vec3s& p : mesh.points) vector("v", p);
+    for (const openvdb::Vec3s& n : mesh.normals) vector("vn", n);
+    auto face = [&](std::vector<uint32_t> corners) {
+        text += 'f';
+        for (const uint32_t c : corners) {
+            text += ' ';
+            number(uint64_t(c) + 1);
+            if (!mesh.normals.empty()) {
+                text += "//";
+                number(uint64_t(c) + 1);
+            }
+        }
+        text += '\n';
+    };
+    for (const openvdb::Vec3I& t : mesh.triangles) face({t[0], t[1], t[2]});
+    for (const openvdb::Vec4I& q : mesh.quads) {
+        if (keepQuads) {
+            face({q[0], q[1], q[2], q[3]});
+        } else {
+            face({q[0], q[1], q[2]});
+            face({q[0], q[2], q[3]});
+        }
+    }
+    return text;
+}
+
+TEST_F(WriteMeshTest, ObjLinesFormattedInParallelMatchTheFormatAtAnyThreadCount)
+{
+    // Lines are formatted in pieces of 4096, in parallel, and written in order: dozens of
+    // pieces of each kind of line, the last ones short.
+    SurfaceMesh mesh;
+    std::mt19937 random(5);
+    std::uniform_real_distribution<float> coordinate(-1000.0f, 1000.0f);
+    std::uniform_int_distribution<uint32_t> vertex(0, 199999);
+    for (int i = 0; i < 200001; ++i) {
+        mesh.points.emplace_back(coordinate(random), coordinate(random), coordinate(random));
+        mesh.normals.emplace_back(coordinate(random), coordinate(random), coordinate(random));
+    }
+    for (int i = 0; i < 30000; ++i) mesh.triangles.emplace_back(vertex(random), vertex(random), vertex(random));
+    for (int i = 0; i < 200000; ++i) {
+        mesh.quads.emplace_back(vertex(random), vertex(random), vertex(random), vertex(random));
+    }
+    const std::string expected = referenceObj(mesh, /*keepQuads=*/false);
+    {
+        tbb::global_control oneThread(tbb::global_control::max_allowed_parallelism, 1);
+        writeMesh(mesh, path("one.obj"));
+    }
+    writeMesh(mesh, path("many.obj"));
+    EXPECT_TRUE(readBytes(path("one.obj")) == expected);
+    EXPECT_TRUE(readBytes(path("many.obj")) == expected);
+    MeshWriteSettings keep;
+    keep.keepQuads = true;
+    mesh.normals.clear();
+    writeMesh(mesh, path("quads.obj"), keep);
+    EXPECT_TRUE(readBytes(path("quads.obj")) == referenceObj(mesh, /*keepQuads=*/true));
 }
 
 TEST_F(WriteMeshTest, AttributeNamesStayDistinctFromEachOtherAndFromTheFormatsColumns)
