@@ -49,7 +49,10 @@ struct MeshWriteSettings
 /// kept distinct from one another and from the format's own columns (PLY x, y, z and,
 /// with normals, nx, ny, nz; the VTK normals array "normals"): such a name gets _2, _3,
 /// ... (writtenAttributeNames() tells which).
-/// Cost: one pass; output is formatted into multi-megabyte chunks.
+/// Cost: one pass, parallel: PLY and VTK records are encoded in 8 MB batches, OBJ lines
+/// formatted in pieces of 4096, and written in order while the next are encoded (the bytes
+/// do not depend on the thread count). The 64x benchmark mesh (2.39M vertices, 4.74M
+/// triangles, two threads): PLY (119 MB) about 0.1 s, OBJ (403 MB of text) about 0.43 s.
 /// Thread-safety: reentrant; concurrent calls must write different paths.
 /// @throw FileError for an unknown extension or a file that cannot be written, e.g.
 ///        "cannot write out/mesh.obj: No such file or directory"; nothing is left behind.
