@@ -15,11 +15,13 @@
 #include <nonbloppy/ReadParticles.h>
 
 #include <gtest/gtest.h>
+#include <tbb/global_control.h>
 
 #include <nlohmann/json.hpp>
 #include <zlib.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <functional>
@@ -330,6 +332,54 @@ TEST_F(ReadStreamingFormatsTest, TablesLargerThanTheBuffer)
     const size_t middle = txt.find('\n', txt.size() / 2) + 1;
     txt.insert(middle, "#" + std::string(3 * io::kChunkBytes, 'c') + "\n");
     expectTableParticles(io::readTableFile(write("p.txt", txt)), kManyParticles);
+}
+
+TEST_F(ReadStreamingFormatsTest, TableColumnTypesChangeDeepInTheFileAsRowByRow)
+{
+    // Rows are parsed in parallel, a buffered block at a time, and stored in order: a column
+    // of whole numbers turns uint64 at a value past int64 and float64 at a fraction, many
+    // blocks in, with every value before it converted ("-0" to -0.0, "+-0" too, as a
+    // float parse reads it); another stays int64 to the end. Same at one thread.
+    constexpr size_t kRows = 200000, kLarge = 150000, kFraction = 190000, kMinusZero = 170000;
+    std::string csv = "x,y,z,n,id\n";
+    for (size_t i = 0; i < kRows; ++i) {
+        std::string n = std::to_string(i);
+        if (i == kLarge) n = "9223372036854775808";
+        if (i == kMinusZero) n = "-0";
+        if (i == kMinusZero + 1) n = "+-0";
+        if (i == kFraction) n = "2.5";
+        csv += std::to_string(i % 97) + ".5," + std::to_string(i % 89) + ",-" + std::to_string(i % 83) + "e-1," + n +
+               "," + std::to_string(int64_t(i) - 100000) + "\n";
+    }
+    ASSERT_GT(csv.size(), 4 * io::kChunkBytes);
+    const std::string file = write("types.csv", csv);
+    ParticleSet one;
+    {
+        tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 1);
+        one = io::readTableFile(file);
+    }
+    const ParticleSet many = io::readTableFile(file);
+    for (const ParticleSet* particles : {static_cast<const ParticleSet*>(&one), &many}) {
+        ASSERT_EQ(particles->size(), kRows);
+        const ParticleAttribute& n = *particles->findAttribute("n");
+        const ParticleAttribute& id = *particles->findAttribute("id");
+        ASSERT_EQ(n.type, ScalarType::Float64);
+        ASSERT_EQ(id.type, ScalarType::Int64);
+        for (size_t i = 0; i < kRows; i += 997) {
+            const float z = float(std::stod("-" + std::to_string(i % 83) + "e-1"));
+            ASSERT_EQ(particles->positions[i], openvdb::Vec3f(float(i % 97) + 0.5f, float(i % 89), z)) << i;
+            ASSERT_EQ(n.asDouble(i), double(i)) << i;
+            ASSERT_EQ(id.asDouble(i), double(int64_t(i) - 100000)) << i;
+        }
+        EXPECT_EQ(n.asDouble(kLarge), 9223372036854775808.0);
+        EXPECT_EQ(n.asDouble(kFraction), 2.5);
+        EXPECT_TRUE(n.asDouble(kMinusZero) == 0.0 && std::signbit(n.asDouble(kMinusZero)));
+        EXPECT_TRUE(n.asDouble(kMinusZero + 1) == 0.0 && std::signbit(n.asDouble(kMinusZero + 1)));
+        EXPECT_EQ(n.asDouble(kRows - 1), double(kRows - 1));
+    }
+    EXPECT_TRUE(one.positions == many.positions);
+    EXPECT_TRUE(one.attributes[0].bytes == many.attributes[0].bytes);
+    EXPECT_TRUE(one.attributes[1].bytes == many.attributes[1].bytes);
 }
 
 TEST_F(ReadStreamingFormatsTest, TableErrorsDeepInTheFile)
