@@ -66,12 +66,8 @@ struct Polygons
     size_t size() const { return mesh.triangles.size() + mesh.quads.size(); }
     Corners operator[](size_t n) const
     {
-        if (n < mesh.triangles.size()) {
-            const Vec3I& t = mesh.triangles[n];
-            return Corners{{t[0], t[1], t[2], 0}, 3};
-        }
-        const openvdb::Vec4I& q = mesh.quads[n - mesh.triangles.size()];
-        return Corners{{q[0], q[1], q[2], q[3]}, 4};
+        const auto [corners, count] = polygon_indices_internal::cornersOf(mesh, n);
+        return Corners{{corners[0], corners[1], corners[2], count == 4 ? corners[3] : 0}, count};
     }
 };
 

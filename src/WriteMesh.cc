@@ -92,22 +92,14 @@ struct PolygonView
     template<typename OpT>
     void forEachOf(size_t i, OpT op) const
     {
-        if (i < mesh.triangles.size()) {
-            const openvdb::Vec3I& t = mesh.triangles[i];
-            const uint32_t corners[3] = {t[0], t[1], t[2]};
-            op(corners, 3);
+        const auto [corners, count] = polygon_indices_internal::cornersOf(mesh, i);
+        if (count == 3 || keepQuads) {
+            op(corners, count);
             return;
         }
-        const openvdb::Vec4I& q = mesh.quads[i - mesh.triangles.size()];
-        if (keepQuads) {
-            const uint32_t corners[4] = {q[0], q[1], q[2], q[3]};
-            op(corners, 4);
-        } else {
-            const uint32_t first[3] = {q[0], q[1], q[2]};
-            const uint32_t second[3] = {q[0], q[2], q[3]};
-            op(first, 3);
-            op(second, 3);
-        }
+        const uint32_t second[3] = {corners[0], corners[2], corners[3]};
+        op(corners, 3);
+        op(second, 3);
     }
 };
 
