@@ -424,7 +424,7 @@ parseTable(StreamReader& in, const std::string& path)
             if (!field.asDouble(value)) {
                 std::vector<std::string_view> texts;
                 splitLine(rowText, separator, texts);
-                fail(path, "bad number '" + printable(texts[i]) + "' on line " + std::to_string(line));
+                fail(path, "bad number '" + printable(trimmed(texts[i])) + "' on line " + std::to_string(line));
             }
             if (attribute < 0) {
                 p[columns[i].component] = static_cast<float>(value);
