@@ -462,9 +462,9 @@ parseTable(StreamReader& in, const std::string& path)
         // or to the end of the data.
         size_t blockSize = 0;
         for (;;) {
-            const char* last = static_cast<const char*>(::memrchr(in.here(), '\n', in.available()));
-            if (last) {
-                blockSize = size_t(last - in.here()) + 1;
+            const size_t last = std::string_view(in.here(), in.available()).rfind('\n');
+            if (last != std::string_view::npos) {
+                blockSize = last + 1;
                 break;
             }
             if (!in.ensure(in.available() + 1)) {
