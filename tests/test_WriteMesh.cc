@@ -226,22 +226,31 @@ referencePly(const SurfaceMesh& mesh)
     return bytes;
 }
 
+/// A mesh of @a vertices random points and normals in [-extent, extent]^3 (fixed @a seed) and
+/// @a triangles and @a quads of random corners: the bytes of every format at every size.
+SurfaceMesh
+randomMesh(unsigned seed, float extent, int vertices, int triangles, int quads)
+{
+    SurfaceMesh mesh;
+    std::mt19937 random(seed);
+    std::uniform_real_distribution<float> coordinate(-extent, extent);
+    std::uniform_int_distribution<uint32_t> vertex(0, uint32_t(vertices - 1));
+    for (int i = 0; i < vertices; ++i) {
+        mesh.points.emplace_back(coordinate(random), coordinate(random), coordinate(random));
+        mesh.normals.emplace_back(coordinate(random), coordinate(random), coordinate(random));
+    }
+    for (int i = 0; i < triangles; ++i) mesh.triangles.emplace_back(vertex(random), vertex(random), vertex(random));
+    for (int i = 0; i < quads; ++i) {
+        mesh.quads.emplace_back(vertex(random), vertex(random), vertex(random), vertex(random));
+    }
+    return mesh;
+}
+
 TEST_F(WriteMeshTest, BatchedParallelEncodingMatchesTheFormatAtAnyThreadCount)
 {
     // Enough polygons for several 8 MB batches of split quads (26 bytes each), so that a
     // batch is encoded while the one before is written.
-    SurfaceMesh mesh;
-    std::mt19937 random(11);
-    std::uniform_real_distribution<float> coordinate(-10.0f, 10.0f);
-    std::uniform_int_distribution<uint32_t> vertex(0, 99999);
-    for (int i = 0; i < 100000; ++i) {
-        mesh.points.emplace_back(coordinate(random), coordinate(random), coordinate(random));
-        mesh.normals.emplace_back(coordinate(random), coordinate(random), coordinate(random));
-    }
-    for (int i = 0; i < 30000; ++i) mesh.triangles.emplace_back(vertex(random), vertex(random), vertex(random));
-    for (int i = 0; i < 1400000; ++i) {
-        mesh.quads.emplace_back(vertex(random), vertex(random), vertex(random), vertex(random));
-    }
+    const SurfaceMesh mesh = randomMesh(11, 10.0f, 100000, 30000, 1400000);
     const std::string expected = referencePly(mesh);
     ASSERT_GT(expected.size(), size_t(4) * (8 << 20));
     {
@@ -309,18 +318,7 @@ TEST_F(WriteMeshTest, ObjLinesFormattedInParallelMatchTheFormatAtAnyThreadCount)
 {
     // Lines are formatted in pieces of 4096, in parallel, and written in order: dozens of
     // pieces of each kind of line, the last ones short.
-    SurfaceMesh mesh;
-    std::mt19937 random(5);
-    std::uniform_real_distribution<float> coordinate(-1000.0f, 1000.0f);
-    std::uniform_int_distribution<uint32_t> vertex(0, 199999);
-    for (int i = 0; i < 200001; ++i) {
-        mesh.points.emplace_back(coordinate(random), coordinate(random), coordinate(random));
-        mesh.normals.emplace_back(coordinate(random), coordinate(random), coordinate(random));
-    }
-    for (int i = 0; i < 30000; ++i) mesh.triangles.emplace_back(vertex(random), vertex(random), vertex(random));
-    for (int i = 0; i < 200000; ++i) {
-        mesh.quads.emplace_back(vertex(random), vertex(random), vertex(random), vertex(random));
-    }
+    SurfaceMesh mesh = randomMesh(5, 1000.0f, 200001, 30000, 200000);
     const std::string expected = referenceObj(mesh, /*keepQuads=*/false);
     {
         tbb::global_control oneThread(tbb::global_control::max_allowed_parallelism, 1);
