@@ -56,7 +56,7 @@ constexpr double kGroupOverRadius = 1.5;
 constexpr double kIndexCellOverRadius = 1.0;
 
 /// The attribute values the interpolation reads.
-struct SortedValues
+struct AttributeValues
 {
     /// Every mean component of a particle side by side, attribute after attribute
     /// (meanComponents doubles per particle), in the index's sorted order, so that a vertex's
@@ -89,7 +89,7 @@ struct InterpolateGroupsOp
     const ParticleIndex::Impl& index;
     const memory_internal::UnwrittenVector<uint32_t>& vertexOrder;  ///< vertices sorted by group
     const std::vector<size_t>& groupStart;  ///< groups of vertexOrder, plus the end
-    const SortedValues& values;
+    const AttributeValues& values;
     std::vector<MeshAttribute>& out;  ///< sized, zeros; out[a].integer for a nearest value
     float effectiveRadius;
     cancellation_internal::CancelPoll& poll;
@@ -318,7 +318,7 @@ interpolateAttributes(SurfaceMesh& mesh, const ParticleSet& particles,
         const ParticleIndex particleIndex = ParticleIndex::build(particles.positions, kIndexCellOverRadius * effectiveRadius);
         const ParticleIndex::Impl& index = particleIndex.impl();
         const std::vector<uint32_t>& original = index.originalIndex;
-        SortedValues values;
+        AttributeValues values;
         values.integers.resize(attributes.size());
         for (size_t a = 0; a < attributes.size(); ++a) {
             if (out[a].integer) values.anyNearest = true;

@@ -257,12 +257,18 @@ void
 parseBlock(std::string_view block, char separator, const std::vector<Column>& columns, std::vector<RowPiece>& pieces)
 {
     const size_t width = columns.size();
+    // Piece k starts at the first line start at or after k/pieces of the block (a block of
+    // fewer bytes than pieces leaves the first ones empty).
     std::vector<size_t> cut(pieces.size() + 1, block.size());
     cut[0] = 0;
     for (size_t k = 1; k < pieces.size(); ++k) {
-        const size_t from = std::max(cut[k - 1], block.size() * k / pieces.size());
-        const size_t newline = from == 0 ? 0 : block.find('\n', from - 1);
-        cut[k] = newline == std::string_view::npos ? block.size() : (from == 0 ? 0 : newline + 1);
+        const size_t target = std::max(cut[k - 1], block.size() * k / pieces.size());
+        if (target == 0) {
+            cut[k] = 0;
+            continue;
+        }
+        const size_t newline = block.find('\n', target - 1);  // a line starts at target if one ends before it
+        cut[k] = newline == std::string_view::npos ? block.size() : newline + 1;
     }
     tbb::parallel_for(tbb::blocked_range<size_t>(0, pieces.size(), 1), [&](const tbb::blocked_range<size_t>& range) {
         std::vector<std::string_view> texts;
