@@ -17,11 +17,12 @@
 /// whose values are all integers is Int64, else Float64.
 ///
 /// Both are read through a StreamReader (a bounded buffer) straight into the final arrays:
-/// table rows a buffered block of whole lines at a time, parsed in parallel and stored in
-/// order, an attribute's values as int64 while every one is a whole number that fits, then
-/// as float64 (those before converted) from the first that is not; JSON through nlohmann's
-/// SAX parser, with no DOM. The 64x benchmark input as CSV with id and velocity (107 MB):
-/// 0.24-0.25 s at two threads, 0.37-0.39 s at one (row by row: 0.35 s either way).
+/// table rows a buffered block of whole lines at a time, cut into pieces that are parsed
+/// in parallel and stored in order as they come, an attribute's values as int64 while
+/// every one is a whole number that fits, then as float64 (those before converted) from
+/// the first that is not; JSON through nlohmann's SAX parser, with no DOM. The 64x
+/// benchmark input as CSV with id and velocity (107 MB), measured side by side: 0.26-0.28 s
+/// at two threads, 0.38-0.41 s at one (row by row: 0.35-0.37 s either way).
 /// Text has no counts to check; once the first rows show the bytes per particle, the
 /// arrays are reserved for the bytes left in the file plus a quarter (re-estimated if that
 /// falls short), so they are not copied as they grow.
@@ -33,8 +34,7 @@
 #include <nonbloppy/Error.h>
 
 #include <nlohmann/json.hpp>
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
+#include <tbb/parallel_pipeline.h>
 #include <tbb/task_arena.h>
 
 #include <algorithm>
@@ -212,7 +212,7 @@ struct ParsedField
     }
 };
 
-/// The data rows of one piece of a block of lines (parseBlock()), parsed.
+/// The data rows of one piece of a block of lines (parsePiece()), parsed.
 struct RowPiece
 {
     struct Row
@@ -224,6 +224,7 @@ struct RowPiece
     size_t lines = 0;                 ///< lines in the piece, rows or not (blank, comments)
     std::vector<Row> rows;
     std::vector<ParsedField> fields;  ///< rows × columns (those of a row of another count unset)
+    std::vector<std::string_view> texts;  ///< scratch: the fields of the line being parsed
 
     void clear()
     {
@@ -247,22 +248,17 @@ looksWhole(std::string_view text)
     return true;
 }
 
-/// Parse the lines of @a block (whole lines, each ended by '\n' but perhaps the last) into
-/// @a pieces, cut at line ends about equally: each line that is neither blank nor a '#'
-/// comment is a row, split at @a separator, its fields parsed as @a columns says (nothing
-/// for an unnamed column, a double for a position, and for an attribute a whole number
-/// where it is one: ParsedField). The pieces run in parallel, each writing its own; a row
-/// of another field count is only counted (the caller reports it, in order).
-void
-parseBlock(std::string_view block, char separator, const std::vector<Column>& columns, std::vector<RowPiece>& pieces)
+/// Where @a block (whole lines, each ended by '\n' but perhaps the last) is cut into
+/// @a count pieces of about equal size: piece k is [cut[k], cut[k + 1]), starting at the
+/// first line start at or after k/count of the block (a block of fewer bytes than pieces
+/// leaves the first ones empty).
+std::vector<size_t>
+cutAtLines(std::string_view block, size_t count)
 {
-    const size_t width = columns.size();
-    // Piece k starts at the first line start at or after k/pieces of the block (a block of
-    // fewer bytes than pieces leaves the first ones empty).
-    std::vector<size_t> cut(pieces.size() + 1, block.size());
+    std::vector<size_t> cut(count + 1, block.size());
     cut[0] = 0;
-    for (size_t k = 1; k < pieces.size(); ++k) {
-        const size_t target = std::max(cut[k - 1], block.size() * k / pieces.size());
+    for (size_t k = 1; k < count; ++k) {
+        const size_t target = std::max(cut[k - 1], block.size() * k / count);
         if (target == 0) {
             cut[k] = 0;
             continue;
@@ -270,50 +266,59 @@ parseBlock(std::string_view block, char separator, const std::vector<Column>& co
         const size_t newline = block.find('\n', target - 1);  // a line starts at target if one ends before it
         cut[k] = newline == std::string_view::npos ? block.size() : newline + 1;
     }
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, pieces.size(), 1), [&](const tbb::blocked_range<size_t>& range) {
-        std::vector<std::string_view> texts;
-        for (size_t k = range.begin(); k < range.end(); ++k) {
-            RowPiece& piece = pieces[k];
-            piece.clear();
-            for (size_t at = cut[k]; at < cut[k + 1];) {
-                const size_t newline = block.find('\n', at);
-                const size_t end = newline == std::string_view::npos || newline >= cut[k + 1] ? cut[k + 1] : newline;
-                const std::string_view line = block.substr(at, end - at);
-                const size_t lineInPiece = piece.lines++;
-                at = end + 1;
-                const std::string_view content = trimmed(line);
-                if (content.empty() || content[0] == '#') continue;
-                splitLine(line, separator, texts);
-                piece.rows.push_back({size_t(line.data() - block.data()), line.size(), lineInPiece, texts.size()});
-                piece.fields.resize(piece.fields.size() + width);
-                if (texts.size() != width) continue;
-                ParsedField* parsed = piece.fields.data() + piece.fields.size() - width;
-                for (size_t i = 0; i < width; ++i) {
-                    if (columns[i].attribute == kUnnamed) continue;
-                    const std::string_view text = trimmed(texts[i]);
-                    ParsedField& field = parsed[i];
-                    field.minus = !text.empty() && text.front() == '-';
-                    // An attribute may be stored as an integer: parseWhole() takes an optional
-                    // '+', an optional '-' and digits only, so other text (most: 2.45, 1e-3)
-                    // is not tried (two from_chars calls per field cost a fifth of the read).
-                    if (columns[i].attribute >= 0 && looksWhole(text)) {
-                        if (io_internal::parseWhole(text, field.whole)) {
-                            field.kind = ParsedField::Whole;
-                            double zero = 0.0;
-                            field.negativeZero =
-                                field.whole == 0 && parseDoubleRefusingOverflow(text, zero) && std::signbit(zero);
-                            continue;
-                        }
-                        if (io_internal::parseWhole(text, field.large)) {
-                            field.kind = ParsedField::Large;
-                            continue;
-                        }
-                    }
-                    field.kind = parseDoubleRefusingOverflow(text, field.value) ? ParsedField::Number : ParsedField::Bad;
+    return cut;
+}
+
+/// Parse the lines of @a block in [@a begin, @a end) (whole lines) into @a piece: each line
+/// that is neither blank nor a '#' comment is a row, split at @a separator, its fields
+/// parsed as @a columns says (nothing for an unnamed column, a double for a position, and
+/// for an attribute a whole number where it is one: ParsedField). A row of another field
+/// count is only counted (the caller reports it, in order). Thread-safety: writes @a piece
+/// only.
+void
+parsePiece(std::string_view block, size_t begin, size_t end, char separator, const std::vector<Column>& columns,
+           RowPiece& piece)
+{
+    const size_t width = columns.size();
+    piece.clear();
+    std::vector<std::string_view>& texts = piece.texts;
+    for (size_t at = begin; at < end;) {
+        const size_t newline = block.find('\n', at);
+        const size_t lineEnd = newline == std::string_view::npos || newline >= end ? end : newline;
+        const std::string_view line = block.substr(at, lineEnd - at);
+        const size_t lineInPiece = piece.lines++;
+        at = lineEnd + 1;
+        const std::string_view content = trimmed(line);
+        if (content.empty() || content[0] == '#') continue;
+        splitLine(line, separator, texts);
+        piece.rows.push_back({size_t(line.data() - block.data()), line.size(), lineInPiece, texts.size()});
+        piece.fields.resize(piece.fields.size() + width);
+        if (texts.size() != width) continue;
+        ParsedField* parsed = piece.fields.data() + piece.fields.size() - width;
+        for (size_t i = 0; i < width; ++i) {
+            if (columns[i].attribute == kUnnamed) continue;
+            const std::string_view text = trimmed(texts[i]);
+            ParsedField& field = parsed[i];
+            field.minus = !text.empty() && text.front() == '-';
+            // An attribute may be stored as an integer: parseWhole() takes an optional
+            // '+', an optional '-' and digits only, so other text (most: 2.45, 1e-3)
+            // is not tried (two from_chars calls per field cost a fifth of the read).
+            if (columns[i].attribute >= 0 && looksWhole(text)) {
+                if (io_internal::parseWhole(text, field.whole)) {
+                    field.kind = ParsedField::Whole;
+                    double zero = 0.0;
+                    field.negativeZero =
+                        field.whole == 0 && parseDoubleRefusingOverflow(text, zero) && std::signbit(zero);
+                    continue;
+                }
+                if (io_internal::parseWhole(text, field.large)) {
+                    field.kind = ParsedField::Large;
+                    continue;
                 }
             }
+            field.kind = parseDoubleRefusingOverflow(text, field.value) ? ParsedField::Number : ParsedField::Bad;
         }
-    });
+    }
 }
 
 ParticleSet
@@ -458,11 +463,19 @@ parseTable(StreamReader& in, const std::string& path)
     };
 
     // The rows are parsed a block of whole lines at a time, straight from the reader's
-    // buffer, in parallel (parseBlock(): from_chars was most of the read), then stored in
-    // order by one thread, which alone knows each attribute's type so far: the same
-    // particles, and the same first error, as parsing row after row.
+    // buffer, cut into pieces of about kPieceBytes that go through a TBB pipeline: parsed in
+    // parallel (parsePiece(): from_chars was most of the read), then stored in order by one
+    // thread, which alone knows each attribute's type so far: the same particles, and the
+    // same first error, as parsing row after row. A piece is stored while it is still in
+    // the cache, and while the next ones are parsed; the whole block parsed before any of
+    // it was stored (1 MiB of text, 1.6 MB of parsed fields) was 7-11% slower than row by
+    // row at one thread, and kept the second thread idle while one stored.
+    constexpr size_t kPieceBytes = size_t(64) << 10;
+    // A piece holds its token from parsing to storing, so piece k + tokens never shares
+    // piece k's slot while k is in flight.
+    const size_t tokens = 2 * size_t(std::max(1, tbb::this_task_arena::max_concurrency()));
+    std::vector<RowPiece> pieces(tokens);
     const uint64_t dataStart = in.pos();
-    std::vector<RowPiece> pieces(2 * size_t(std::max(1, tbb::this_task_arena::max_concurrency())));
     while (in.ensure(1)) {
         // Whole lines: up to the last '\n' buffered (more is read while there is none),
         // or to the end of the data.
@@ -479,8 +492,9 @@ parseTable(StreamReader& in, const std::string& path)
             }
         }
         const std::string_view block(in.here(), blockSize);
-        parseBlock(block, separator, columns, pieces);
-        for (const RowPiece& piece : pieces) {
+        const size_t pieceCount = std::max<size_t>(1, (blockSize + kPieceBytes - 1) / kPieceBytes);
+        const std::vector<size_t> cut = cutAtLines(block, pieceCount);
+        const auto storePiece = [&](const RowPiece& piece) {
             for (size_t r = 0; r < piece.rows.size(); ++r) {
                 const RowPiece::Row& row = piece.rows[r];
                 const size_t line = lineNumber + row.line + 1;  // 1-based
@@ -501,7 +515,21 @@ parseTable(StreamReader& in, const std::string& path)
                 }
             }
             lineNumber += piece.lines;
-        }
+        };
+        size_t next = 0;
+        tbb::parallel_pipeline(tokens,
+            tbb::make_filter<void, size_t>(tbb::filter_mode::serial_in_order,
+                [&](tbb::flow_control& control) {
+                    if (next == pieceCount) control.stop();
+                    return next++;
+                }) &
+            tbb::make_filter<size_t, size_t>(tbb::filter_mode::parallel,
+                [&](size_t k) {
+                    parsePiece(block, cut[k], cut[k + 1], separator, columns, pieces[k % tokens]);
+                    return k;
+                }) &
+            tbb::make_filter<size_t, void>(tbb::filter_mode::serial_in_order,
+                [&](size_t k) { storePiece(pieces[k % tokens]); }));
         in.advance(blockSize);
     }
     for (size_t i = 0; i < columns.size(); ++i) {

@@ -16,6 +16,7 @@
 
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
+#include <tbb/task_arena.h>
 
 #include <nlohmann/json.hpp>
 #include <zlib.h>
@@ -28,6 +29,7 @@
 #include <sstream>
 #include <string>
 #include <thread>
+#include <utility>
 #include <vector>
 
 #include <sys/stat.h>
@@ -339,7 +341,7 @@ TEST_F(ReadStreamingFormatsTest, TableColumnTypesChangeDeepInTheFileAsRowByRow)
     // Rows are parsed in parallel, a buffered block at a time, and stored in order: a column
     // of whole numbers turns uint64 at a value past int64 and float64 at a fraction, many
     // blocks in, with every value before it converted ("-0" to -0.0, "+-0" too, as a
-    // float parse reads it); another stays int64 to the end. Same at one thread.
+    // float parse reads it); another stays int64 to the end. Same at one thread and eight.
     constexpr size_t kRows = 200000, kLarge = 150000, kFraction = 190000, kMinusZero = 170000;
     std::string csv = "x,y,z,n,id\n";
     for (size_t i = 0; i < kRows; ++i) {
@@ -358,8 +360,14 @@ TEST_F(ReadStreamingFormatsTest, TableColumnTypesChangeDeepInTheFileAsRowByRow)
         tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 1);
         one = io::readTableFile(file);
     }
-    const ParticleSet many = io::readTableFile(file);
-    for (const ParticleSet* particles : {static_cast<const ParticleSet*>(&one), &many}) {
+    ParticleSet many;
+    {
+        // Eight threads, whatever the machine has, so that pieces are parsed out of order.
+        tbb::global_control wide(tbb::global_control::max_allowed_parallelism, 8);
+        tbb::task_arena arena(8);
+        arena.execute([&] { many = io::readTableFile(file); });
+    }
+    for (const ParticleSet* particles : {&std::as_const(one), &std::as_const(many)}) {
         ASSERT_EQ(particles->size(), kRows);
         const ParticleAttribute& n = *particles->findAttribute("n");
         const ParticleAttribute& id = *particles->findAttribute("id");
@@ -406,6 +414,21 @@ TEST_F(ReadStreamingFormatsTest, TableErrorsDeepInTheFile)
     const std::string badFile = write("bad.csv", bad);
     EXPECT_EQ(errorOfBoth(badFile, io::readTableFile),
               "bad number '12x' on line " + std::to_string(lineOfRow(row)) + " (" + badFile + ")");
+
+    // Two errors pieces apart (a block is cut into pieces of 64 KiB, parsed in any order):
+    // the one nearer the start is reported, before or after the bad number.
+    const auto withExtraField = [&](std::string text, size_t otherRow) {
+        size_t pos = 0;
+        for (size_t line = 1; line <= lineOfRow(otherRow); ++line) pos = text.find('\n', pos) + 1;
+        text.insert(pos - 1, ",7");  // at the end of the row's line
+        return text;
+    };
+    const std::string laterFile = write("later.csv", withExtraField(bad, row + 3000));
+    EXPECT_EQ(errorOfBoth(laterFile, io::readTableFile),
+              "bad number '12x' on line " + std::to_string(lineOfRow(row)) + " (" + laterFile + ")");
+    const std::string earlierFile = write("earlier.csv", withExtraField(bad, row - 3000));
+    EXPECT_EQ(errorOfBoth(earlierFile, io::readTableFile),
+              "line " + std::to_string(lineOfRow(row - 3000)) + " has 10 fields, the header 9 (" + earlierFile + ")");
 }
 
 // ---------------------------------------------------------------------------------------
