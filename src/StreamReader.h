@@ -118,6 +118,19 @@ public:
         return true;
     }
 
+    /// Back to the first byte, as when just made, to read the data again (a file is read
+    /// again from disk; memory and a pipe loaded whole are not copied). Not for gzip, whose
+    /// inflater has moved on: @throw FileError then. Cost: a seek.
+    void rewind()
+    {
+        if (mGzip) fail(mPath, "cannot read compressed data twice");
+        if (mFd >= 0 && ::lseek(mFd, 0, SEEK_SET) != 0) failRead(mPath, errno);
+        mRawPos = 0;
+        mHead = mTail = 0;
+        mBufferStart = 0;
+        mPeekUsed = mPeekPos = 0;  // peeked bytes are read again from the file
+    }
+
     /// For gzip, inflate the rest, keeping nothing: its errors then come first, as when the
     /// whole file was inflated before parsing, and pos() becomes the inflated size.
     void drain()

@@ -9,6 +9,7 @@
 
 #include "TestUtil.h"
 
+#include "../src/ParticleReaders.h"
 #include "../src/StreamReader.h"
 
 #include <nonbloppy/Error.h>
@@ -24,6 +25,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstdlib>
 #include <cstring>
 #include <functional>
 #include <sstream>
@@ -498,6 +500,77 @@ TEST_F(ReadStreamingFormatsTest, JsonErrorsDeepInTheFile)
     EXPECT_EQ(errorOfBoth(twoFile, io::readJsonFile),
               "bad JSON particle list: particle " + std::to_string(point) +
               " has 2 coordinates, expected 3 (" + twoFile + ")");
+}
+
+TEST_F(ReadStreamingFormatsTest, JsonNumbersReadWithoutNlohmannAsNlohmannReadsThem)
+{
+    // `[[x, y, z], ...]` is read without nlohmann; a UTF-8 byte order mark, which nlohmann
+    // skips, sends the same text through nlohmann instead. Every number must give the same
+    // float bits both ways, and those of strtod's double.
+    const std::vector<std::string> numbers = {
+        "0", "-0", "1", "-1", "0.1", "-0.0", "1e2", "1E+2", "-2.5e-3", "0.1e1", "16777217", "0.30000000000000004",
+        "123456789012345678901234567890", "9007199254740993", "-9223372036854775809", "18446744073709551615",
+        "18446744073709551616", "3.4028235677973366e38", "1e-50", "4.9e-324", "2.2250738585072011e-308",
+        "-1.00000005960464477539062500001", "123.456e-7"};
+    std::string text = "[";
+    const char* spaces[] = {"", " ", "\t", "\r\n", "\n  "};
+    for (size_t n = 0; n < numbers.size(); ++n) {
+        const std::string space = spaces[n % 5];
+        text += (n ? "," : "") + space + "[" + numbers[n] + "," + space + "2" + space + ", " +
+                numbers[numbers.size() - 1 - n] + "]" + space;
+    }
+    text += "]\n";
+    const ParticleSet fast = io::readJsonParticles(text.data(), text.size(), "fast.json");
+    const std::string bom = "\xef\xbb\xbf" + text;
+    const ParticleSet nlohmann = io::readJsonParticles(bom.data(), bom.size(), "bom.json");
+    ASSERT_EQ(fast.size(), numbers.size());
+    ASSERT_EQ(nlohmann.size(), numbers.size());
+    const auto bits = [](float f) {
+        uint32_t b;
+        std::memcpy(&b, &f, 4);
+        return b;
+    };
+    for (size_t n = 0; n < numbers.size(); ++n) {
+        const float expected = static_cast<float>(std::strtod(numbers[n].c_str(), nullptr));
+        EXPECT_EQ(bits(fast.positions[n][0]), bits(expected)) << numbers[n];
+        EXPECT_EQ(bits(nlohmann.positions[n][0]), bits(expected)) << numbers[n];
+        EXPECT_EQ(bits(fast.positions[n][2]), bits(nlohmann.positions[n][2])) << numbers[numbers.size() - 1 - n];
+        EXPECT_EQ(fast.positions[n][1], 2.0f);
+    }
+}
+
+TEST_F(ReadStreamingFormatsTest, JsonTheFastReadingLeavesToNlohmannReadsTheSame)
+{
+    // What the fast reading does not take is read again from the start by nlohmann: a
+    // particle longer than its 4 KB window is accepted, and text JSON forbids gets
+    // nlohmann's message, from memory, a file or a pipe.
+    const std::string longText = "[[1, 2," + std::string(5000, ' ') + "3], [4, 5, 6]]";
+    const ParticleSet longParticle = io::readJsonParticles(longText.data(), longText.size(), "long.json");
+    ASSERT_EQ(longParticle.size(), 2u);
+    EXPECT_EQ(longParticle.positions[0], openvdb::Vec3f(1, 2, 3));
+    EXPECT_EQ(longParticle.positions[1], openvdb::Vec3f(4, 5, 6));
+    // A number whose double underflows (std::from_chars refuses it; strtod gives +0).
+    const std::string tiny = "[[1e-400, 2, 3]]";
+    const ParticleSet tinyParticle = io::readJsonParticles(tiny.data(), tiny.size(), "tiny.json");
+    ASSERT_EQ(tinyParticle.size(), 1u);
+    EXPECT_EQ(tinyParticle.positions[0], openvdb::Vec3f(0, 2, 3));
+    EXPECT_FALSE(std::signbit(tinyParticle.positions[0][0]));
+    for (const std::string bad : {"[[1,2,3]] x", "[[1,2,3],]", "[[01,2,3]]", "[[1.,2,3]]", "[[.5,2,3]]", "[[+1,2,3]]",
+                                  "[[1e,2,3]]", "[[-,2,3]]", "[[NaN,2,3]]", "[[1,2,3]", "[[1,2,3]][]", "[[1,2,3] [4,5,6]]"}) {
+        const std::string file = write("bad.json", bad);
+        EXPECT_EQ(errorOfBoth(file, io::readJsonFile), jsonSyntaxError(bad) + " (" + file + ")") << bad;
+        EXPECT_EQ(messageOf<FileError>([&] { io::readJsonParticles(bad.data(), bad.size(), "m.json"); }),
+                  jsonSyntaxError(bad) + " (m.json)") << bad;
+    }
+    // Deep in a pipe, which is loaded whole and read again from memory.
+    std::string garbled = jsonBytes(kManyParticles);
+    garbled[garbled.find('[', garbled.size() / 2) + 1] = '@';
+    const std::string fifo = path("garbled.json");
+    ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+    std::thread writer([&] { writeBytes(fifo, garbled); });
+    const std::string error = messageOf<FileError>([&] { io::readJsonFile(fifo); });
+    writer.join();
+    EXPECT_EQ(error, jsonSyntaxError(garbled) + " (" + fifo + ")");
 }
 
 // ---------------------------------------------------------------------------------------
