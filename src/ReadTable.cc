@@ -24,7 +24,7 @@
 /// (errors included) again from the start through nlohmann's SAX parser, with no DOM. The
 /// 64x benchmark input as CSV with id and velocity (107 MB), measured side by side:
 /// 0.26-0.28 s at two threads, 0.38-0.41 s at one (row by row: 0.35-0.37 s either way); its
-/// positions as JSON (51 MB): 0.12-0.13 s (nlohmann's parser alone: 0.65 s).
+/// positions as JSON (51 MB): 0.12-0.13 s (through nlohmann's parser: 0.63-0.65 s).
 /// Text has no counts to check; once the first rows show the bytes per particle, the
 /// arrays are reserved for the bytes left in the file plus a quarter (re-estimated if that
 /// falls short), so they are not copied as they grow.
@@ -690,8 +690,9 @@ inline const char* jsonNumberEnd(const char* p, const char* end)
 /// path leaves to nlohmann: a byte order mark, a number over 4 KB with its spaces, one that
 /// overflows), @a positions then partly filled. The values are nlohmann's: a number's
 /// double is correctly rounded by from_chars as by strtod, an integer's is the integer
-/// rounded the same way, and "-0" is -0.0 either way. nlohmann's parser read the 64x
-/// benchmark input (51 MB) at about 80 MB/s: 0.56 s, half a frame's meshing.
+/// rounded the same way, and "-0" is -0.0 either way. nlohmann read the 64x benchmark
+/// input's positions (51 MB) in 0.63 s through this reader (0.56 s from memory), about half
+/// a frame's meshing; this path in 0.12 s.
 bool
 readJsonFast(StreamReader& in, std::vector<openvdb::Vec3f>& positions)
 {
