@@ -8,7 +8,6 @@
 #include "ParticleReaders.h"
 
 #include <cstdlib>
-#include <cstring>
 #include <string>
 
 namespace {
