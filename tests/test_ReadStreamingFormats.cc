@@ -511,7 +511,7 @@ TEST_F(ReadStreamingFormatsTest, JsonNumbersReadWithoutNlohmannAsNlohmannReadsTh
         "0", "-0", "1", "-1", "0.1", "-0.0", "1e2", "1E+2", "-2.5e-3", "0.1e1", "16777217", "0.30000000000000004",
         "123456789012345678901234567890", "9007199254740993", "-9223372036854775809", "18446744073709551615",
         "18446744073709551616", "3.4028235677973366e38", "1e-50", "4.9e-324", "2.2250738585072011e-308",
-        "-1.00000005960464477539062500001", "123.456e-7"};
+        "-1.00000005960464477539062500001", "123.456e-7", "1e-400", "-1e-400"};
     std::string text = "[";
     const char* spaces[] = {"", " ", "\t", "\r\n", "\n  "};
     for (size_t n = 0; n < numbers.size(); ++n) {
@@ -525,6 +525,13 @@ TEST_F(ReadStreamingFormatsTest, JsonNumbersReadWithoutNlohmannAsNlohmannReadsTh
     const ParticleSet nlohmann = io::readJsonParticles(bom.data(), bom.size(), "bom.json");
     ASSERT_EQ(fast.size(), numbers.size());
     ASSERT_EQ(nlohmann.size(), numbers.size());
+    // A number whose double underflows (from_chars refuses it; parseDoubleText() and
+    // nlohmann's strtod give +0) is read without nlohmann too.
+    const std::string tiny = "[[1e-400, 2, 3]]";
+    const ParticleSet tinyParticle = io::readJsonParticles(tiny.data(), tiny.size(), "tiny.json");
+    ASSERT_EQ(tinyParticle.size(), 1u);
+    EXPECT_EQ(tinyParticle.positions[0], openvdb::Vec3f(0, 2, 3));
+    EXPECT_FALSE(std::signbit(tinyParticle.positions[0][0]));
     const auto bits = [](float f) {
         uint32_t b;
         std::memcpy(&b, &f, 4);
@@ -542,19 +549,17 @@ TEST_F(ReadStreamingFormatsTest, JsonNumbersReadWithoutNlohmannAsNlohmannReadsTh
 TEST_F(ReadStreamingFormatsTest, JsonTheFastReadingLeavesToNlohmannReadsTheSame)
 {
     // What the fast reading does not take is read again from the start by nlohmann: a
-    // particle longer than its 4 KB window is accepted, and text JSON forbids gets
-    // nlohmann's message, from memory, a file or a pipe.
+    // particle longer than its 4 KB window is accepted; a number past the largest double,
+    // and text JSON forbids, get nlohmann's message, from memory, a file or a pipe.
     const std::string longText = "[[1, 2," + std::string(5000, ' ') + "3], [4, 5, 6]]";
     const ParticleSet longParticle = io::readJsonParticles(longText.data(), longText.size(), "long.json");
     ASSERT_EQ(longParticle.size(), 2u);
     EXPECT_EQ(longParticle.positions[0], openvdb::Vec3f(1, 2, 3));
     EXPECT_EQ(longParticle.positions[1], openvdb::Vec3f(4, 5, 6));
-    // A number whose double underflows (std::from_chars refuses it; strtod gives +0).
-    const std::string tiny = "[[1e-400, 2, 3]]";
-    const ParticleSet tinyParticle = io::readJsonParticles(tiny.data(), tiny.size(), "tiny.json");
-    ASSERT_EQ(tinyParticle.size(), 1u);
-    EXPECT_EQ(tinyParticle.positions[0], openvdb::Vec3f(0, 2, 3));
-    EXPECT_FALSE(std::signbit(tinyParticle.positions[0][0]));
+    // A number past the largest double: nlohmann's message.
+    const std::string huge = "[[1e400, 2, 3]]";
+    EXPECT_EQ(messageOf<FileError>([&] { io::readJsonParticles(huge.data(), huge.size(), "huge.json"); }),
+              "bad JSON particle list: number overflow parsing '1e400' (byte 7) (huge.json)");
     for (const std::string bad : {"[[1,2,3]] x", "[[1,2,3],]", "[[01,2,3]]", "[[1.,2,3]]", "[[.5,2,3]]", "[[+1,2,3]]",
                                   "[[1e,2,3]]", "[[-,2,3]]", "[[NaN,2,3]]", "[[1,2,3]", "[[1,2,3]][]", "[[1,2,3] [4,5,6]]"}) {
         const std::string file = write("bad.json", bad);
