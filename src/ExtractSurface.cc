@@ -558,8 +558,8 @@ bool extractByRegionImpl(const openvdb::FloatGrid& density, double threshold, Su
         openvdb::FloatTree& regionTree = regionGrid->tree();
         // The voxels a region keeps: kShellPlanes planes beyond each cut face, unbounded
         // along the third axis.
-        openvdb::CoordBBox keep(openvdb::Coord(std::numeric_limits<int>::min()),
-                                openvdb::Coord(std::numeric_limits<int>::max()));
+        openvdb::CoordBBox keep{openvdb::Coord(std::numeric_limits<int>::min()),
+                                openvdb::Coord(std::numeric_limits<int>::max())};
         keep.min()[axis] = slabBegin - kShellPlanes;
         keep.max()[axis] = slabEnd + kShellPlanes - 1;
         keep.min()[cross] = bandBegin - kShellPlanes;

@@ -569,7 +569,7 @@ namespace {
 class JsonPointsHandler : public nlohmann::json_sax<nlohmann::json>
 {
 public:
-    JsonPointsHandler(StreamReader& in, const std::string& path) : mIn(in), mPath(path) {}
+    explicit JsonPointsHandler(StreamReader& in) : mIn(in) {}
 
     std::vector<openvdb::Vec3f> positions;
     std::string error;
@@ -640,7 +640,6 @@ private:
     }
 
     StreamReader& mIn;
-    const std::string& mPath;
     int mDepth = 0;
     int mComponent = 0;
     openvdb::Vec3f mPoint;
@@ -775,7 +774,7 @@ readJson(StreamReader& in, const std::string& path)
     // Not the usual layout, or not valid: nlohmann parses it from the start, and accepts it
     // or says why (its messages name the line and column).
     in.rewind();
-    JsonPointsHandler handler(in, path);
+    JsonPointsHandler handler(in);
     const bool ok = nlohmann::json::sax_parse(StreamReader::CharIterator(in, &handler.recentChars), StreamReader::CharIterator(),
                                               &handler, nlohmann::json::input_format_t::json, true);
     if (!ok || !handler.error.empty()) {

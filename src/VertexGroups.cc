@@ -130,8 +130,9 @@ void groupVerticesByCell(const std::vector<openvdb::Vec3s>& points, double group
     using particle_index_internal::cellOf;
     // Largest |coordinate| of a grouped vertex; NaN fails the comparison too.
     const float reach = float(double(1 << 30) * groupSize);
+    // One '&' of the three tests rather than '&&', which would branch and not vectorize.
     const auto inReach = [reach](const openvdb::Vec3s& p) {
-        return (std::abs(p[0]) < reach) & (std::abs(p[1]) < reach) & (std::abs(p[2]) < reach);
+        return bool(int(std::abs(p[0]) < reach) & int(std::abs(p[1]) < reach) & int(std::abs(p[2]) < reach));
     };
     // The cells of the lowest and highest corners of the grouped vertices' box bound every
     // one of their cells, since cellOf() is monotonic in each coordinate: min and max (which

@@ -115,9 +115,9 @@ TEST(Cancellation, ReconstructorStaysUsableAfterAStopInEveryStage)
     for (const char* stage : kStages) {
         SCOPED_TRACE(stage);
         StopInStage stop(stage);
-        EXPECT_EQ(cancelMessage([&] { reconstructor.reconstruct(ParticleSet{frame, {}}, &stop); }),
+        EXPECT_EQ(cancelMessage([&] { reconstructor.reconstruct(ParticleSet{frame, {}, {}}, &stop); }),
                   std::string("interrupted during ") + stage);
-        const SurfaceResult& got = reconstructor.reconstruct(ParticleSet{frame, {}});
+        const SurfaceResult& got = reconstructor.reconstruct(ParticleSet{frame, {}, {}});
         expectSameBytes(got.mesh, expected.mesh);
     }
     EXPECT_EQ(reconstructor.frameCount(), std::size(kStages));
@@ -135,7 +135,7 @@ TEST(Cancellation, StopAfterAnyNumberOfPollsNamesAStage)
         SCOPED_TRACE(n);
         StopAfterPolls stop(n);
         const std::string message =
-            cancelMessage([&] { reconstructor.reconstruct(ParticleSet{frame, {}}, &stop); });
+            cancelMessage([&] { reconstructor.reconstruct(ParticleSet{frame, {}, {}}, &stop); });
         if (message == "(not cancelled)") {
             // The number of polls varies a little with the threads' split of the work.
             EXPECT_GT(n, total / 2);
@@ -144,7 +144,7 @@ TEST(Cancellation, StopAfterAnyNumberOfPollsNamesAStage)
         bool known = false;
         for (const char* stage : kStages) known |= message == std::string("interrupted during ") + stage;
         EXPECT_TRUE(known) << message;
-        expectSameBytes(reconstructor.reconstruct(ParticleSet{frame, {}}).mesh, expected.mesh);
+        expectSameBytes(reconstructor.reconstruct(ParticleSet{frame, {}, {}}).mesh, expected.mesh);
     }
 }
 

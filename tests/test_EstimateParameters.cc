@@ -177,7 +177,8 @@ TEST(EstimateParameters, ThresholdGrowsWithTheRadius)
 {
     EXPECT_GT(calibrateThreshold(3.0), calibrateThreshold(2.0));
     EXPECT_GT(calibrateThreshold(2.0), 0.0);
-    for (const auto& [ratio, spelled] : {std::pair<double, const char*>{0.5, "0.5"}, {0.4, "0.4"}}) {
+    for (const auto& [ratioGiven, spelled] : {std::pair<double, const char*>{0.5, "0.5"}, {0.4, "0.4"}}) {
+        const double ratio = ratioGiven;  // C++17 lambdas cannot capture a structured binding
         EXPECT_EQ(nonbloppy_test::messageOf<ParameterError>([&] { calibrateThreshold(ratio); }),
                   std::string("--radius must exceed half the particle spacing to calibrate --threshold, got ") +
                       spelled + " spacings");
@@ -188,7 +189,8 @@ TEST(EstimateParameters, ThresholdGrowsWithTheRadius)
     EXPECT_EQ(nonbloppy_test::messageOf<ParameterError>([] { calibrateRelaxedThreshold(32.5, 0.3, 2); }), tooLarge);
     // Just above half a spacing the kernel reached no sample: both returned r_0 = 0, and
     // buildSurface() meshed nothing without a word.
-    for (const auto& [ratio, spelled] : {std::pair<double, const char*>{0.5000001, "0.5"}, {0.501, "0.501"}}) {
+    for (const auto& [ratioGiven, spelled] : {std::pair<double, const char*>{0.5000001, "0.5"}, {0.501, "0.501"}}) {
+        const double ratio = ratioGiven;  // as above
         const std::string message = std::string("--radius is too small to calibrate --threshold: at ") + spelled +
                                     " spacings the density where the surface belongs is 0; give a larger --radius "
                                     "or --threshold";

@@ -92,11 +92,11 @@ TEST(SurfaceReconstructor, KeepsTheFirstFramesParametersWhenAsked)
     const auto sparse = latticeParticles(0.2, 0.7, [](const openvdb::Vec3d& x) { return x.length() < 0.6; });
     SurfaceReconstructor reconstructor;
     reconstructor.setKeepParameters(true);
-    const double spacing = reconstructor.reconstruct(ParticleSet{dense, {}}).parameters.spacing;
+    const double spacing = reconstructor.reconstruct(ParticleSet{dense, {}, {}}).parameters.spacing;
     EXPECT_NEAR(spacing, 0.1, 0.005 * 0.1);
-    EXPECT_EQ(reconstructor.reconstruct(ParticleSet{sparse, {}}).parameters.spacing, spacing);
+    EXPECT_EQ(reconstructor.reconstruct(ParticleSet{sparse, {}, {}}).parameters.spacing, spacing);
     reconstructor.setKeepParameters(false);
-    EXPECT_NEAR(reconstructor.reconstruct(ParticleSet{sparse, {}}).parameters.spacing, 0.2, 0.005 * 0.2);
+    EXPECT_NEAR(reconstructor.reconstruct(ParticleSet{sparse, {}, {}}).parameters.spacing, 0.2, 0.005 * 0.2);
 }
 
 TEST(SurfaceReconstructor, NewParametersForgetTheKeptOnes)
@@ -110,22 +110,22 @@ TEST(SurfaceReconstructor, NewParametersForgetTheKeptOnes)
     strong.blend = 0.5;
     SurfaceReconstructor reconstructor(strong);
     reconstructor.setKeepParameters(true);
-    EXPECT_NEAR(reconstructor.reconstruct(ParticleSet{dense, {}}).parameters.spacing, 0.1, 0.005 * 0.1);
+    EXPECT_NEAR(reconstructor.reconstruct(ParticleSet{dense, {}, {}}).parameters.spacing, 0.1, 0.005 * 0.1);
     reconstructor.setParameters(SurfaceParameters());
     EXPECT_EQ(reconstructor.parameters().blend, SurfaceParameters().blend);
     EXPECT_TRUE(reconstructor.keepParameters());  // only the kept values are forgotten
-    const SurfaceResult& next = reconstructor.reconstruct(ParticleSet{sparse, {}});
+    const SurfaceResult& next = reconstructor.reconstruct(ParticleSet{sparse, {}, {}});
     EXPECT_NEAR(next.parameters.spacing, 0.2, 0.005 * 0.2);
     SurfaceReconstructor fresh;
     fresh.setKeepParameters(true);
-    const SurfaceResult& expected = fresh.reconstruct(ParticleSet{sparse, {}});
+    const SurfaceResult& expected = fresh.reconstruct(ParticleSet{sparse, {}, {}});
     EXPECT_EQ(next.parameters.spacing, expected.parameters.spacing);
     EXPECT_EQ(next.parameters.effectiveRadius, expected.parameters.effectiveRadius);
     EXPECT_EQ(next.parameters.threshold, expected.parameters.threshold);
     EXPECT_EQ(next.parameters.voxelSize, expected.parameters.voxelSize);
     expectSameMesh(next.mesh, expected.mesh);
     // And the new parameters are kept in turn: a dense frame now keeps the sparse spacing.
-    EXPECT_EQ(reconstructor.reconstruct(ParticleSet{dense, {}}).parameters.spacing, next.parameters.spacing);
+    EXPECT_EQ(reconstructor.reconstruct(ParticleSet{dense, {}, {}}).parameters.spacing, next.parameters.spacing);
 }
 
 TEST(SurfaceReconstructor, AFrameWithoutParticlesIsRefusedKeptParametersOrNot)
@@ -138,11 +138,11 @@ TEST(SurfaceReconstructor, AFrameWithoutParticlesIsRefusedKeptParametersOrNot)
     for (const bool keep : {false, true}) {
         SurfaceReconstructor reconstructor(params);
         reconstructor.setKeepParameters(keep);
-        const size_t vertices = reconstructor.reconstruct(ParticleSet{ball, {}}).mesh.points.size();
+        const size_t vertices = reconstructor.reconstruct(ParticleSet{ball, {}, {}}).mesh.points.size();
         EXPECT_EQ(nonbloppy_test::messageOf<ParameterError>([&] { reconstructor.reconstruct(ParticleSet{}); }),
                   "no particles to mesh")
             << "keep " << keep;
-        EXPECT_EQ(reconstructor.reconstruct(ParticleSet{ball, {}}).mesh.points.size(), vertices);
+        EXPECT_EQ(reconstructor.reconstruct(ParticleSet{ball, {}, {}}).mesh.points.size(), vertices);
     }
 }
 
@@ -157,12 +157,12 @@ TEST(SurfaceReconstructor, AFrameThatFailsKeepsNoParameters)
         SurfaceReconstructor reconstructor;
         reconstructor.setKeepParameters(true);
         StopInStage stop(stage);
-        EXPECT_THROW(reconstructor.reconstruct(ParticleSet{dense, {}}, &stop), CancelledError);
-        const SurfaceResult& next = reconstructor.reconstruct(ParticleSet{sparse, {}});
+        EXPECT_THROW(reconstructor.reconstruct(ParticleSet{dense, {}, {}}, &stop), CancelledError);
+        const SurfaceResult& next = reconstructor.reconstruct(ParticleSet{sparse, {}, {}});
         EXPECT_NEAR(next.parameters.spacing, 0.2, 0.005 * 0.2);
         SurfaceReconstructor fresh;
         fresh.setKeepParameters(true);
-        expectSameMesh(next.mesh, fresh.reconstruct(ParticleSet{sparse, {}}).mesh);
+        expectSameMesh(next.mesh, fresh.reconstruct(ParticleSet{sparse, {}, {}}).mesh);
     }
 }
 
@@ -171,9 +171,9 @@ TEST(SurfaceReconstructor, CancelledFrameLeavesItUsable)
     const auto frame = ballFrame(0.6, 3);
     SurfaceReconstructor reconstructor;
     StopAlways stop;
-    EXPECT_THROW(reconstructor.reconstruct(ParticleSet{frame, {}}, &stop), CancelledError);
+    EXPECT_THROW(reconstructor.reconstruct(ParticleSet{frame, {}, {}}, &stop), CancelledError);
     const SurfaceResult expected = buildSurface(frame);
-    expectSameMesh(reconstructor.reconstruct(ParticleSet{frame, {}}).mesh, expected.mesh);
+    expectSameMesh(reconstructor.reconstruct(ParticleSet{frame, {}, {}}).mesh, expected.mesh);
 }
 
 TEST(SurfaceReconstructor, BadParametersThrowParameterError)
@@ -181,7 +181,7 @@ TEST(SurfaceReconstructor, BadParametersThrowParameterError)
     SurfaceParameters params;
     params.blend = 2.0;
     SurfaceReconstructor reconstructor(params);
-    const ParticleSet frame{ballFrame(0.5, 1), {}};
+    const ParticleSet frame{ballFrame(0.5, 1), {}, {}};
     EXPECT_EQ(nonbloppy_test::messageOf<ParameterError>([&] { reconstructor.reconstruct(frame); }),
               "--blend must lie in [0,1], got 2");
 }
@@ -195,10 +195,10 @@ TEST(SurfaceReconstructor, AFrameThatThrowsLeavesAnEmptyUsableIndex)
     const auto large = ballFrame(0.9, 2);  // more particles: the position buffer is recycled
     auto withNaN = large;
     withNaN[7][1] = std::numeric_limits<float>::quiet_NaN();
-    const auto nanFrame = [&](SurfaceReconstructor& r) { r.reconstruct(ParticleSet{withNaN, {}}); };
+    const auto nanFrame = [&](SurfaceReconstructor& r) { r.reconstruct(ParticleSet{withNaN, {}, {}}); };
     const auto stoppedFrame = [&](SurfaceReconstructor& r) {
         StopInStage stop("relax vertices");
-        r.reconstruct(ParticleSet{large, {}}, &stop);
+        r.reconstruct(ParticleSet{large, {}, {}}, &stop);
     };
     const auto readerFails = [&](SurfaceReconstructor& r) { r.reconstruct(ThrowingParticles{&large, 11}); };
     const std::vector<std::function<void(SurfaceReconstructor&)>> failures{nanFrame, stoppedFrame, readerFails};
@@ -207,7 +207,7 @@ TEST(SurfaceReconstructor, AFrameThatThrowsLeavesAnEmptyUsableIndex)
     for (size_t k = 0; k < failures.size(); ++k) {
         SCOPED_TRACE(messages[k]);
         SurfaceReconstructor reconstructor;
-        const SurfaceResult& first = reconstructor.reconstruct(ParticleSet{small, {}});
+        const SurfaceResult& first = reconstructor.reconstruct(ParticleSet{small, {}, {}});
         ASSERT_EQ(reconstructor.particleIndex().size(), small.size());
         SurfaceMesh probe = first.mesh;
         try {
@@ -231,9 +231,9 @@ TEST(SurfaceReconstructor, AFrameThatThrowsLeavesAnEmptyUsableIndex)
         EXPECT_EQ(rasterizeDensity(reconstructor.particleIndex(), density)->activeVoxelCount(), 0u);
 
         // And the next frame is a fresh object's.
-        const SurfaceResult& next = reconstructor.reconstruct(ParticleSet{large, {}});
+        const SurfaceResult& next = reconstructor.reconstruct(ParticleSet{large, {}, {}});
         EXPECT_EQ(reconstructor.particleIndex().size(), large.size());
         SurfaceReconstructor fresh;
-        expectSameMesh(next.mesh, fresh.reconstruct(ParticleSet{large, {}}).mesh);
+        expectSameMesh(next.mesh, fresh.reconstruct(ParticleSet{large, {}, {}}).mesh);
     }
 }

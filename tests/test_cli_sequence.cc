@@ -211,7 +211,7 @@ TEST_F(CliSequenceTest, NoOutputIsNamedSoTheInputPatternWouldReadItAsAFrame)
     EXPECT_EQ(listDir(dir() + "/in"), (std::vector<std::string>{"f_007.vtk"}));
     EXPECT_EQ(readText(in("f_007.vtk")), before);
     // A name the pattern does not read, or another directory, is fine.
-    for (const std::string output : {in("f_####_mesh.vtk"), out("f_####.vtk")}) {
+    for (const std::string& output : {in("f_####_mesh.vtk"), out("f_####.vtk")}) {
         const RunResult r = run("mesh -q " + quote(in("f_{}.vtk")) + " -o " + quote(output));
         EXPECT_EQ(r.exitCode, 0) << output << ": " << r.err;
     }
