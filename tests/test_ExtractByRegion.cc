@@ -391,8 +391,13 @@ TEST(ExtractByRegion, SeamVerticesThatShareAPositionAreNotWelded)
     };
     for (int i = 0; i < 200; ++i)
         for (int j = 0; j < 20; ++j)
-            for (int k = 0; k < 20; ++k)
-                box.emplace_back(3.0e4f + 0.25f * (float(i) + jitter()), 3.0e4f + 0.25f * (float(j) + jitter()),
-                                 3.0e4f + 0.25f * (float(k) + jitter()));
+            for (int k = 0; k < 20; ++k) {
+                // Drawn in sequence, z first (as GCC evaluated the arguments this box was found
+                // with): an argument list's order is unspecified, and clang's left-to-right
+                // order made another box, with no ambiguous seam to fall back on.
+                const float jz = jitter(), jy = jitter(), jx = jitter();
+                box.emplace_back(3.0e4f + 0.25f * (float(i) + jx), 3.0e4f + 0.25f * (float(j) + jy),
+                                 3.0e4f + 0.25f * (float(k) + jz));
+            }
     expectWholeGridsMesh(box, SurfaceParameters(), 64, 2, "box 3e4 out");
 }

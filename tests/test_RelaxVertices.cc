@@ -183,13 +183,18 @@ TEST(RelaxVertices, VerticesThatTravelFarMatchTheDirectSum)
     };
     for (int i = 0; i < 6; ++i)
         for (int j = 0; j < 6; ++j)
-            for (int k = 0; k < 6; ++k)
-                particles.push_back(openvdb::Vec3f(0.3f * (float(i) + 0.3f * jitter()), 0.3f * (float(j) + 0.3f * jitter()),
-                                                   0.3f * (float(k) + 0.3f * jitter())));
+            for (int k = 0; k < 6; ++k) {
+                // In sequence, z first (GCC's argument order, which the data were made with):
+                // an argument list's order is unspecified, and other compilers drew another block.
+                const float jz = jitter(), jy = jitter(), jx = jitter();
+                particles.push_back(openvdb::Vec3f(0.3f * (float(i) + 0.3f * jx), 0.3f * (float(j) + 0.3f * jy),
+                                                   0.3f * (float(k) + 0.3f * jz)));
+            }
     const double radius = 1.0;
     SurfaceMesh mesh;
     for (int n = 0; n < 3000; ++n) {  // around the block, most within r_e of some particle
-        mesh.points.push_back(openvdb::Vec3s(0.75f + 3.8f * jitter(), 0.75f + 3.8f * jitter(), 0.75f + 3.8f * jitter()));
+        const float jz = jitter(), jy = jitter(), jx = jitter();  // as above
+        mesh.points.push_back(openvdb::Vec3s(0.75f + 3.8f * jx, 0.75f + 3.8f * jy, 0.75f + 3.8f * jz));
     }
     std::vector<openvdb::Vec3d> expected(mesh.points.begin(), mesh.points.end());
     const int iterations = 3;
@@ -230,7 +235,9 @@ TEST(RelaxVertices, AStopLeavesEachVertexWhereItWasOrFullyRelaxed)
     };
     SurfaceMesh start;
     for (int n = 0; n < 20000; ++n) {
-        start.points.push_back(openvdb::Vec3s(600.0f * (jitter() + 0.5f), 1.2f * jitter(), 1.2f * jitter()));
+        // In sequence, z first (GCC's argument order, which the data were made with).
+        const float jz = jitter(), jy = jitter(), jx = jitter();
+        start.points.push_back(openvdb::Vec3s(600.0f * (jx + 0.5f), 1.2f * jy, 1.2f * jz));
     }
     const ParticleIndex index = ParticleIndex::build(particles, 0.5);
     SurfaceMesh relaxed = start;
