@@ -20,9 +20,9 @@
 /// table rows a buffered block of whole lines at a time, cut into pieces that are parsed
 /// in parallel and stored in order as they come, an attribute's values as int64 while
 /// every one is a whole number that fits, then as float64 (those before converted) from
-/// the first that is not; JSON `[[x, y, z], ...]` with parseDoubleText(), anything else
-/// (errors included) again from the start through nlohmann's SAX parser, with no DOM. The
-/// 64x benchmark input as CSV with id and velocity (107 MB), measured side by side:
+/// the first that is not; JSON `[[x, y, z], ...]` with parseDoubleRefusingOverflow(),
+/// anything else (errors included) again from the start through nlohmann's SAX parser, with
+/// no DOM. The 64x benchmark input as CSV with id and velocity (107 MB), measured side by side:
 /// 0.26-0.28 s at two threads, 0.38-0.41 s at one (row by row: 0.35-0.37 s either way); its
 /// positions as JSON (51 MB): 0.12-0.13 s (through nlohmann's parser: 0.63-0.65 s).
 /// Text has no counts to check; once the first rows show the bytes per particle, the
@@ -684,10 +684,11 @@ inline const char* jsonNumberEnd(const char* p, const char* end)
 }
 
 /// The particle list without nlohmann, for the layout of nearly every file: `[[x, y, z],
-/// ...]` with JSON whitespace and numbers, read as they come with parseDoubleText(). True
-/// with every position read; false as soon as the text is anything else (an error, or JSON
-/// this path leaves to nlohmann: a byte order mark, a particle longer than 4 KB with its
-/// spaces, a number past the largest double), @a positions then partly filled. The values
+/// ...]` with JSON whitespace and numbers, read as they come with
+/// parseDoubleRefusingOverflow(). True with every position read; false as soon as the text
+/// is anything else (an error, or JSON this path leaves to nlohmann: a byte order mark, a
+/// particle longer than 4 KB with its spaces, a number past the largest double), @a
+/// positions then partly filled. The values
 /// are nlohmann's: a number's double is correctly rounded by from_chars (or, below the
 /// smallest double, strtod) as by nlohmann's strtod, an integer's is the integer rounded the
 /// same way, and "-0" is -0.0 either way. nlohmann read the 64x benchmark
