@@ -4,6 +4,7 @@
 ///        file, text, number and type-name helpers that the streaming readers use too.
 
 #include "FileFormats.h"
+#include "MachineMemory.h"
 
 #include <nonbloppy/Error.h>
 
@@ -145,6 +146,17 @@ void
 fail(const std::string& path, const std::string& what)
 {
     throw FileError(what + " (" + path + ")");
+}
+
+void
+requireMemoryForParticles(const std::string& path, uint64_t count, uint64_t bytesPerParticle)
+{
+    const double bytes = double(count) * double(bytesPerParticle);
+    const double headroom = machine_memory_internal::memoryHeadroomBytes();
+    if (!(headroom >= 0.0) || !(bytes > headroom)) return;
+    fail(path, std::to_string(count) + " particles would take " + machine_memory_internal::formatBytes(bytes) +
+        " of memory, more than the " + machine_memory_internal::formatBytes(headroom) +
+        " this process can still take");
 }
 
 namespace {
@@ -1012,6 +1024,7 @@ private:
         if (n > std::numeric_limits<uint64_t>::max() / 3) fail(mPath, "truncated POINTS section");
         mReader->requireRoom(3 * n, type, "POINTS section");
         static_assert(sizeof(openvdb::Vec3f) == 12, "Vec3f must be three packed floats");
+        requireMemoryForParticles(mPath, n, sizeof(openvdb::Vec3f));
         mData.points.resize(size_t(n));
         mPointCount = n;
         mReader->readFloats(size_t(3 * n), type, "POINTS section",

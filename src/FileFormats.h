@@ -75,6 +75,14 @@ std::string requireMeshExtension(const std::string& path);
 /// Throw FileError("<what> (<path>)").
 [[noreturn]] void fail(const std::string& path, const std::string& what);
 
+/// Throw FileError("<count> particles would take <bytes> of memory, more than the <headroom>
+/// this process can still take (<path>)") if @a count particles of @a bytesPerParticle each
+/// exceed machine_memory_internal::memoryHeadroomBytes(): a file that holds more particles
+/// than fit in memory is refused before its arrays are allocated, naming the file, instead
+/// of ending in std::bad_alloc ("out of memory") or the kernel's OOM killer. Nothing where
+/// the headroom is unknown. Cost: a few small reads under /proc and /sys.
+void requireMemoryForParticles(const std::string& path, uint64_t count, uint64_t bytesPerParticle);
+
 /// @a text made safe for a one-line message: at most @a maxLength characters (then "..."),
 /// non-printable bytes replaced by '?'.
 std::string printable(std::string_view text, size_t maxLength = 40);

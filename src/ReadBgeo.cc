@@ -180,6 +180,8 @@ parseBgeo(StreamReader& stream, const std::string& path)
             uint64_t(pointCount), (stream.available() + compressedLeft * kTrustedRatio) / pointBytes));
     }
 
+    // In memory: 12 bytes of position (w is dropped) and the attributes' float32 values.
+    requireMemoryForParticles(path, reserved, pointBytes - 4);
     ParticleSet particles;
     particles.positions.reserve(reserved);
     particles.attributes.resize(attributes.size());

@@ -397,6 +397,11 @@ private:
                 fail(mPath, "PLY property '" + property.name + "' must be float or double");
             }
         }
+        uint64_t bytesPerParticle = sizeof(openvdb::Vec3f);
+        for (const AttributeColumn& column : attributeColumns) {
+            bytesPerParticle += scalarSize(element.properties[column.index].type);
+        }
+        requireMemoryForParticles(mPath, count, bytesPerParticle);
         mData.positions.resize(count);
         const std::vector<ColumnGroup> groups = groupColumns(attributeColumns);
         mData.attributes.reserve(groups.size());  // the columns point into it
@@ -546,6 +551,7 @@ readXyzParticles(const std::string& path)
         fail(path, "XYZ file size " + std::to_string(stream.size()) +
             " is not a multiple of 12 bytes (three float32 per particle)");
     }
+    requireMemoryForParticles(path, stream.size() / 12, sizeof(openvdb::Vec3f));
     ParticleSet particles;
     particles.positions.resize(size_t(stream.size() / 12));
     static_assert(sizeof(openvdb::Vec3f) == 12, "Vec3f must be three packed floats");

@@ -166,6 +166,7 @@ convertGrid(const PointDataGrid& grid, const std::string& path)
         count += leaf->pointCount();
     }
 
+    requireMemoryForParticles(path, count, sizeof(openvdb::Vec3f));
     particles.positions.resize(size_t(count));
     size_t n = 0;
     const openvdb::math::Transform& transform = grid.transform();

@@ -1431,6 +1431,7 @@ private:
         size_t start = 0;
         if (target == ArraySink::kPositions) {
             start = mPiece.positionOffset;
+            requireMemoryForParticles(mPath, mPiece.positionOffset + tuples, sizeof(openvdb::Vec3f));
             mParticles.positions.resize(mPiece.positionOffset + size_t(tuples));
         } else if (target >= 0) {
             std::vector<unsigned char>& bytes = mParticles.attributes[size_t(target)].bytes;

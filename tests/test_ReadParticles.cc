@@ -24,6 +24,8 @@
 #include <string>
 #include <vector>
 
+#include <unistd.h>
+
 namespace {
 
 using nonbloppy_test::dataPath;
@@ -584,6 +586,44 @@ TEST_F(ReadParticlesTest, HeadersClaimingMoreThanTheFileHoldsAreRejectedBeforeAl
     EXPECT_LT(nonbloppy_test::largestAllocationDuring([&] { message = fileErrorOf(ply); }), size_t(2) << 20);
     EXPECT_EQ(message, "truncated PLY vertex element (" + ply + ")");
     EXPECT_LT(nonbloppy_test::largestAllocationDuring([&] { message = fileErrorOf(p); }), size_t(2) << 20);
+}
+
+// A file that really holds more particles than the machine's memory (here sparse files, which
+// take no disk) is refused by name before its arrays are allocated, not with std::bad_alloc
+// ("out of memory", naming nothing) or by the kernel's OOM killer.
+TEST_F(ReadParticlesTest, FilesHoldingMoreParticlesThanMemoryAreRefusedBeforeAllocating)
+{
+    const long pages = sysconf(_SC_PHYS_PAGES), pageSize = sysconf(_SC_PAGE_SIZE);
+    ASSERT_GT(pages, 0);
+    ASSERT_GT(pageSize, 0);
+    // Twice the machine's memory in float32 positions alone.
+    const uint64_t count = 2 * uint64_t(pages) * uint64_t(pageSize) / 12;
+    const std::string countText = std::to_string(count);
+    const auto sparseFile = [&](const std::string& file, const std::string& header, uint64_t dataBytes) {
+        writeBytes(file, header);
+        if (truncate(file.c_str(), off_t(header.size() + dataBytes)) != 0) return false;
+        return true;
+    };
+    const std::string ply = path("many.ply"), xyz = path("many.xyz"), vtk = path("many.vtk");
+    if (!sparseFile(ply, "ply\nformat binary_little_endian 1.0\nelement vertex " + countText +
+                             "\nproperty float x\nproperty float y\nproperty float z\nend_header\n",
+                    count * 12)) {
+        GTEST_SKIP() << "this file system holds no sparse file of " << count * 12 << " bytes";
+    }
+    ASSERT_TRUE(sparseFile(xyz, "", count * 12));
+    ASSERT_TRUE(sparseFile(vtk, "# vtk DataFile Version 4.1\nx\nBINARY\nDATASET POLYDATA\nPOINTS " + countText +
+                                    " float\n", count * 12));
+    for (const std::string& file : {ply, xyz, vtk}) {
+        std::string message;
+        EXPECT_LT(nonbloppy_test::largestAllocationDuring([&] { message = fileErrorOf(file); }), size_t(2) << 20)
+            << file;
+        const std::string start = countText + " particles would take ";
+        const std::string end = " this process can still take (" + file + ")";
+        EXPECT_EQ(message.substr(0, start.size()), start) << message;
+        EXPECT_NE(message.find(" of memory, more than the "), std::string::npos) << message;
+        ASSERT_GE(message.size(), end.size()) << message;
+        EXPECT_EQ(message.substr(message.size() - end.size()), end) << message;
+    }
 }
 
 TEST_F(ReadParticlesTest, CorruptHeadersGiveOneLineMessages)

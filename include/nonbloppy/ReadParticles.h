@@ -67,10 +67,12 @@
 namespace nonbloppy {
 
 /// Read every particle and per-particle attribute of @a path.
-/// @throw FileError  for a missing, unreadable, truncated or corrupt file, or an unknown
-///                   extension; one line naming @a path, e.g.
-///                   "cannot open x.vtk: No such file or directory",
-///                   "truncated POINTS section (x.vtk)".
+/// @throw FileError  for a missing, unreadable, truncated or corrupt file, an unknown
+///                   extension, or more particles than the memory this process can still
+///                   take (checked before the arrays are allocated); one line naming @a path,
+///                   e.g. "cannot open x.vtk: No such file or directory",
+///                   "truncated POINTS section (x.vtk)", "8000000000 particles would take
+///                   96 GB of memory, more than the 25.2 GB this process can still take (x.ply)".
 /// @throw ParameterError  for NaN or infinite coordinates, or doubles too large for float:
 ///                   "non-finite position of particle 17 (x.vtk)".
 /// Thread-safe: yes (no shared state).
