@@ -32,6 +32,7 @@
 #include <cerrno>
 #include <cmath>
 #include <cstring>
+#include <new>
 
 #include <unistd.h>
 
@@ -602,6 +603,24 @@ std::string houdiniAdvice(const std::string& path)
            + "; export it from Houdini as .bhclassic (classic binary geometry; renaming does not convert it)";
 }
 
+/// The reader for the lower-case extension @a ext, which isParticleFile() accepted.
+ParticleSet
+readParticlesByExtension(const std::string& path, const std::string& ext)
+{
+    if (ext == ".vtk") return readVtkParticles(path);
+    if (ext == ".ply") {
+        FileStream stream(path);
+        return PlyReader(stream, path).read();
+    }
+    if (ext == ".xyz") return readXyzParticles(path);
+    if (ext == ".bgeo") return readBgeoFile(path);
+    if (ext == ".csv" || ext == ".txt") return readTableFile(path);
+    if (ext == ".json") return readJsonFile(path);
+    if (ext == ".vtu" || ext == ".vtp") return readVtuFile(path);
+    // .vdb: walked and checked through a window, then read by OpenVDB from the file.
+    return readVdbPointsFile(path);
+}
+
 } // namespace
 
 ParticleSet
@@ -620,27 +639,18 @@ readParticles(const std::string& path)
     }
 
     ParticleSet particles;
-    if (ext == ".vtk") {
-        particles = readVtkParticles(path);
-    } else if (ext == ".ply") {
-        FileStream stream(path);
-        particles = PlyReader(stream, path).read();
-    } else if (ext == ".xyz") {
-        particles = readXyzParticles(path);
-    } else if (ext == ".bgeo") {
-        particles = readBgeoFile(path);
-    } else if (ext == ".csv" || ext == ".txt") {
-        particles = readTableFile(path);
-    } else if (ext == ".json") {
-        particles = readJsonFile(path);
-    } else if (ext == ".vtu" || ext == ".vtp") {
-        particles = readVtuFile(path);
-    } else {
-        // .vdb: walked and checked through a window, then read by OpenVDB from the file.
-        particles = readVdbPointsFile(path);
+    // The readers refuse before allocating what a file's header or size announces beyond the
+    // memory left (requireMemoryForParticles()); text read row by row (CSV, JSON) announces
+    // nothing, so its growth can still run out: said here with the file's name, not as a bare
+    // "out of memory" (whatever was read is freed by then).
+    try {
+        particles = readParticlesByExtension(path, ext);
+    } catch (const std::bad_alloc&) {
+        fail(path, "out of memory while reading the particles");
     }
 
     // Later stages hash positions into voxels; one NaN would poison the whole grid.
+
     for (size_t i = 0; i < particles.positions.size(); ++i) {
         const openvdb::Vec3f& p = particles.positions[i];
         if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2])) {
