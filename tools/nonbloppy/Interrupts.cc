@@ -59,6 +59,7 @@ SignalHandlerScope::SignalHandlerScope()
         if (kStopSignals[n] == SIGHUP && mOld[n] == SIG_IGN) std::signal(SIGHUP, SIG_IGN);
     }
     mOldPipe = std::signal(SIGPIPE, SIG_IGN);
+    mOldFileSize = std::signal(SIGXFSZ, SIG_IGN);
 }
 
 SignalHandlerScope::~SignalHandlerScope()
@@ -67,6 +68,7 @@ SignalHandlerScope::~SignalHandlerScope()
         std::signal(kStopSignals[n], mOld[n] == SIG_ERR ? SIG_DFL : mOld[n]);
     }
     std::signal(SIGPIPE, mOldPipe == SIG_ERR ? SIG_DFL : mOldPipe);
+    std::signal(SIGXFSZ, mOldFileSize == SIG_ERR ? SIG_DFL : mOldFileSize);
 }
 
 bool interruptRequested()

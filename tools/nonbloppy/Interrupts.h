@@ -25,7 +25,10 @@ namespace nonbloppy_tool {
 /// SIGINTs), a later one ends the process at once (the signal's default action: the run did
 /// not stop on its own, it may be blocked reading a FIFO nobody writes); a SIGHUP that was
 /// ignored (nohup) stays ignored. SIGPIPE is ignored: a reader of stdout that went away
-/// ('| head -1') used to end the run silently with exit 141. The previous handlers are
+/// ('| head -1') used to end the run silently with exit 141. SIGXFSZ is ignored too: under a
+/// file-size limit (ulimit -f) it ended the run with exit 153 and left the temporary output
+/// behind; ignored, the write fails with EFBIG ("File too large"), reported and cleaned up
+/// like a full disk. The previous handlers are
 /// restored at the end. One at a time (the flag is the process's).
 class SignalHandlerScope
 {
@@ -39,6 +42,7 @@ private:
     static constexpr std::array<int, 3> kStopSignals{SIGINT, SIGTERM, SIGHUP};
     std::array<void (*)(int), 3> mOld{SIG_DFL, SIG_DFL, SIG_DFL};
     void (*mOldPipe)(int) = SIG_DFL;
+    void (*mOldFileSize)(int) = SIG_DFL;
 };
 
 /// True once a stop signal arrived within the current SignalHandlerScope. Lock-free; any thread.
