@@ -165,6 +165,22 @@ void runStoppable(CancelPoll& poll, WorkT&& work)
     stopWatcher();
 }
 
+/// Run @a work, a call of OpenVDB's parallel tools made inside a TBB algorithm of nonbloppy's
+/// own (a parallel_invoke, a pipeline), under a TBB context isolated from the caller's. When
+/// a sibling task throws (std::bad_alloc under ulimit -v, say), TBB cancels the caller's
+/// context and every context bound to it: the tool's parallel loops then skip their tasks and
+/// its serial code reads what they never wrote. createPointIndexGrid() crashed that way
+/// (segfault in PointPartitioner's binning, exit 139, a 4M-particle CSV at ulimit -v 340000).
+/// Isolated, the tool runs to its end; exceptions of @a work itself still reach the caller.
+/// Cost: one task spawn (microseconds).
+template<typename WorkT>
+void runIsolatedFromCancellation(WorkT&& work)
+{
+    tbb::task_group_context context(tbb::task_group_context::isolated);
+    tbb::task_group group(context);
+    group.run_and_wait([&] { work(); });
+}
+
 } // namespace cancellation_internal
 } // namespace nonbloppy
 

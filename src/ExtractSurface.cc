@@ -855,7 +855,11 @@ bool extractByRegionImpl(const openvdb::FloatGrid& density, double threshold, Su
             })
         & tbb::make_filter<size_t, size_t>(tbb::filter_mode::parallel,
             [&](size_t r) {
-                if (!poll.stopped() && !ambiguousSeam) meshers[r] = meshRegion(regions[r]);
+                // Isolated: an exception in another region or a weld (std::bad_alloc) cancels
+                // the pipeline, and volumeToMesh must not see its loops cancelled.
+                if (!poll.stopped() && !ambiguousSeam) {
+                    cancellation_internal::runIsolatedFromCancellation([&] { meshers[r] = meshRegion(regions[r]); });
+                }
                 return r;
             })
         & tbb::make_filter<size_t, void>(tbb::filter_mode::serial_in_order,

@@ -114,8 +114,11 @@ ParticleIndex ParticleIndex::build(std::vector<openvdb::Vec3f> positions, double
     // them in one thread, 25 MB and 6,000 page faults on the 64x benchmark input.
     tbb::parallel_invoke(
         [&] {
-            impl.grid = openvdb::tools::createPointIndexGrid<openvdb::tools::PointIndexGrid>(
-                PositionList{positions}, *transform);
+            // Isolated: a std::bad_alloc of the other branch must not cancel its loops.
+            cancellation_internal::runIsolatedFromCancellation([&] {
+                impl.grid = openvdb::tools::createPointIndexGrid<openvdb::tools::PointIndexGrid>(
+                    PositionList{positions}, *transform);
+            });
         },
         [&] {
             impl.sortedPositions.resize(positions.size());

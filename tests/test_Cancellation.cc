@@ -16,10 +16,20 @@
 #include <nonbloppy/Particles.h>
 #include <nonbloppy/SurfaceReconstructor.h>
 
+#include "../src/Cancellation.h"
+
 #include <gtest/gtest.h>
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_invoke.h>
+#include <tbb/task_arena.h>
+
 #include <atomic>
+#include <chrono>
+#include <new>
 #include <string>
+#include <thread>
 #include <vector>
 
 using namespace nonbloppy;
@@ -203,4 +213,49 @@ TEST(Cancellation, AnInterrupterThatNeverFiresChangesNoByte)
     const SurfaceResult without = buildSurface(frame, withSpacing());
     EXPECT_GT(never.polls, 0);
     expectSameBytes(with.mesh, without.mesh);
+}
+
+// A TBB algorithm whose sibling task throws (std::bad_alloc, say) is cancelled, and so are
+// the loops of an OpenVDB tool running inside it, whose serial code then read what they
+// never wrote: createPointIndexGrid() crashed so under ulimit -v. The tool's call runs
+// isolated from that cancellation and completes every task, while the exception still
+// reaches the caller.
+TEST(RunIsolatedFromCancellation, ASiblingsExceptionCancelsNoTaskOfTheIsolatedWork)
+{
+    constexpr size_t kTasks = 64;
+    for (const bool isolated : {false, true}) {
+        std::atomic<bool> started{false}, thrown{false};
+        std::atomic<size_t> ran{0};
+        bool concurrent = true;
+        tbb::task_arena arena(2);
+        const auto waitFor = [](const std::atomic<bool>& flag) {
+            const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(5);
+            while (!flag && std::chrono::steady_clock::now() < deadline) std::this_thread::yield();
+            return bool(flag);
+        };
+        const auto loop = [&] {
+            tbb::parallel_for(tbb::blocked_range<size_t>(0, kTasks, 1), [&](const tbb::blocked_range<size_t>& range) {
+                ran += range.size();
+            });
+        };
+        EXPECT_THROW(arena.execute([&] {
+            tbb::parallel_invoke(
+                [&] {
+                    started = true;
+                    concurrent = waitFor(thrown);
+                    // Give the exception time to cancel the context.
+                    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+                    if (isolated) cancellation_internal::runIsolatedFromCancellation(loop);
+                    else loop();
+                },
+                [&] {
+                    if (!waitFor(started)) return;
+                    thrown = true;
+                    throw std::bad_alloc();
+                });
+        }), std::bad_alloc);
+        if (!concurrent) GTEST_SKIP() << "the two branches did not run at once (one worker thread)";
+        if (isolated) EXPECT_EQ(ran, kTasks);
+        else EXPECT_LT(ran, kTasks) << "the hazard this test guards against no longer shows";
+    }
 }
