@@ -23,9 +23,10 @@ namespace io_internal {
 /// @throw FileError naming @a path.
 ParticleSet readVdbPointsFile(const std::string& path);
 
-/// Walk the `.vdb` file @a path as far as it can be walked without parsing trees: header,
-/// file metadata, every grid descriptor, and each grid's metadata and transform, checking
-/// every length and offset against the file's size (a grid must end inside the file).
+/// Walk the `.vdb` file @a path as far as it can be walked without parsing value trees:
+/// header, file metadata, every grid descriptor, each grid's metadata and transform, and
+/// every PointDataGrid's tree and attribute pages as readVdbPointsFile() checks them,
+/// checking every length and offset against the file's size (a grid must end inside the file).
 /// OpenVDB's io::File trusts them: a truncated file made it allocate gigabytes for a
 /// "string" and report an unregistered grid type of a billion spaces.
 /// @throw FileError naming @a path ("cannot read .vdb file: truncated grid 'density' ...").

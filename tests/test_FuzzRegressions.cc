@@ -13,6 +13,7 @@
 
 #include <nonbloppy/Error.h>
 #include <nonbloppy/ReadParticles.h>
+#include <nonbloppy/ReadVdb.h>
 
 #include <openvdb/openvdb.h>
 
@@ -346,3 +347,30 @@ TEST_F(VdbLeafBuffers, WhatOpenVdbWritesStillReads)
 }
 
 } // namespace
+
+// readVdbFile() ('nonbloppy inspect') walks every PointDataGrid's leaves as readParticles()
+// does before OpenVDB reads them: it read them unchecked, and OpenVDB's assertions on page
+// sizes aborted the process (exit 134) on five of these files. Same message, word for word,
+// except where its layout walk finds first that the grid ends beyond the file.
+TEST(FuzzRegressions, ReadVdbFileRefusesEveryVdbFileAsReadParticlesDoes)
+{
+    size_t vdbFiles = 0, truncated = 0;
+    for (const std::string& file : fuzzFiles()) {
+        if (file.size() < 4 || file.compare(file.size() - 4, 4, ".vdb") != 0) continue;
+        ++vdbFiles;
+        const std::string path = fuzzPath(file);
+        std::string message = "(no FileError)";
+        try {
+            nonbloppy::readVdbFile(path);
+        } catch (const nonbloppy::FileError& e) {
+            message = e.what();
+        }
+        if (message.rfind("cannot read .vdb file: truncated grid 'points' (it ends at byte ", 0) == 0) {
+            ++truncated;
+            continue;
+        }
+        EXPECT_EQ(message, readFuzzFile(path).message) << file;
+    }
+    EXPECT_GE(vdbFiles, size_t(20));
+    EXPECT_LE(truncated, vdbFiles / 2);
+}
