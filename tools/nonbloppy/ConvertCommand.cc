@@ -49,7 +49,10 @@ int runConvert(const ConvertOptions& o)
     // It used to kill the process, leaving the writer's temporary file beside OUT.
     SignalHandlerScope signals;
     const WarningPrinter printer;
-    const nonbloppy::ParticleSet particles = nonbloppy::readParticles(o.input);
+    const nonbloppy::ParticleSet particles = [&] {
+        const InputReadScope reading;  // may block (a FIFO): see kStuckReadSeconds
+        return nonbloppy::readParticles(o.input);
+    }();
     throwIfInterrupted();
     if (!particles.skipped.empty()) {
         WarningLine(printer) << "not read from " << o.input << ", so not converted: " << joinedSkipped(particles);

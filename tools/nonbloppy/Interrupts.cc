@@ -11,6 +11,7 @@
 #include <cstdint>
 
 #include <time.h>
+#include <unistd.h>
 
 namespace nonbloppy_tool {
 
@@ -30,6 +31,28 @@ static_assert(std::atomic<int64_t>::is_always_lock_free, "the signal handler nee
 /// run's mesh beside the previous run's .vdb (and a stray backup of the old mesh).
 constexpr int64_t kRepeatedSignalNanoseconds = 1'000'000'000;
 
+/// The first stop signal's number, for its default action once a read is stuck; 0 before.
+std::atomic<int> gFirstStopSignal{0};
+/// Live InputReadScope and OutputsPendingScope objects.
+std::atomic<int> gInputReads{0};
+std::atomic<int> gOutputsPending{0};
+static_assert(std::atomic<int>::is_always_lock_free, "the signal handlers need lock-free counters");
+
+/// SIGALRM, kStuckReadSeconds after the first stop signal: the run has not stopped. If it is
+/// reading its input with no output pending, it is blocked there (or reading for long without
+/// a poll, which loses nothing): the first signal's default action. Otherwise it will stop at
+/// its next poll or once its outputs are settled: asked again in a second.
+extern "C" void onStopGraceOver(int)
+{
+    const int signalNumber = gFirstStopSignal.load();
+    if (signalNumber != 0 && gInputReads.load() > 0 && gOutputsPending.load() == 0) {
+        std::signal(signalNumber, SIG_DFL);
+        std::raise(signalNumber);
+        return;
+    }
+    ::alarm(1);
+}
+
 extern "C" void onInterruptSignal(int signalNumber)
 {
     timespec now{};
@@ -37,7 +60,9 @@ extern "C" void onInterruptSignal(int signalNumber)
     const int64_t at = std::max<int64_t>(1, int64_t(now.tv_sec) * 1'000'000'000 + now.tv_nsec);
     int64_t first = 0;
     if (gFirstStopSignalAt.compare_exchange_strong(first, at)) {
+        gFirstStopSignal = signalNumber;
         gInterruptRequested = true;
+        ::alarm(kStuckReadSeconds);  // async-signal-safe, as are the counters onStopGraceOver() reads
         return;
     }
     // A signal a second or more after the first means "stop now": the run has not stopped on
@@ -54,6 +79,8 @@ SignalHandlerScope::SignalHandlerScope()
 {
     gInterruptRequested = false;
     gFirstStopSignalAt = 0;
+    gFirstStopSignal = 0;
+    mOldAlarm = std::signal(SIGALRM, onStopGraceOver);
     for (size_t n = 0; n < kStopSignals.size(); ++n) {
         mOld[n] = std::signal(kStopSignals[n], onInterruptSignal);
         if (kStopSignals[n] == SIGHUP && mOld[n] == SIG_IGN) std::signal(SIGHUP, SIG_IGN);
@@ -69,7 +96,14 @@ SignalHandlerScope::~SignalHandlerScope()
     }
     std::signal(SIGPIPE, mOldPipe == SIG_ERR ? SIG_DFL : mOldPipe);
     std::signal(SIGXFSZ, mOldFileSize == SIG_ERR ? SIG_DFL : mOldFileSize);
+    ::alarm(0);
+    std::signal(SIGALRM, mOldAlarm == SIG_ERR ? SIG_DFL : mOldAlarm);
 }
+
+InputReadScope::InputReadScope() { ++gInputReads; }
+InputReadScope::~InputReadScope() { --gInputReads; }
+OutputsPendingScope::OutputsPendingScope() { ++gOutputsPending; }
+OutputsPendingScope::~OutputsPendingScope() { --gOutputsPending; }
 
 bool interruptRequested()
 {

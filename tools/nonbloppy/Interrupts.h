@@ -43,6 +43,36 @@ private:
     std::array<void (*)(int), 3> mOld{SIG_DFL, SIG_DFL, SIG_DFL};
     void (*mOldPipe)(int) = SIG_DFL;
     void (*mOldFileSize)(int) = SIG_DFL;
+    void (*mOldAlarm)(int) = SIG_DFL;
+};
+
+/// Seconds after the first stop signal at which a run still reading its input, with no
+/// output of its own in progress, ends with the signal's default action (exit 143 for
+/// SIGTERM, 130 for SIGINT): a read can block without polling (opening a FIFO that nobody
+/// writes: `timeout 20 nonbloppy mesh in.vtk` never ended, as timeout's two signals arrive
+/// together and count as one request), and there is nothing to clean up then.
+constexpr unsigned kStuckReadSeconds = 2;
+
+/// For its lifetime the run reads an input that may block (see kStuckReadSeconds). Any
+/// thread; scopes nest and overlap (a sequence reads a frame while it writes the last).
+class InputReadScope
+{
+public:
+    InputReadScope();
+    ~InputReadScope();
+    InputReadScope(const InputReadScope&) = delete;
+    InputReadScope& operator=(const InputReadScope&) = delete;
+};
+
+/// For its lifetime the run has outputs it must finish or put back when it stops: the stuck
+/// read's default action waits for it to end (OutputCleanup holds one). Any thread; nests.
+class OutputsPendingScope
+{
+public:
+    OutputsPendingScope();
+    ~OutputsPendingScope();
+    OutputsPendingScope(const OutputsPendingScope&) = delete;
+    OutputsPendingScope& operator=(const OutputsPendingScope&) = delete;
 };
 
 /// True once a stop signal arrived within the current SignalHandlerScope. Lock-free; any thread.

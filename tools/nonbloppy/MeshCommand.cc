@@ -515,6 +515,7 @@ MeshedFrame meshFrameSurface(const MeshOptions& o, ProgressInterrupter& interrup
     MeshedFrame frame;
     {
         StageScope stage(interrupter, frame.before, "read particles");
+        const InputReadScope reading;  // may block (a FIFO): see kStuckReadSeconds
         frame.particles = nonbloppy::readParticles(o.input);
     }
     if (frame.particles.size() == 0) {

@@ -5,6 +5,8 @@
 #ifndef NONBLOPPY_TOOL_OUTPUT_CLEANUP_H
 #define NONBLOPPY_TOOL_OUTPUT_CLEANUP_H
 
+#include "Interrupts.h"
+
 #include <string>
 #include <vector>
 
@@ -52,6 +54,7 @@ private:
         bool written;
     };
     std::vector<Output> mOutputs;
+    OutputsPendingScope mPending;  ///< a stuck read's default action waits for this
 };
 
 } // namespace nonbloppy_tool
