@@ -27,6 +27,8 @@
 #include <tbb/task_group.h>
 
 #include <algorithm>
+#include <atomic>
+#include <cerrno>
 #include <charconv>
 #include <cstdint>
 #include <cstring>
@@ -38,6 +40,32 @@
 namespace nonbloppy {
 
 namespace {
+
+/// Writes made from TBB tasks, and the errno of the first that failed, for the caller:
+/// errno is per thread, and writeFileAtomically() reports the calling thread's, so a full
+/// disk was reported as "Input/output error" whenever the failing write ran on a worker
+/// (half the runs at two threads; hostile-input audit).
+class TaskWrites
+{
+public:
+    void write(std::ostream& os, const char* data, std::streamsize size)
+    {
+        os.write(data, size);
+        const int error = errno;
+        if (!os && error != 0) {
+            int none = 0;
+            mErrno.compare_exchange_strong(none, error);
+        }
+    }
+    /// In the calling thread once the tasks are done: errno as the failed write left it.
+    void restoreErrno() const
+    {
+        if (const int error = mErrno.load()) errno = error;
+    }
+
+private:
+    std::atomic<int> mErrno{0};
+};
 
 /// Collects output bytes and passes them on to the stream in large chunks.
 class ChunkWriter
@@ -166,6 +194,7 @@ writeRecords(ChunkWriter& out, size_t count, size_t recordBytes, const EncodeT& 
     batches[0] = memory_internal::SystemBuffer(std::min(count, perBatch) * recordBytes);
     if (count > perBatch) batches[1] = memory_internal::SystemBuffer(perBatch * recordBytes);
     tbb::task_group writing;
+    TaskWrites writes;
     try {
         for (size_t first = 0, k = 0; first < count; first += perBatch, ++k) {
             const size_t n = std::min(perBatch, count - first);
@@ -174,9 +203,12 @@ writeRecords(ChunkWriter& out, size_t count, size_t recordBytes, const EncodeT& 
                 for (size_t i = r.begin(); i < r.end(); ++i) encode(first + i, batch + i * recordBytes);
             });
             writing.wait();  // the batch before is written: its buffer is free for the next
-            writing.run([&os, batch, bytes = std::streamsize(n * recordBytes)] { os.write(batch, bytes); });
+            writing.run([&os, &writes, batch, bytes = std::streamsize(n * recordBytes)] {
+                writes.write(os, batch, bytes);
+            });
         }
         writing.wait();
+        writes.restoreErrno();
     } catch (...) {
         writing.wait();  // the buffers outlive the write in flight
         throw;
@@ -274,6 +306,7 @@ writeTextItems(ChunkWriter& out, size_t count, const FormatT& format)
     const size_t tokens = 2 * size_t(std::max(1, tbb::this_task_arena::max_concurrency()));
     std::vector<std::string> texts(tokens);
     size_t next = 0;
+    TaskWrites writes;
     tbb::parallel_pipeline(tokens,
         tbb::make_filter<void, size_t>(tbb::filter_mode::serial_in_order,
             [&](tbb::flow_control& control) -> size_t {
@@ -291,8 +324,9 @@ writeTextItems(ChunkWriter& out, size_t count, const FormatT& format)
         & tbb::make_filter<size_t, void>(tbb::filter_mode::serial_in_order,
             [&](size_t piece) {
                 const std::string& text = texts[piece % tokens];
-                os.write(text.data(), std::streamsize(text.size()));
+                writes.write(os, text.data(), std::streamsize(text.size()));
             }));
+    writes.restoreErrno();
 }
 
 /// Appends @a value as the shortest decimal text that reads back as exactly it.

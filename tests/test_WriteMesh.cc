@@ -723,6 +723,38 @@ TEST_F(WriteMeshTest, LargeFilesGoPastThePageCacheWithTheSameBytes)
     EXPECT_EQ(listDirectory(dir()).size(), 6u);
 }
 
+TEST_F(WriteMeshTest, AWriteThatFailsInATaskReportsItsOwnError)
+{
+    // The writers hand their batches to the stream from TBB tasks, and errno is per thread:
+    // a full disk was reported as "Input/output error" whenever the failing write ran on a
+    // worker (half the runs at two threads; hostile-input audit). A 1 MB file-size limit
+    // (SIGXFSZ ignored) fails every format's write with EFBIG, on whichever thread, through
+    // the page cache and with direct I/O; each time the caller must say so and leave nothing.
+    const SurfaceMesh mesh = randomMesh(11, 10.0f, 200000, 300000, 0);
+    struct rlimit saved;
+    ASSERT_EQ(getrlimit(RLIMIT_FSIZE, &saved), 0);
+    const auto oldHandler = std::signal(SIGXFSZ, SIG_IGN);
+    struct rlimit limited = saved;
+    limited.rlim_cur = 1u << 20;
+    ASSERT_EQ(setrlimit(RLIMIT_FSIZE, &limited), 0);
+    std::vector<std::string> messages, expected;
+    for (int round = 0; round < 4; ++round) {
+        for (const char* name : {"m.obj", "m.ply", "m.vtk"}) {
+            for (const bool directIo : {false, true}) {
+                MeshWriteSettings settings;
+                settings.directIo = directIo;
+                const std::string target = path(name);
+                messages.push_back(messageOf<nonbloppy::FileError>([&] { nonbloppy::writeMesh(mesh, target, settings); }));
+                expected.push_back("cannot write " + target + ": File too large");
+            }
+        }
+    }
+    setrlimit(RLIMIT_FSIZE, &saved);
+    std::signal(SIGXFSZ, oldHandler);
+    EXPECT_EQ(messages, expected);
+    EXPECT_TRUE(listDirectory(dir()).empty());
+}
+
 TEST_F(WriteMeshTest, ADirectWriteThatFailsInTheWriterThreadFailsTheFile)
 {
     if (!nonbloppy::directIoSuitable(dir())) GTEST_SKIP() << "no direct I/O on " << dir();
