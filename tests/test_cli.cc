@@ -185,6 +185,41 @@ TEST_F(CliTest, ADensityGridLargerThanTheMemoryIsRefusedBeforeItIsAllocated)
 #endif
 }
 
+TEST_F(CliTest, RunningOutOfMemoryNamesTheStageAndTheFile)
+{
+#if defined(NONBLOPPY_TEST_ASAN)
+    GTEST_SKIP() << "AddressSanitizer reserves more address space than the limit this test sets";
+#else
+    // 4M particles under a 450 MB limit of address space: past the memory checks, some
+    // allocation fails (on this machine in rasterization). The message said only "out of
+    // memory"; it names the stage (or, while reading, the file) and the input. And no stage
+    // may crash instead: the index build did, exit 139, at 340 MB (see
+    // runIsolatedFromCancellation()).
+    std::string csv = "x,y,z\n";
+    csv.reserve(size_t(90) << 20);
+    char row[64];
+    for (int i = 0; i < 4000000; ++i) {
+        csv.append(row, size_t(std::snprintf(row, sizeof(row), "%.4f,%.4f,%.4f\n", (i % 200) * 0.05,
+                                             (i / 200 % 200) * 0.05, (i / 40000) * 0.05)));
+    }
+    const std::string input = in("many.csv");
+    writeText(input, csv);
+    csv = std::string();
+    for (const size_t kilobytes : {340000, 450000}) {
+        SCOPED_TRACE(kilobytes);
+        const RunResult r = runWithAddressLimit(kilobytes, "mesh " + quote(input) + " -q -o " + quote(out("m.ply")));
+        EXPECT_EQ(r.exitCode, 1);
+        const std::string inStage = "nonbloppy: out of memory in stage '", meshing = "' meshing " + input + "\n";
+        const std::string reading = "nonbloppy: out of memory while reading the particles (" + input + ")\n";
+        const bool namesStage = r.err.rfind(inStage, 0) == 0 && r.err.size() > inStage.size() + meshing.size()
+                                && r.err.compare(r.err.size() - meshing.size(), meshing.size(), meshing) == 0
+                                && std::count(r.err.begin(), r.err.end(), '\n') == 1;
+        EXPECT_TRUE(namesStage || r.err == reading) << r.err;
+        EXPECT_TRUE(listDir(dir() + "/out").empty()) << "output files left behind";
+    }
+#endif
+}
+
 TEST_F(CliTest, ASmoothingLargerThanTheMemoryIsRefusedBeforeItIsAllocated)
 {
 #if defined(NONBLOPPY_TEST_ASAN)

@@ -28,6 +28,7 @@
 #include <iostream>
 #include <limits>
 #include <memory>
+#include <new>
 #include <optional>
 #include <sstream>
 #include <string>
@@ -598,7 +599,14 @@ Command setupInspectCommand(CLI::App& parent)
     cmd->add_flag("--json", options->json, "Print one JSON object instead of text")
         ->group(kGroupInputOutput);
 
-    return {cmd, [options]() { return runInspect(options->path, options->json); }};
+    return {cmd, [options]() {
+        try {
+            return runInspect(options->path, options->json);
+        } catch (const std::bad_alloc&) {
+            // Said with the file's name, not as a bare "out of memory".
+            throw nonbloppy::Error("out of memory inspecting " + options->path);
+        }
+    }};
 }
 
 } // namespace nonbloppy_tool

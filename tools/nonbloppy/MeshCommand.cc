@@ -40,6 +40,7 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <new>
 #include <optional>
 #include <string>
 #include <utility>
@@ -108,6 +109,8 @@ public:
                               : std::uncaught_exceptions() > 0 ? " failed (" : " done (";
             std::cerr << ("[progress] " + mFrame + mStages.back().name + how + seconds + " s)\n") << std::flush;
         }
+        // The innermost stage an exception leaves ends first.
+        if (std::uncaught_exceptions() > 0 && mFailedStage.empty()) mFailedStage = mStages.back().name;
         mStages.pop_back();
     }
 
@@ -158,7 +161,13 @@ private:
         mLastDraw = std::chrono::steady_clock::now();
     }
 
+public:
+    /// The stage an exception ended (its name), or "" if none did.
+    const std::string& failedStage() const { return mFailedStage; }
+
+private:
     struct Stage { std::string name; std::chrono::steady_clock::time_point start; };
+    std::string mFailedStage;
     bool mVerbose, mLive;
     std::string mFrame;
     std::vector<Stage> mStages;
@@ -1119,6 +1128,13 @@ int runMesh(const MeshOptions& o)
         // meshFrame() has removed what was written; the library leaves nothing behind.
         std::cerr << "nonbloppy: interrupted" << std::endl;
         return kExitInterrupted;
+    } catch (const std::bad_alloc&) {
+        // The stages whose memory grows with their input refuse what will not fit before
+        // they allocate; what remains (a tight ulimit -v, memory taken by others meanwhile)
+        // says at least where and what, not a bare "out of memory".
+        const std::string& stage = interrupter.failedStage();
+        throw nonbloppy::Error("out of memory" + (stage.empty() ? std::string() : " in stage '" + stage + "'")
+                               + " meshing " + o.input);
     }
 }
 
