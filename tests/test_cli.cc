@@ -832,6 +832,24 @@ TEST_F(CliTest, UnreadableNumbersAreNamed)
     expectUsageError(base + "--frame-jobs 1e3", "--frame-jobs needs an integer, got '1e3'");
 }
 
+TEST_F(CliTest, NumbersAreReadAsDecimalOnly)
+{
+    // CLI11 reads integers with strtoll in base 0 and reals with strtold: "-t 010" ran 8
+    // iterations (octal), "-t 08" was "out of range", hexadecimal and leading blanks were
+    // taken (hostile-input audit).
+    const std::string base = "mesh " + quote(kCube) + " -o " + quote(out("x.obj")) + " ";
+    expectUsageError(base + "--iterations 0x10", "--iterations needs an integer, got '0x10'");
+    expectUsageError(base + "--spacing 0x1p-4", "--spacing needs a number, got '0x1p-4'");
+    expectUsageError(base + "--threads ' 1'", "--threads needs an integer, got ' 1'");
+    expectUsageError(base + "--radius '0.1 '", "--radius needs a number, got '0.1 '");
+    expectUsageError(base + "--voxel-size 1e", "--voxel-size needs a number, got '1e'");
+    const RunResult r = run(base + "-t 010 --threads 02 --spacing .05");
+    EXPECT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_NE(r.out.find("  iterations t         10 "), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("  threads              2 "), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("  spacing s            0.05 "), std::string::npos) << r.out;
+}
+
 TEST_F(CliTest, CommandLineMistakesAreSaidInTheToolsWords)
 {
     // CLI11's own wording ("A subcommand is required", "--blend: 1 required FLOAT missing",

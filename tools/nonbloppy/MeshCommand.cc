@@ -27,6 +27,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cctype>
 #include <cerrno>
 #include <chrono>
 #include <cmath>
@@ -294,6 +295,62 @@ void requireWritableDirectory(const std::string& path)
     if (error != 0) {
         throw nonbloppy::FileError("cannot write " + path + ": " + std::strerror(error));
     }
+}
+
+/// Read @a option's values as decimal numbers only (integers if @a integer), before CLI11
+/// converts them: CLI11 reads integers with strtoll in base 0, so "-t 010" ran 8 iterations
+/// (octal), "-t 08" was "out of range" and "-t 0x10" 16, and reals with strtold, which takes
+/// hexadecimal ("--spacing 0x1p-4") and leading blanks too (hostile-input audit). An integer
+/// loses its leading zeros ("010" is 10); a real may also be inf or nan (refused or taken by
+/// the range checks, with their own messages); an empty value is left to validateParameters().
+/// @throw UsageError("-t needs an integer, got '0x10'"), "--spacing needs a number, got ' 1'".
+void readDecimalOnly(CLI::Option* option, bool integer)
+{
+    option->transform(
+        [name = option->get_name(), integer](const std::string& given) {
+            std::string value = given;
+            if (value.empty()) return value;
+            size_t at = (value[0] == '+' || value[0] == '-') ? 1 : 0;
+            const size_t digitsStart = at;
+            while (at < value.size() && std::isdigit(static_cast<unsigned char>(value[at]))) ++at;
+            size_t digits = at - digitsStart;
+            bool decimal = false;
+            if (integer) {
+                decimal = digits > 0 && at == value.size();
+                if (decimal) {
+                    // Leading zeros off, one digit kept: strtoll must not see an octal number.
+                    const size_t firstNonZero = value.find_first_not_of('0', digitsStart);
+                    const size_t keep = firstNonZero == std::string::npos || firstNonZero == value.size()
+                                            ? value.size() - 1 : firstNonZero;
+                    value.erase(digitsStart, keep - digitsStart);
+                }
+            } else {
+                if (at < value.size() && value[at] == '.') {
+                    ++at;
+                    const size_t fraction = at;
+                    while (at < value.size() && std::isdigit(static_cast<unsigned char>(value[at]))) ++at;
+                    digits += at - fraction;
+                }
+                if (digits > 0 && at < value.size() && (value[at] == 'e' || value[at] == 'E')) {
+                    size_t exponent = at + 1;
+                    if (exponent < value.size() && (value[exponent] == '+' || value[exponent] == '-')) ++exponent;
+                    const size_t exponentDigits = exponent;
+                    while (exponent < value.size() && std::isdigit(static_cast<unsigned char>(value[exponent]))) {
+                        ++exponent;
+                    }
+                    at = exponent > exponentDigits ? exponent : value.size() + 1;  // "1e" is no number
+                }
+                std::string word = value.substr(digitsStart);
+                std::transform(word.begin(), word.end(), word.begin(),
+                               [](unsigned char c) { return char(std::tolower(c)); });
+                decimal = (digits > 0 && at == value.size()) || word == "inf" || word == "infinity" || word == "nan";
+            }
+            if (!decimal) {
+                throw UsageError(name + " needs " + (integer ? "an integer" : "a number") + ", got '" + value + "'");
+            }
+            return value;
+        },
+        "", "");
 }
 
 /// Check everything that can be checked without reading the input, so a mistake costs
@@ -1229,6 +1286,14 @@ Command setupMeshCommand(CLI::App& parent)
     CLI::Option* verbose = cmd->add_flag("-v,--verbose", o.verbose,
         "Print each stage, its progress and its memory (bytes per particle) on stderr")->group(kGroupDebug);
     quiet->excludes(verbose);
+
+    for (CLI::Option* option : {o.iterationsOpt, o.regionLeavesOpt, o.threadsOpt, o.frameJobsOpt}) {
+        readDecimalOnly(option, /*integer=*/true);
+    }
+    for (CLI::Option* option : {o.spacingOpt, o.radiusOpt, o.thresholdOpt, o.voxelSizeOpt, o.blendOpt,
+                                o.adaptivityOpt, o.maxStepOpt}) {
+        readDecimalOnly(option, /*integer=*/false);
+    }
 
     return {cmd, [options]() { return runMesh(*options); }};
 }
