@@ -441,6 +441,14 @@ parseTable(StreamReader& in, const std::string& path)
             }
             if (attribute < 0) {
                 p[columns[i].component] = static_cast<float>(value);
+                if (std::isfinite(value) && !std::isfinite(p[columns[i].component])) {
+                    // Positions are float: said here, where the text is known, rather than as
+                    // a "non-finite position" that the file does not hold.
+                    std::vector<std::string_view> texts;
+                    splitLine(rowText, separator, texts);
+                    fail(path, "coordinate " + printable(trimmed(texts[i])) + " on line " + std::to_string(line) +
+                               " lies outside float's range (-3.4e38 to 3.4e38)");
+                }
                 continue;
             }
             std::vector<unsigned char>& bytes = particles.attributes[size_t(attribute)].bytes;
@@ -579,7 +587,14 @@ public:
     {
         if (mDepth != 2) return reject("expected an array of [x, y, z] arrays");
         if (mComponent >= 3) return reject("particle " + std::to_string(positions.size()) + " has more than 3 coordinates");
-        mPoint[mComponent++] = static_cast<float>(value);
+        mPoint[mComponent] = static_cast<float>(value);
+        if (std::isfinite(value) && !std::isfinite(mPoint[mComponent])) {
+            char text[32];
+            const std::string shortest(text, std::to_chars(text, text + sizeof(text), value).ptr);
+            return reject("coordinate " + shortest + " of particle " + std::to_string(positions.size()) +
+                          " lies outside float's range (-3.4e38 to 3.4e38)");
+        }
+        ++mComponent;
         return true;
     }
     bool null() override { return reject("null where a coordinate was expected"); }
@@ -736,6 +751,7 @@ readJsonFast(StreamReader& in, std::vector<openvdb::Vec3f>& positions)
                 double value;
                 if (!parseDoubleRefusingOverflow(std::string_view(p, size_t(numberEnd - p)), value)) return false;
                 point[axis] = static_cast<float>(value);
+                if (!std::isfinite(point[axis])) return false;  // beyond float: nlohmann's path says so
                 p = numberEnd;
             }
             if (!expect(']')) return false;

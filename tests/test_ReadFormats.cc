@@ -673,6 +673,21 @@ TEST_F(ReadFormatsTest, JsonPointList)
         << fileErrorOf(cut);
 }
 
+TEST_F(ReadFormatsTest, CoordinatesBeyondFloatAreNamedWithTheirText)
+{
+    // Positions are float: a finite 1e39 became +inf and was refused as a "non-finite
+    // position of particle 2", which the file does not hold (hostile-input audit).
+    const std::string csv = write("big.csv", "x,y,z\n0,0,0\n0,-3.5e38,1\n");
+    EXPECT_EQ(fileErrorOf(csv), "coordinate -3.5e38 on line 3 lies outside float's range (-3.4e38 to 3.4e38) (" + csv + ")");
+    const std::string json = write("big.json", "[[0,0,0],[1e39,0,0]]");
+    EXPECT_EQ(fileErrorOf(json), "bad JSON particle list: coordinate 1e+39 of particle 1 lies outside float's range "
+                                 "(-3.4e38 to 3.4e38) (" + json + ")");
+    // Float's largest value itself, and a CSV attribute beyond float (kept as double), read.
+    const ParticleSet edge = readParticles(write("edge.csv", "x,y,z,v\n3.4028234e38,0,0,1e300\n"));
+    ASSERT_EQ(edge.size(), 1u);
+    EXPECT_EQ(edge.positions[0][0], 3.4028234e38f);
+}
+
 TEST_F(ReadFormatsTest, MinusZeroKeepsItsSignInJsonAndCsv)
 {
     // nlohmann's SAX parser hands the integer -0 to number_integer() as 0, its text gone: a

@@ -74,7 +74,9 @@ namespace nonbloppy {
 ///                   "truncated POINTS section (x.vtk)", "8000000000 particles would take
 ///                   96 GB of memory, more than the 25.2 GB this process can still take (x.ply)".
 /// @throw ParameterError  for NaN or infinite coordinates, or doubles too large for float:
-///                   "non-finite position of particle 17 (x.vtk)".
+///                   "non-finite position of particle 17 (x.vtk)"; in CSV and JSON text, a
+///                   finite coordinate beyond float is a FileError quoting it ("coordinate
+///                   1e39 on line 3 lies outside float's range (-3.4e38 to 3.4e38) (x.csv)").
 /// Thread-safe: yes (no shared state).
 NONBLOPPY_API ParticleSet readParticles(const std::string& path);
 
