@@ -861,6 +861,10 @@ TEST_F(CliTest, CommandLineMistakesAreSaidInTheToolsWords)
     expectUsageError("--bogus", "unknown option '--bogus'; " + commands);
     const std::string base = "mesh " + quote(kCube) + " -o " + quote(out("x.obj")) + " ";
     expectUsageError(base + "--bogus 3", "mesh has no option '--bogus'; see 'nonbloppy help mesh'");
+    // CLI11 checks required arguments first: these said "IN is required" (hostile-input audit).
+    expectUsageError("mesh --bogus", "mesh has no option '--bogus'; see 'nonbloppy help mesh'");
+    expectUsageError("mesh --version", "mesh has no option '--version'; see 'nonbloppy help mesh'");
+    expectUsageError("convert --frobnicate", "convert has no option '--frobnicate'; see 'nonbloppy help convert'");
     expectUsageError(base + "extra.vtk more.vtk", "unexpected argument 'extra.vtk' to mesh; see 'nonbloppy help mesh'");
     expectUsageError(base + "--blend", "--blend needs a number");
     expectUsageError(base + "--threads", "--threads needs an integer");

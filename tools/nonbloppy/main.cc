@@ -138,6 +138,15 @@ std::string parseMessage(const CLI::App& app, const std::string& message, int ar
     }
     const std::string where = command ? command->get_name() : std::string("nonbloppy");
     const std::string helpHint = "see 'nonbloppy help " + (command ? command->get_name() + "'" : std::string("'"));
+    // CLI11 checks the required arguments before it refuses unknown ones: "mesh --bogus"
+    // said "IN is required" (hostile-input audit). An unknown option is the first mistake.
+    const std::string required = " is required";
+    if (command && message.size() > required.size()
+        && message.compare(message.size() - required.size(), required.size(), required) == 0) {
+        for (const std::string& extra : command->remaining()) {
+            if (extra.size() > 1 && extra[0] == '-') return where + " has no option '" + extra + "'; " + helpHint;
+        }
+    }
     std::smatch match;
     static const std::regex missing(R"(^(\S+): \d+ required (\S+) missing$)");
     static const std::regex repeated(R"(^(\S+): At Most 1 required but received (\d+)$)");
