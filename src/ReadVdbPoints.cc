@@ -481,7 +481,10 @@ public:
         const uint32_t count = load<uint32_t>("metadata of " + owner);
         // An item takes at least 12 bytes (two string lengths and a value size).
         if (count > left() / 12) {
-            corrupt("metadata of " + owner + " claims " + std::to_string(count) + " items");
+            // Mostly a cut-off file (hostile-input audit: "claims 1 items" did not say so).
+            corrupt("truncated or corrupt metadata of " + owner + ": it claims " + std::to_string(count) +
+                    (count == 1 ? " item" : " items") + ", at least 12 bytes each, and " + std::to_string(left()) +
+                    " bytes are left");
         }
         for (uint32_t i = 0; i < count; ++i) {
             const std::string name = string("a metadata name of " + owner);

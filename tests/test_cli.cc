@@ -751,7 +751,8 @@ TEST_F(CliTest, InspectTruncatedVdbIsOneLine)
     const size_t half = bytes.size() / 2;
     const std::vector<std::pair<size_t, std::string>> cuts = {
         {4, "not a VDB file"},
-        {64, "metadata of the file claims 1 items"},
+        {64, "truncated or corrupt metadata of the file: it claims 1 item, at least 12 bytes each, and 3 bytes are "
+             "left"},
         {half, "truncated grid 'density' (it ends at byte " + std::to_string(bytes.size()) + ", the file has "
                    + std::to_string(half) + ")"},
     };
