@@ -953,7 +953,10 @@ TEST_F(CliTest, AnEmptyInputNameIsAUsageError)
     for (const auto& [command, expected] :
          {std::pair<std::string, std::string>{"mesh '' -o " + quote(out("m.obj")), "IN needs a file name, got ''"},
           {"inspect ''", "FILE needs a file name, got ''"},
-          {"convert '' " + quote(out("p.ply")), "IN needs a file name, got ''"}}) {
+          {"convert '' " + quote(out("p.ply")), "IN needs a file name, got ''"},
+          // Outputs too: "particle file name has no extension ()" (hostile-input audit).
+          {"mesh " + quote(kCube) + " -o ''", "--output needs a file name, got ''"},
+          {"convert " + quote(kCube) + " ''", "OUT needs a file name, got ''"}}) {
         const RunResult r = run(command);
         EXPECT_EQ(r.exitCode, 2) << command;
         EXPECT_EQ(r.err, "nonbloppy: " + expected + "\n") << command;

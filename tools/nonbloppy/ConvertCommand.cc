@@ -38,6 +38,7 @@ int runConvert(const ConvertOptions& o)
     // Everything that can be checked before reading: a name for each file, the output
     // format, and not overwriting the input.
     requireFileName(o.input, "IN");
+    requireFileName(o.output, "OUT");  // not "particle file name has no extension ()"
     requireAsUsage([&] { nonbloppy::requireParticleOutputFile(o.output); });
     std::error_code ec;
     if (o.input == o.output || std::filesystem::equivalent(o.input, o.output, ec)) {

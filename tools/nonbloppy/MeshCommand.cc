@@ -414,6 +414,7 @@ void validateParameters(const MeshOptions& o)
 void validatePaths(const MeshOptions& o)
 {
     requireFileName(o.input, "IN");
+    requireFileName(o.output, "--output");  // not "mesh file name has no extension ()"
     // writeMesh()'s own check, which would say the same after all the work.
     requireAsUsage([&] { nonbloppy::requireMeshFile(o.output); });
     if (!o.vdbPath.empty() && lowerExtension(o.vdbPath) != ".vdb") {
