@@ -746,11 +746,14 @@ TEST_F(CliSequenceTest, MovingSpacingEstimateIsSaidOnceWithTheValuesThatPinTheLe
     r = run(mesh);
     ASSERT_EQ(r.exitCode, 0) << r.err;
     EXPECT_EQ(r.err, "");
+    // With two frame jobs the small frame 2 finishes first, and the warning named it as the
+    // reference and pinned its lengths (hostile-input audit): now the same words as above.
     makeFrames({kCube, kFree, kCube, kFree});
-    r = run(mesh + " --frame-jobs 2");
-    ASSERT_EQ(r.exitCode, 0) << r.err;
-    EXPECT_EQ(count(r.err, "nonbloppy: warning: the spacing estimate moves between frames ("), 1u) << r.err;
-    EXPECT_EQ(count(r.err, "\n"), 1u) << r.err;
+    for (int repeat = 0; repeat < 3; ++repeat) {
+        r = run(mesh + " --frame-jobs 2");
+        ASSERT_EQ(r.exitCode, 0) << r.err;
+        EXPECT_EQ(r.err, warning + " --radius 0.0996763 --voxel-size 0.0249191 --threshold 2.85599 --max-step 0.0249191\n");
+    }
 }
 
 TEST_F(CliSequenceTest, TheLoggedLengthsAndStepCapGivenBackMeshTheSameBytes)

@@ -540,15 +540,13 @@ struct OnceWarnings
 {
     std::atomic<bool> facesEndInside{false};
     std::atomic<bool> coarseFloats{false};
-    std::atomic<bool> lengthsMoved{false};
     std::atomic<bool> meshInput{false};
     std::atomic<bool> attributesNotRead{false};
     std::atomic<bool> normalsMissing{false};
     OutputWarnings outputs;  ///< those of --attributes, --vdb-surface and --vdb-points
-    /// The first frame meshed and its parameters, which warnIfLengthsMove() compares the
-    /// later frames with.
-    std::mutex firstFrameMutex;
-    std::optional<std::pair<int, nonbloppy::ResolvedParameters>> firstFrame;
+    /// Each frame meshed and its parameters, for warnIfLengthsMoved() at the end of the run.
+    std::mutex frameLengthsMutex;
+    std::vector<std::pair<int, nonbloppy::ResolvedParameters>> frameLengths;
 };
 
 /// A warning line of this run, printed when the statement ends (see WarningPrinter).
@@ -697,46 +695,56 @@ FrameOutcome meshFrame(const MeshOptions& o, ProgressInterrupter& interrupter, B
 }
 
 /// How far a sequence's spacing estimate may move from the first frame's, as a fraction of
-/// it, before warnIfLengthsMove() says so: each derived length moves by as much, and 1% of h
+/// it, before warnIfLengthsMoved() says so: each derived length moves by as much, and 1% of h
 /// is a whole voxel 100 voxels from the origin. (Two dam-break frames simulated with the
 /// same particle radius, 0.025, estimate 0.0467 and 0.0486: 4% apart.)
 constexpr double kSpacingMoveTolerance = 0.01;
 
-/// Once per run of a sequence: the lengths not given are derived from each frame's own
-/// spacing estimate, so when that moves, the voxel grid (h), the kernel (r_e) and the
-/// iso-value (r_0) move with it and the surface changes from frame to frame for that alone
-/// (a flicker in a rendered sequence). Says which values pin them: those of the first frame
-/// meshed (the lowest number, unless --frame-jobs meshes several at once).
-void warnIfLengthsMove(int frame, const nonbloppy::ResolvedParameters& p, bool maxStepGiven, OnceWarnings& once)
+/// Keeps frame @a frame's parameters for warnIfLengthsMoved(), unless its lengths are all
+/// given (then none moves). Any thread.
+void recordFrameLengths(int frame, const nonbloppy::ResolvedParameters& p, OnceWarnings& once)
 {
     if (p.spacingGiven || (p.effectiveRadiusGiven && p.voxelSizeGiven && p.thresholdGiven)) return;
-    if (once.lengthsMoved.load()) return;
-    std::pair<int, nonbloppy::ResolvedParameters> first;
+    std::lock_guard<std::mutex> lock(once.frameLengthsMutex);
+    once.frameLengths.emplace_back(frame, p);
+}
+
+/// Once per run of a sequence, at its end: the lengths not given are derived from each
+/// frame's own spacing estimate, so when that moves, the voxel grid (h), the kernel (r_e) and
+/// the iso-value (r_0) move with it and the surface changes from frame to frame for that
+/// alone (a flicker in a rendered sequence). Names the lowest-numbered frame meshed and the
+/// first one after it whose estimate moved, and the values that pin the lengths: the
+/// former's. At the end, in frame order, so the warning is the same whatever --frame-jobs
+/// (as frames finished, it named whichever finished first; hostile-input audit).
+void warnIfLengthsMoved(bool maxStepGiven, OnceWarnings& once)
+{
+    std::vector<std::pair<int, nonbloppy::ResolvedParameters>> frames;
     {
-        std::lock_guard<std::mutex> lock(once.firstFrameMutex);
-        if (!once.firstFrame) {
-            once.firstFrame.emplace(frame, p);
-            return;
-        }
-        first = *once.firstFrame;
+        std::lock_guard<std::mutex> lock(once.frameLengthsMutex);
+        frames = once.frameLengths;
     }
-    const double reference = first.second.spacing;
-    if (!(std::abs(p.spacing - reference) > kSpacingMoveTolerance * reference) || once.lengthsMoved.exchange(true)) {
-        return;
-    }
+    if (frames.size() < 2) return;
+    std::sort(frames.begin(), frames.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+    const auto& [firstFrame, first] = frames.front();
+    const double reference = first.spacing;
+    const auto moved = std::find_if(frames.begin() + 1, frames.end(), [&](const auto& frame) {
+        return std::abs(frame.second.spacing - reference) > kSpacingMoveTolerance * reference;
+    });
+    if (moved == frames.end()) return;
+    const nonbloppy::ResolvedParameters& p = moved->second;
     std::string pin;
-    if (!p.effectiveRadiusGiven) pin += " --radius " + formatNumber(first.second.effectiveRadius);
-    if (!p.voxelSizeGiven) pin += " --voxel-size " + formatNumber(first.second.voxelSize);
-    if (!p.thresholdGiven) pin += " --threshold " + formatNumber(first.second.threshold);
+    if (!p.effectiveRadiusGiven) pin += " --radius " + formatNumber(first.effectiveRadius);
+    if (!p.voxelSizeGiven) pin += " --voxel-size " + formatNumber(first.voxelSize);
+    if (!p.thresholdGiven) pin += " --threshold " + formatNumber(first.threshold);
     // The faithful step cap s/2 follows the estimate too, and with the three lengths given
     // and no spacing there is none: pinned as well, so the pinned run meshes frame 1 alike.
     if (p.method == nonbloppy::Method::Faithful && !maxStepGiven) {
-        pin += " --max-step " + formatNumber(first.second.maxStep);
+        pin += " --max-step " + formatNumber(first.maxStep);
     }
-    warning(once) << "the spacing estimate moves between frames (" << formatNumber(reference)
-                  << " in frame " << first.first << ", " << formatNumber(p.spacing) << " in frame " << frame
+    warning(once) << "the spacing estimate moves between frames (" << formatNumber(reference) << " in frame "
+                  << firstFrame << ", " << formatNumber(p.spacing) << " in frame " << moved->first
                   << ") and the lengths derived from it move too; to mesh every frame alike, give frame "
-                  << first.first << "'s:" << pin;
+                  << firstFrame << "'s:" << pin;
 }
 
 /// Once per run: relaxation too strong for the calibrated r_0 shrinks every flat face.
@@ -1083,7 +1091,7 @@ int runSequence(const MeshOptions& o)
                                     ProgressInterrupter& interrupter, ResidentSampler* sampler) {
         const FrameOutcome outcome = writeFrame(f, frame, interrupter, remover, once, OnInterrupt::Finish);
         warnAboutFrame(f, outcome, once);
-        warnIfLengthsMove(job.frame.number, outcome.result.parameters, o.maxStepOpt->count() > 0, once);
+        recordFrameLengths(job.frame.number, outcome.result.parameters, once);
 
         FrameReport report;
         const nonbloppy::SurfaceResult& result = outcome.result;
@@ -1137,7 +1145,9 @@ int runSequence(const MeshOptions& o)
             return report;
         });
     };
-    return runBatch(jobs, settings, meshOne, [] { return interruptRequested(); });
+    const int status = runBatch(jobs, settings, meshOne, [] { return interruptRequested(); });
+    warnIfLengthsMoved(o.maxStepOpt->count() > 0, once);
+    return status;
 }
 
 int runMesh(const MeshOptions& o)
