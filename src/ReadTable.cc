@@ -597,8 +597,8 @@ public:
         ++mComponent;
         return true;
     }
-    bool null() override { return reject("null where a coordinate was expected"); }
-    bool boolean(bool) override { return reject("boolean where a coordinate was expected"); }
+    bool null() override { return reject("null where a coordinate was expected" + inParticle()); }
+    bool boolean(bool) override { return reject("boolean where a coordinate was expected" + inParticle()); }
     bool number_integer(number_integer_t value) override
     {
         // nlohmann hands "-0" over as the integer 0, its text gone: a coordinate -0 came back
@@ -609,8 +609,8 @@ public:
     }
     bool number_unsigned(number_unsigned_t value) override { return number(double(value)); }
     bool number_float(number_float_t value, const string_t&) override { return number(value); }
-    bool string(string_t&) override { return reject("string where a coordinate was expected"); }
-    bool binary(binary_t&) override { return reject("binary value where a coordinate was expected"); }
+    bool string(string_t&) override { return reject("string where a coordinate was expected" + inParticle()); }
+    bool binary(binary_t&) override { return reject("binary value where a coordinate was expected" + inParticle()); }
     bool start_object(std::size_t) override { return reject("object where an array was expected"); }
     bool key(string_t&) override { return reject("object where an array was expected"); }
     bool end_object() override { return reject("object where an array was expected"); }
@@ -648,6 +648,14 @@ public:
     }
 
 private:
+    /// " (coordinate 2 of particle 7)" inside a particle's array, else "": which value it was,
+    /// as the other messages say (hostile-input audit).
+    std::string inParticle() const
+    {
+        if (mDepth != 2) return std::string();
+        return " (coordinate " + std::to_string(mComponent) + " of particle " + std::to_string(positions.size()) + ")";
+    }
+
     bool reject(const std::string& message)
     {
         if (error.empty()) error = message;

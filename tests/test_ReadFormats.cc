@@ -666,6 +666,9 @@ TEST_F(ReadFormatsTest, JsonPointList)
     EXPECT_EQ(fileErrorOf(two), "bad JSON particle list: particle 1 has 2 coordinates, expected 3 (" + two + ")");
     const std::string deep = write("deep.json", std::string(100000, '[') + std::string(100000, ']'));
     EXPECT_EQ(fileErrorOf(deep), "bad JSON particle list: arrays nested deeper than [[x, y, z], ...] (" + deep + ")");
+    const std::string text = write("text.json", "[[0,0,0],[0.1,0,0],[0,0.1,\"3\"]]");
+    EXPECT_EQ(fileErrorOf(text), "bad JSON particle list: string where a coordinate was expected (coordinate 2 of "
+                                 "particle 2) (" + text + ")");
     const std::string object = write("object.json", "{\"x\": 1}");
     EXPECT_EQ(fileErrorOf(object), "bad JSON particle list: object where an array was expected (" + object + ")");
     const std::string cut = write("cut.json", "[[1,2,3],[4,");
