@@ -432,6 +432,19 @@ TEST_F(CliTest, InspectParticleFile)
     // Whole rows: the file's name holds "24389" too.
     EXPECT_NE(text.out.find("\n  particles        24389\n"), std::string::npos) << text.out;
     EXPECT_NE(text.out.find("\n                   velocity  float32 x3\n"), std::string::npos) << text.out;
+
+    // The text's box too, each coordinate as the shortest text of its float: at six digits a
+    // box 0.7 wide at x = 1e6 lost its width ("(1e+06, ...) -> (1e+06, ...)").
+    std::string far;
+    for (int corner = 0; corner < 8; ++corner) {
+        far += std::to_string(1e6 + 0.7 * (corner & 1)) + "," + std::to_string(0.7 * ((corner >> 1) & 1)) + ","
+               + std::to_string(0.7 * ((corner >> 2) & 1)) + "\n";
+    }
+    writeText(in("far.csv"), "x,y,z\n" + far);
+    const RunResult farText = run("inspect " + quote(in("far.csv")));
+    ASSERT_EQ(farText.exitCode, 0) << farText.err;
+    EXPECT_NE(farText.out.find("\n  bounding box     (1e+06, 0, 0) -> (1000000.7, 0.7, 0.7)\n"), std::string::npos)
+        << farText.out;
 }
 
 TEST_F(CliTest, InspectJsonIsValidForNamesThatAreNotUtf8)

@@ -22,6 +22,7 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -115,6 +116,20 @@ private:
 std::string formatVec3(double x, double y, double z)
 {
     return "(" + formatNumber(x) + ", " + formatNumber(y) + ", " + formatNumber(z) + ")";
+}
+
+/// A position's coordinates (floats), each as the shortest text that reads back as it:
+/// "(1000000.7, 0.25, -3)". formatVec3()'s six digits dropped a box's width far from the
+/// origin ("(1e+06, ...) -> (1e+06, ...)" for a cube 0.7 wide at x = 1e6; hostile-input audit).
+std::string formatPosition(const openvdb::Vec3d& p)
+{
+    std::string text = "(";
+    for (int axis = 0; axis < 3; ++axis) {
+        char digits[32];
+        text.append(digits, std::to_chars(digits, digits + sizeof(digits), float(p[axis])).ptr);
+        text += axis < 2 ? ", " : ")";
+    }
+    return text;
 }
 
 std::string formatCoord(const openvdb::Coord& c)
@@ -214,9 +229,7 @@ int inspectParticles(const std::string& path, const nonbloppy::ParticleSet& part
     std::cout << path << ": particle file\n";
     printRow("particles", std::to_string(particles.size()));
     if (bbox) {
-        printRow("bounding box", formatVec3(bbox->first.x(), bbox->first.y(), bbox->first.z())
-                                     + " -> "
-                                     + formatVec3(bbox->second.x(), bbox->second.y(), bbox->second.z()));
+        printRow("bounding box", formatPosition(bbox->first) + " -> " + formatPosition(bbox->second));
     }
     // estimateSpacing() does not say which of its two measures it gave: name both.
     printRow("spacing", spacing ? formatNumber(*spacing) + " (estimated: volume per particle inside the fluid, "
@@ -334,9 +347,7 @@ int inspectMesh(const std::string& path, const nonbloppy::SurfaceMesh& mesh, boo
     printRow("area", formatNumber(m.area));
     printRow("volume", formatNumber(m.volume) + (m.closed ? "" : " (not closed: not meaningful)"));
     if (bbox) {
-        printRow("bounding box", formatVec3(bbox->first.x(), bbox->first.y(), bbox->first.z())
-                                     + " -> "
-                                     + formatVec3(bbox->second.x(), bbox->second.y(), bbox->second.z()));
+        printRow("bounding box", formatPosition(bbox->first) + " -> " + formatPosition(bbox->second));
     }
     if (attributes) printAttributes(*attributes);
     else printRow("attributes", "- (the particle readers refuse this file)");
