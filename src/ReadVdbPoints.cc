@@ -1366,7 +1366,7 @@ readVdbPoints(const VdbSource& source, const std::string& path)
                  names += printable(grid->getName()) + " " + grid->valueType();
              }
              return names.empty() ? std::string("none") : names;
-         }() + "); a density cache cannot be meshed as particles");
+         }() + "); a density cache holds no particles to read");
 }
 
 } // namespace

@@ -1098,7 +1098,7 @@ TEST_F(ReadFormatsTest, VdbWithoutPointsIsAClearError)
     const std::string file = path("density.vdb");
     openvdb::io::File(file).write({density});
     EXPECT_EQ(fileErrorOf(file), "no PointDataGrid in this .vdb file (grids: density float); a density "
-                                 "cache cannot be meshed as particles (" + file + ")");
+                                 "cache holds no particles to read (" + file + ")");
     const std::string junk = write("junk.vdb", "not a vdb file at all");
     EXPECT_EQ(fileErrorOf(junk).rfind("cannot read .vdb file: ", 0), 0u) << fileErrorOf(junk);
 }

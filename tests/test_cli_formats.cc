@@ -137,7 +137,7 @@ TEST_F(CliFormatsTest, ConvertToXyzWarnsAndErrorsAreOneLine)
     bad = run("convert " + quote(density) + " " + quote(path("p.csv")));
     EXPECT_EQ(bad.exitCode, 1);
     EXPECT_EQ(bad.err, "nonbloppy: no PointDataGrid in this .vdb file (grids: density float); a density "
-                       "cache cannot be meshed as particles (" + density + ")\n");
+                       "cache holds no particles to read (" + density + ")\n");
     EXPECT_FALSE(fs::exists(path("p.csv")));
 }
 
