@@ -723,6 +723,34 @@ TEST_F(WriteMeshTest, LargeFilesGoPastThePageCacheWithTheSameBytes)
     EXPECT_EQ(listDirectory(dir()).size(), 6u);
 }
 
+/// For its lifetime, a file-size limit of @a bytes with SIGXFSZ ignored: writes past it fail
+/// with EFBIG, a stand-in for a full disk that needs no file system of its own.
+class FileSizeLimit
+{
+public:
+    explicit FileSizeLimit(rlim_t bytes)
+    {
+        mSet = getrlimit(RLIMIT_FSIZE, &mSaved) == 0;
+        mOldHandler = std::signal(SIGXFSZ, SIG_IGN);
+        struct rlimit limited = mSaved;
+        limited.rlim_cur = bytes;
+        mSet = mSet && setrlimit(RLIMIT_FSIZE, &limited) == 0;
+    }
+    ~FileSizeLimit()
+    {
+        setrlimit(RLIMIT_FSIZE, &mSaved);
+        std::signal(SIGXFSZ, mOldHandler);
+    }
+    FileSizeLimit(const FileSizeLimit&) = delete;
+    FileSizeLimit& operator=(const FileSizeLimit&) = delete;
+    bool set() const { return mSet; }
+
+private:
+    struct rlimit mSaved{};
+    void (*mOldHandler)(int) = SIG_DFL;
+    bool mSet = false;
+};
+
 TEST_F(WriteMeshTest, AWriteThatFailsInATaskReportsItsOwnError)
 {
     // The writers hand their batches to the stream from TBB tasks, and errno is per thread:
@@ -731,26 +759,22 @@ TEST_F(WriteMeshTest, AWriteThatFailsInATaskReportsItsOwnError)
     // (SIGXFSZ ignored) fails every format's write with EFBIG, on whichever thread, through
     // the page cache and with direct I/O; each time the caller must say so and leave nothing.
     const SurfaceMesh mesh = randomMesh(11, 10.0f, 200000, 300000, 0);
-    struct rlimit saved;
-    ASSERT_EQ(getrlimit(RLIMIT_FSIZE, &saved), 0);
-    const auto oldHandler = std::signal(SIGXFSZ, SIG_IGN);
-    struct rlimit limited = saved;
-    limited.rlim_cur = 1u << 20;
-    ASSERT_EQ(setrlimit(RLIMIT_FSIZE, &limited), 0);
     std::vector<std::string> messages, expected;
-    for (int round = 0; round < 4; ++round) {
-        for (const char* name : {"m.obj", "m.ply", "m.vtk"}) {
-            for (const bool directIo : {false, true}) {
-                MeshWriteSettings settings;
-                settings.directIo = directIo;
-                const std::string target = path(name);
-                messages.push_back(messageOf<nonbloppy::FileError>([&] { nonbloppy::writeMesh(mesh, target, settings); }));
-                expected.push_back("cannot write " + target + ": File too large");
+    {
+        const FileSizeLimit limit(1u << 20);
+        ASSERT_TRUE(limit.set());
+        for (int round = 0; round < 4; ++round) {
+            for (const char* name : {"m.obj", "m.ply", "m.vtk"}) {
+                for (const bool directIo : {false, true}) {
+                    MeshWriteSettings settings;
+                    settings.directIo = directIo;
+                    const std::string target = path(name);
+                    messages.push_back(messageOf<nonbloppy::FileError>([&] { nonbloppy::writeMesh(mesh, target, settings); }));
+                    expected.push_back("cannot write " + target + ": File too large");
+                }
             }
         }
     }
-    setrlimit(RLIMIT_FSIZE, &saved);
-    std::signal(SIGXFSZ, oldHandler);
     EXPECT_EQ(messages, expected);
     EXPECT_TRUE(listDirectory(dir()).empty());
 }
@@ -761,26 +785,22 @@ TEST_F(WriteMeshTest, ADirectWriteThatFailsInTheWriterThreadFailsTheFile)
     // A 6 MB file-size limit stands in for a full disk: the second 4 MiB buffer, written by
     // the writer thread while the caller fills the third, fails with EFBIG (SIGXFSZ
     // ignored). The error must reach the caller, and nothing may be left.
-    struct rlimit saved;
-    ASSERT_EQ(getrlimit(RLIMIT_FSIZE, &saved), 0);
-    const auto oldHandler = std::signal(SIGXFSZ, SIG_IGN);
-    struct rlimit limited = saved;
-    limited.rlim_cur = 6u << 20;
-    ASSERT_EQ(setrlimit(RLIMIT_FSIZE, &limited), 0);
     const std::string target = path("full.bin");
     const std::string bytes((size_t(13) << 20) + 5, 'x');
     std::string message;
-    try {
-        nonbloppy::writeFileAtomically(target, [&](std::ostream& os) {
-            for (size_t at = 0; at < bytes.size(); at += 100000) {
-                os.write(bytes.data() + at, std::streamsize(std::min<size_t>(100000, bytes.size() - at)));
-            }
-        }, bytes.size());
-    } catch (const nonbloppy::FileError& e) {
-        message = e.what();
+    {
+        const FileSizeLimit limit(6u << 20);
+        ASSERT_TRUE(limit.set());
+        try {
+            nonbloppy::writeFileAtomically(target, [&](std::ostream& os) {
+                for (size_t at = 0; at < bytes.size(); at += 100000) {
+                    os.write(bytes.data() + at, std::streamsize(std::min<size_t>(100000, bytes.size() - at)));
+                }
+            }, bytes.size());
+        } catch (const nonbloppy::FileError& e) {
+            message = e.what();
+        }
     }
-    setrlimit(RLIMIT_FSIZE, &saved);
-    std::signal(SIGXFSZ, oldHandler);
     EXPECT_EQ(message, "cannot write " + target + ": File too large");
     EXPECT_TRUE(listDirectory(dir()).empty());
 }
