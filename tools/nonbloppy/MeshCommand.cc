@@ -27,8 +27,8 @@
 
 #include <algorithm>
 #include <atomic>
-#include <cctype>
 #include <cerrno>
+#include <charconv>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -44,6 +44,7 @@
 #include <new>
 #include <optional>
 #include <string>
+#include <system_error>
 #include <utility>
 #include <vector>
 
@@ -144,6 +145,9 @@ public:
         mDrawn = false;
     }
 
+    /// The stage an exception ended (its name), or "" if none did.
+    const std::string& failedStage() const { return mFailedStage; }
+
 private:
     static std::mutex& outputMutex()
     {
@@ -162,11 +166,6 @@ private:
         mLastDraw = std::chrono::steady_clock::now();
     }
 
-public:
-    /// The stage an exception ended (its name), or "" if none did.
-    const std::string& failedStage() const { return mFailedStage; }
-
-private:
     struct Stage { std::string name; std::chrono::steady_clock::time_point start; };
     std::string mFailedStage;
     bool mVerbose, mLive;
@@ -310,40 +309,26 @@ void readDecimalOnly(CLI::Option* option, bool integer)
         [name = option->get_name(), integer](const std::string& given) {
             std::string value = given;
             if (value.empty()) return value;
-            size_t at = (value[0] == '+' || value[0] == '-') ? 1 : 0;
-            const size_t digitsStart = at;
-            while (at < value.size() && std::isdigit(static_cast<unsigned char>(value[at]))) ++at;
-            size_t digits = at - digitsStart;
+            const size_t unsignedStart = (value[0] == '+' || value[0] == '-') ? 1 : 0;
             bool decimal = false;
             if (integer) {
-                decimal = digits > 0 && at == value.size();
+                decimal = value.size() > unsignedStart
+                          && value.find_first_not_of("0123456789", unsignedStart) == std::string::npos;
                 if (decimal) {
                     // Leading zeros off, one digit kept: strtoll must not see an octal number.
-                    const size_t firstNonZero = value.find_first_not_of('0', digitsStart);
-                    const size_t keep = firstNonZero == std::string::npos || firstNonZero == value.size()
-                                            ? value.size() - 1 : firstNonZero;
-                    value.erase(digitsStart, keep - digitsStart);
+                    const size_t keep = std::min(value.find_first_not_of('0', unsignedStart), value.size() - 1);
+                    value.erase(unsignedStart, keep - unsignedStart);
                 }
             } else {
-                if (at < value.size() && value[at] == '.') {
-                    ++at;
-                    const size_t fraction = at;
-                    while (at < value.size() && std::isdigit(static_cast<unsigned char>(value[at]))) ++at;
-                    digits += at - fraction;
-                }
-                if (digits > 0 && at < value.size() && (value[at] == 'e' || value[at] == 'E')) {
-                    size_t exponent = at + 1;
-                    if (exponent < value.size() && (value[exponent] == '+' || value[exponent] == '-')) ++exponent;
-                    const size_t exponentDigits = exponent;
-                    while (exponent < value.size() && std::isdigit(static_cast<unsigned char>(value[exponent]))) {
-                        ++exponent;
-                    }
-                    at = exponent > exponentDigits ? exponent : value.size() + 1;  // "1e" is no number
-                }
-                std::string word = value.substr(digitsStart);
-                std::transform(word.begin(), word.end(), word.begin(),
-                               [](unsigned char c) { return char(std::tolower(c)); });
-                decimal = (digits > 0 && at == value.size()) || word == "inf" || word == "infinity" || word == "nan";
+                // std::from_chars reads strtod's decimal forms, inf and nan, and no hexadecimal,
+                // no blanks and no '+' (skipped here, once); nor nan's "(chars)", refused as before.
+                const char* first = value.data() + (value[0] == '+' ? 1 : 0);
+                const char* last = value.data() + value.size();
+                double parsed = 0.0;
+                const auto [end, error] = std::from_chars(first, last, parsed);
+                decimal = end == last && (error == std::errc() || error == std::errc::result_out_of_range)
+                          && !(value[0] == '+' && first < last && *first == '-')  // "+-1"
+                          && value.find('(') == std::string::npos;
             }
             if (!decimal) {
                 throw UsageError(name + " needs " + (integer ? "an integer" : "a number") + ", got '" + value + "'");
