@@ -433,20 +433,22 @@ parseTable(StreamReader& in, const std::string& path)
                     continue;
                 }
             }
-            double value;
-            if (!field.asDouble(value)) {
+            // The field's text as written, for an error (the row is split again only then).
+            const auto fieldText = [&] {
                 std::vector<std::string_view> texts;
                 splitLine(rowText, separator, texts);
-                fail(path, "bad number '" + printable(trimmed(texts[i])) + "' on line " + std::to_string(line));
+                return printable(trimmed(texts[i]));
+            };
+            double value;
+            if (!field.asDouble(value)) {
+                fail(path, "bad number '" + fieldText() + "' on line " + std::to_string(line));
             }
             if (attribute < 0) {
                 p[columns[i].component] = static_cast<float>(value);
                 if (std::isfinite(value) && !std::isfinite(p[columns[i].component])) {
                     // Positions are float: said here, where the text is known, rather than as
                     // a "non-finite position" that the file does not hold.
-                    std::vector<std::string_view> texts;
-                    splitLine(rowText, separator, texts);
-                    fail(path, "coordinate " + printable(trimmed(texts[i])) + " on line " + std::to_string(line) +
+                    fail(path, "coordinate " + fieldText() + " on line " + std::to_string(line) +
                                " lies outside float's range (-3.4e38 to 3.4e38)");
                 }
                 continue;
