@@ -36,6 +36,23 @@ using namespace nonbloppy_test;
 const std::string kData = NONBLOPPY_TEST_DATA_DIR;
 const std::string kCube = kData + "/cube_2366_particles.vtk";
 
+/// Wait (at most 30 s) until process @a pid catches @a signal, as its /proc status tells
+/// (SigCgt: the caught signals as a hex mask, signal n at bit n - 1): its handler is installed.
+void waitUntilCatches(pid_t pid, int signal)
+{
+    const auto catches = [&] {
+        std::istringstream status(readText("/proc/" + std::to_string(pid) + "/status"));
+        for (std::string line; std::getline(status, line);) {
+            if (line.rfind("SigCgt:", 0) == 0) return (std::stoull(line.substr(7), nullptr, 16) >> (signal - 1)) & 1;
+        }
+        return 0ull;
+    };
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+    while (!catches() && std::chrono::steady_clock::now() < deadline) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    }
+}
+
 class CliTest : public CliFixture
 {
 protected:
@@ -1078,23 +1095,12 @@ TEST_F(CliTest, AReadStuckOnTheFirstSignalEndsAfterAGrace)
         const std::string errFile = dir() + "/stderr.txt";
         const pid_t pid = spawnCli(args, errFile);
         ASSERT_NE(pid, 0);
-        // SigCgt: the signals the process catches, in hex; SIGTERM is bit 14.
-        const auto catchesSigterm = [&] {
-            std::istringstream status(readText("/proc/" + std::to_string(pid) + "/status"));
-            for (std::string line; std::getline(status, line);) {
-                if (line.rfind("SigCgt:", 0) == 0) return (std::stoull(line.substr(7), nullptr, 16) >> (SIGTERM - 1)) & 1;
-            }
-            return 0ull;
-        };
-        auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(30);
-        while (!catchesSigterm() && std::chrono::steady_clock::now() < deadline) {
-            std::this_thread::sleep_for(std::chrono::milliseconds(5));
-        }
+        waitUntilCatches(pid, SIGTERM);
         const auto signalled = std::chrono::steady_clock::now();
         ASSERT_EQ(::kill(pid, SIGTERM), 0);
         ASSERT_EQ(::kill(pid, SIGTERM), 0);
         int status = 0;
-        deadline = signalled + std::chrono::seconds(20);
+        const auto deadline = signalled + std::chrono::seconds(20);
         pid_t ended = 0;
         while ((ended = ::waitpid(pid, &status, WNOHANG)) == 0 && std::chrono::steady_clock::now() < deadline) {
             std::this_thread::sleep_for(std::chrono::milliseconds(10));
@@ -1124,18 +1130,7 @@ TEST_F(CliTest, ConvertStopsOnASignalAndLeavesItsOutputAsItWas)
     const std::string errFile = dir() + "/stderr.txt";
     const pid_t pid = spawnCli({"convert", fifo, out("p.ply")}, errFile);
     ASSERT_NE(pid, 0);
-    // SigCgt: the signals the process catches, in hex; SIGINT is bit 1.
-    const auto catchesSigint = [&] {
-        std::istringstream status(readText("/proc/" + std::to_string(pid) + "/status"));
-        for (std::string line; std::getline(status, line);) {
-            if (line.rfind("SigCgt:", 0) == 0) return (std::stoull(line.substr(7), nullptr, 16) >> (SIGINT - 1)) & 1;
-        }
-        return 0ull;
-    };
-    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(30);
-    while (!catchesSigint() && std::chrono::steady_clock::now() < deadline) {
-        std::this_thread::sleep_for(std::chrono::milliseconds(5));
-    }
+    waitUntilCatches(pid, SIGINT);
     ASSERT_EQ(::kill(pid, SIGINT), 0);
     {
         std::ofstream feed(fifo, std::ios::binary);  // opens once convert opens its end
