@@ -584,7 +584,9 @@ TEST_F(CliSequenceTest, LogHasOneObjectPerFrameAndASummary)
     }
     EXPECT_EQ(frame2.back(), '}');
     // CPU seconds: a frame's, over its stages, and the whole process's in the summary,
-    // which holds both frames' (and the start, and the writing of the log).
+    // which holds each frame's (and the start, and the writing of the log). Not their sum: the
+    // first frame's files are written while the second frame runs, and the CPU time of that
+    // overlap counts in both frames (CI saw the sum exceed the summary by 49 us).
     const auto numberAfter = [](const std::string& line, const std::string& key) {
         const size_t at = line.find("\"" + key + "\": ");
         return at == std::string::npos ? -1.0 : std::stod(line.substr(at + key.size() + 4));
@@ -592,7 +594,7 @@ TEST_F(CliSequenceTest, LogHasOneObjectPerFrameAndASummary)
     const double frame1Cpu = numberAfter(logLines[0], "cpu_seconds"), frame2Cpu = numberAfter(frame2, "cpu_seconds");
     EXPECT_GT(frame1Cpu, 0.0) << logLines[0];
     EXPECT_GT(frame2Cpu, 0.0) << frame2;
-    EXPECT_GE(numberAfter(logLines[2], "cpu_seconds"), frame1Cpu + frame2Cpu) << logLines[2];
+    EXPECT_GE(numberAfter(logLines[2], "cpu_seconds"), std::max(frame1Cpu, frame2Cpu)) << logLines[2];
     const std::string& summary = logLines[2];
     for (const char* field : {"{\"summary\": true, ", "\"frames_done\": 2, ", "\"frames_failed\": 0, ",
                               "\"frames_skipped\": 0, ", "\"frames_missing\": 0, ",
