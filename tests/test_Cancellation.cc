@@ -24,6 +24,7 @@
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_invoke.h>
 #include <tbb/task_arena.h>
+#include <tbb/task_group.h>  // is_current_task_group_canceling
 
 #include <atomic>
 #include <chrono>
@@ -243,8 +244,12 @@ TEST(RunIsolatedFromCancellation, ASiblingsExceptionCancelsNoTaskOfTheIsolatedWo
                 [&] {
                     started = true;
                     concurrent = waitFor(thrown);
-                    // Give the exception time to cancel the context.
-                    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+                    // Until the exception has cancelled this context (a fixed 20 ms sleep
+                    // could end first on a loaded machine).
+                    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(5);
+                    while (!tbb::is_current_task_group_canceling() && std::chrono::steady_clock::now() < deadline) {
+                        std::this_thread::yield();
+                    }
                     if (isolated) cancellation_internal::runIsolatedFromCancellation(loop);
                     else loop();
                 },

@@ -30,7 +30,9 @@ TEST(Timing, AStageCountsTheCpuTimeSpentInIt)
     StageTimings timings;
     {
         ScopedStageTimer timer(timings, "busy");
-        burnCpu(0.03);
+        // A little over 0.03 s: the stage's two clock readings, each divided before they
+        // are subtracted, may put exactly 30,000 us just below 0.03.
+        burnCpu(0.031);
     }
     {
         // Sleeping takes wall-clock time but next to no CPU time.
