@@ -28,6 +28,7 @@
 #include <cmath>
 #include <limits>
 #include <sstream>
+#include <tuple>
 
 namespace nonbloppy {
 
@@ -179,14 +180,25 @@ inline int ceilToInt(float x)
     return truncated + (x > float(truncated) ? 1 : 0);
 }
 
-/// Leaves stacked along z (same x and y) that one task fills together. With the default
-/// r_e = 2 s and h = s/2, a particle's support is 8 voxels tall (9 when it sits exactly on a
-/// voxel centre), so it straddles almost every leaf boundary it meets: filled a leaf at a
-/// time, each of its rows cost two 8-lane evaluations, one per leaf. In a column it costs
-/// one, unless it straddles the column's ends (7 in 64 positions). Measured on the 64x
-/// dam-break input: rasterization 0.92 → 0.65 s; 8 leaves were 7% faster than 4.
+/// A column: the leaves that one task fills together, up to kColumnLeaves stacked along z
+/// in each of kColumnStacks × kColumnStacks (x, y) positions. With the default r_e = 2 s and
+/// h = s/2, a particle's support is 8 voxels tall (9 when it sits exactly on a voxel centre),
+/// so it straddles almost every leaf boundary it meets: filled a leaf at a time, each of its
+/// rows cost two 8-lane evaluations, one per leaf. In a column it costs one, unless it
+/// straddles the column's ends (7 in 64 positions). Measured on the 64x dam-break input:
+/// rasterization 0.92 → 0.65 s; 8 leaves were 7% faster than 4.
+/// The width: each particle costs a fixed amount per column its query box meets (the index
+/// lookup, its voxel range, its z-vectors), and that box, r_e wider than the column on each
+/// side and rounded out to index cells, meets about 5 columns one leaf wide and 1.7 four
+/// leaves wide. Same input, medians of 5 alternating runs: one thread 0.66 s one stack wide,
+/// 0.55 s 4 × 4 (a 295 KB scratch block per thread, in L2); two threads (7 runs) 0.35 s and
+/// 0.30 s. 2 × 2 and 8 × 8, and 16 or 32 leaves tall, were no faster than 4 × 4 by 8.
 constexpr int kColumnLeaves = 8;
 constexpr int kColumnVoxels = kColumnLeaves * int(FloatLeaf::DIM);
+/// Leaf stacks per column along x and along y (a power of two).
+constexpr int kColumnStacks = 4;
+/// Voxels of a column along x and along y.
+constexpr int kColumnWidth = kColumnStacks * int(FloatLeaf::DIM);
 /// Row length of a column's scratch block: a vector may start at the column's last voxel.
 constexpr int kColumnRowStride = kColumnVoxels + 8;
 
@@ -241,22 +253,37 @@ NONBLOPPY_TARGET_AVX2 inline void addRowVectorAvx2(float* row, const float* dz2,
 }
 #endif
 
-/// A run of origins [first, end) that forms one column.
+/// A run [first, end) of the column order (groupColumns()) that forms one column.
 struct Column
 {
     size_t first;
     size_t end;
 };
 
-/// Groups the sorted leaf origins into columns: consecutive origins with the same x and y,
-/// at most kColumnVoxels apart in z from the column's first.
-std::vector<Column> groupColumns(const std::vector<openvdb::Coord>& origins)
+/// The x and y of the column holding the leaf at @a origin (its first voxel).
+inline std::pair<int, int> columnOf(const openvdb::Coord& origin)
 {
+    return {origin[0] & ~(kColumnWidth - 1), origin[1] & ~(kColumnWidth - 1)};
+}
+
+/// Groups the sorted leaf origins into columns: origins in the same kColumnWidth² cell of
+/// x and y, at most kColumnVoxels apart in z from the column's first. @a order lists the
+/// origins' indices column by column, each column's in z order.
+std::vector<Column> groupColumns(const std::vector<openvdb::Coord>& origins, std::vector<size_t>& order)
+{
+    order.resize(origins.size());
+    for (size_t n = 0; n < order.size(); ++n) order[n] = n;
+    const auto key = [&](size_t n) {
+        const auto [x, y] = columnOf(origins[n]);
+        return std::make_tuple(x, y, origins[n][2], n);
+    };
+    tbb::parallel_sort(order.begin(), order.end(), [&](size_t a, size_t b) { return key(a) < key(b); });
     std::vector<Column> columns;
-    for (size_t n = 0; n < origins.size();) {
+    for (size_t n = 0; n < order.size();) {
+        const openvdb::Coord& first = origins[order[n]];
         size_t end = n + 1;
-        while (end < origins.size() && origins[end][0] == origins[n][0] && origins[end][1] == origins[n][1] &&
-               origins[end][2] - origins[n][2] < kColumnVoxels) {
+        while (end < order.size() && columnOf(origins[order[end]]) == columnOf(first) &&
+               origins[order[end]][2] - first[2] < kColumnVoxels) {
             ++end;
         }
         columns.push_back({n, end});
@@ -265,8 +292,8 @@ std::vector<Column> groupColumns(const std::vector<openvdb::Coord>& origins)
     return columns;
 }
 
-/// The leaf at @a origin from a column's scratch block (@a rows: its first voxel, rows of
-/// kColumnRowStride floats): values copied as they are, voxels with a positive sum active
+/// The leaf at @a origin from a column's scratch block (@a rows: its first voxel, in rows of
+/// kColumnRowStride floats, kColumnWidth rows per x): values copied as they are, voxels with a positive sum active
 /// (the others hold +0, the background). Null if no voxel is active.
 FloatLeaf* makeLeaf(const openvdb::Coord& origin, const float* rows)
 {
@@ -278,7 +305,7 @@ FloatLeaf* makeLeaf(const openvdb::Coord& origin, const float* rows)
     for (int i = 0; i < kDim; ++i) {
         uint64_t word = 0;  // voxels (i, j, l) for all j, l: one 64-bit word of the mask
         for (int j = 0; j < kDim; ++j) {
-            const float* row = rows + (i * kDim + j) * kColumnRowStride;
+            const float* row = rows + (i * kColumnWidth + j) * kColumnRowStride;
             std::memcpy(data + (i << 6) + (j << 3), row, kDim * sizeof(float));
             for (int l = 0; l < kDim; ++l) word |= uint64_t(row[l] > 0.0f) << ((j << 3) + l);
         }
@@ -297,6 +324,7 @@ struct RasterizeColumnOp
 {
     const ParticleIndex& particles;
     const std::vector<openvdb::Coord>& origins;
+    const std::vector<size_t>& order;
     const std::vector<Column>& columns;
     std::vector<FloatLeaf*>& results;
     double voxelSize;
@@ -304,6 +332,7 @@ struct RasterizeColumnOp
     CancelPoll& poll;
     std::atomic<size_t>& done;
     bool avx2;  ///< run the AVX2 copy of the loop (InstructionSet.h)
+    tbb::enumerable_thread_specific<std::vector<float>>& columnScratch;  ///< per thread
 
     void operator()(const tbb::blocked_range<size_t>& range) const
     {
@@ -336,7 +365,11 @@ struct RasterizeColumnOp
         const float radius2 = radius * radius;
         const float minDistance2 = (kMinDistanceFraction * radius) * (kMinDistanceFraction * radius);
         constexpr int kDim = int(FloatLeaf::DIM);
-        alignas(32) float values[kDim * kDim * kColumnRowStride];
+        // The column's sums, rows of kColumnRowStride floats along z, one per (x, y): on the
+        // heap, once per thread (a few hundred KB, too much for a caller's thread stack).
+        std::vector<float>& scratch = columnScratch.local();
+        scratch.resize(size_t(kColumnWidth) * kColumnWidth * kColumnRowStride);
+        float* const values = scratch.data();
         std::vector<std::pair<uint32_t, uint32_t>> runs;  // particle slots [first, end)
         size_t leavesSincePoll = 0;
 
@@ -347,13 +380,16 @@ struct RasterizeColumnOp
                 if (poll.stopped()) return;
             }
             leavesSincePoll += column.end - column.first;
-            const openvdb::Coord origin = origins[column.first];
-            const int height = origins[column.end - 1][2] + kDim - origin[2];  // voxels in z
-            const int extent[3] = {kDim, kDim, height};
-            std::fill(values, values + kDim * kDim * kColumnRowStride, 0.0f);
+            const auto [columnX, columnY] = columnOf(origins[order[column.first]]);
+            const openvdb::Coord origin(columnX, columnY, origins[order[column.first]][2]);
+            const int height = origins[order[column.end - 1]][2] + kDim - origin[2];  // voxels in z
+            const int extent[3] = {kColumnWidth, kColumnWidth, height};
+            for (int r = 0; r < kColumnWidth * kColumnWidth; ++r) {
+                std::fill_n(values + r * kColumnRowStride, height + 8, 0.0f);
+            }
             const openvdb::Vec3d columnMin = origin.asVec3d() * voxelSize;
             const openvdb::Vec3d columnMax =
-                (origin.asVec3d() + openvdb::Vec3d(kDim - 1, kDim - 1, height - 1)) * voxelSize;
+                (origin.asVec3d() + openvdb::Vec3d(kColumnWidth - 1, kColumnWidth - 1, height - 1)) * voxelSize;
             ZSpan span;
             // The runs are listed first and walked here rather than in a visitor lambda:
             // a lambda is compiled for the baseline, so the AVX2 row code would not inline.
@@ -389,9 +425,9 @@ struct RasterizeColumnOp
                                                                         : std::numeric_limits<float>::infinity();
                         }
                     }
-                    for (int i = std::max(0, lo[0]); i <= std::min(kDim - 1, hi[0]); ++i) {
+                    for (int i = std::max(0, lo[0]); i <= std::min(kColumnWidth - 1, hi[0]); ++i) {
                         const float dx = float(origin[0] + i) * h - p[0];
-                        for (int j = std::max(0, lo[1]); j <= std::min(kDim - 1, hi[1]); ++j) {
+                        for (int j = std::max(0, lo[1]); j <= std::min(kColumnWidth - 1, hi[1]); ++j) {
                             const float dy = float(origin[1] + j) * h - p[1];
                             // A row outside the support's disc gets an infinite distance, so
                             // its weights are r_e/∞ − 1 < 0, clamped to +0, which adds
@@ -401,7 +437,7 @@ struct RasterizeColumnOp
                             const float rowDistance2 = dx * dx + dy * dy;
                             const float dxy2 =
                                 rowDistance2 < radius2 ? rowDistance2 : std::numeric_limits<float>::infinity();
-                            float* row = values + (i * kDim + j) * kColumnRowStride;
+                            float* row = values + (i * kColumnWidth + j) * kColumnRowStride;
                             for (int v = 0; v < span.count; ++v) {
 #if NONBLOPPY_HAS_AVX2_COPY
                                 if constexpr (Avx2) {
@@ -418,7 +454,9 @@ struct RasterizeColumnOp
                 }
             }
             for (size_t n = column.first; n < column.end; ++n) {
-                results[n] = makeLeaf(origins[n], values + (origins[n][2] - origin[2]));
+                const openvdb::Coord& leafOrigin = origins[order[n]];
+                const int row = (leafOrigin[0] - origin[0]) * kColumnWidth + (leafOrigin[1] - origin[1]);
+                results[order[n]] = makeLeaf(leafOrigin, values + row * kColumnRowStride + (leafOrigin[2] - origin[2]));
             }
         }
         // Progress for the caller's display; a stop is remembered by the poll.
@@ -479,10 +517,12 @@ openvdb::FloatGrid::Ptr instruction_set_internal::rasterizeDensity(const Particl
     std::vector<FloatLeaf*> results(origins.size(), nullptr);
     std::atomic<size_t> done{0};
     if (!poll.stopped()) {
-        const std::vector<Column> columns = groupColumns(origins);
+        std::vector<size_t> order;
+        const std::vector<Column> columns = groupColumns(origins, order);
+        tbb::enumerable_thread_specific<std::vector<float>> columnScratch;
         tbb::parallel_for(tbb::blocked_range<size_t>(0, columns.size(), 4),
-            RasterizeColumnOp{particles, origins, columns, results, voxelSize, settings.effectiveRadius, poll,
-                              done, instruction_set_internal::useAvx2(set)});
+            RasterizeColumnOp{particles, origins, order, columns, results, voxelSize, settings.effectiveRadius, poll,
+                              done, instruction_set_internal::useAvx2(set), columnScratch});
     }
 
     openvdb::FloatGrid::Ptr grid = openvdb::FloatGrid::create(0.0f);

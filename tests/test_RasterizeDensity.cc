@@ -94,6 +94,27 @@ TEST(RasterizeDensity, WideSupportsAndGappedColumnsMatchTheBruteForceSum)
     EXPECT_FALSE(grid->tree().isValueOn(openvdb::Coord(0, 0, 30)));  // the gap stays empty
 }
 
+TEST(RasterizeDensity, ClustersScatteredOverColumnsOfManyStacksMatchTheBruteForceSum)
+{
+    // A task fills a column 4 x 4 leaf stacks wide (32 voxels along x and y). Small clusters
+    // with empty stacks between them, on both sides of column boundaries (x and y = 0 and
+    // 32 voxels, h = 0.02) and at different heights, each sum only their own particles.
+    const double radius = 0.05, voxelSize = 0.02;
+    std::mt19937 random(7);
+    std::uniform_real_distribution<float> offset(-0.02f, 0.02f);
+    std::vector<openvdb::Vec3f> positions;
+    const openvdb::Vec3f centres[] = {{0.05f, 0.05f, 0.0f},  {0.45f, 0.05f, 0.3f},  {0.05f, 0.45f, -0.2f},
+                                      {0.63f, 0.63f, 0.0f},  {0.66f, 0.1f, 0.0f},   {-0.01f, 0.3f, 0.1f},
+                                      {0.3f, -0.02f, 0.2f}};
+    for (const openvdb::Vec3f& centre : centres) {
+        for (int n = 0; n < 12; ++n) positions.push_back(centre + openvdb::Vec3f(offset(random), offset(random), offset(random)));
+    }
+    const openvdb::FloatGrid::Ptr grid = rasterize(positions, radius, voxelSize);
+    expectBruteForceValues(*grid, positions, radius,
+                           openvdb::CoordBBox(openvdb::Coord(-6, -6, -16), openvdb::Coord(40, 40, 20)));
+    EXPECT_FALSE(grid->tree().isValueOn(openvdb::Coord(16, 16, 0)));  // between the clusters
+}
+
 TEST(RasterizeDensity, VoxelsFarWiderThanTheSupportMatchTheBruteForceSum)
 {
     // h = 64 r_e: a leaf column spans 512 h, some 650,000 index cells per axis around 300
