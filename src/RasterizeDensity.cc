@@ -195,8 +195,9 @@ inline int ceilToInt(float x)
 /// 0.30 s. 2 × 2 and 8 × 8, and 16 or 32 leaves tall, were no faster than 4 × 4 by 8.
 constexpr int kColumnLeaves = 8;
 constexpr int kColumnVoxels = kColumnLeaves * int(FloatLeaf::DIM);
-/// Leaf stacks per column along x and along y (a power of two).
+/// Leaf stacks per column along x and along y (a power of two, at most 5 bits of a mask).
 constexpr int kColumnStacks = 4;
+static_assert(kColumnStacks * kColumnStacks <= 32, "a column's stacks are a 32-bit mask");
 /// Voxels of a column along x and along y.
 constexpr int kColumnWidth = kColumnStacks * int(FloatLeaf::DIM);
 /// Row length of a column's scratch block: a vector may start at the column's last voxel.
@@ -383,13 +384,34 @@ struct RasterizeColumnOp
             const auto [columnX, columnY] = columnOf(origins[order[column.first]]);
             const openvdb::Coord origin(columnX, columnY, origins[order[column.first]][2]);
             const int height = origins[order[column.end - 1]][2] + kDim - origin[2];  // voxels in z
-            const int extent[3] = {kColumnWidth, kColumnWidth, height};
-            for (int r = 0; r < kColumnWidth * kColumnWidth; ++r) {
-                std::fill_n(values + r * kColumnRowStride, height + 8, 0.0f);
+            // The voxels filled, relative to the origin: [boxFirst, boxLast] per axis, the box of
+            // the column's stacks. Isolated droplets make columns of one or two stacks; with
+            // the whole column's 32 x 32 voxels queried and cleared, they took 30-50% more
+            // rasterization time than one stack at a time (100,000 particles 40 r_e apart).
+            int boxFirst[3] = {kColumnWidth, kColumnWidth, 0}, boxLast[3] = {-1, -1, height - 1};
+            // Zeroed: the rows of the stacks the column holds. The others inside the box
+            // only ever get +0 added (a voxel within r_e of a particle lies in a candidate
+            // leaf, and the candidates of this column's cell and z-range are all in it) and
+            // are never read, so they are left as they are.
+            uint32_t stacksZeroed = 0;  // bit sx * kColumnStacks + sy
+            for (size_t n = column.first; n < column.end; ++n) {
+                const int sx = (origins[order[n]][0] - origin[0]) / kDim, sy = (origins[order[n]][1] - origin[1]) / kDim;
+                const uint32_t bit = 1u << (sx * kColumnStacks + sy);
+                if (stacksZeroed & bit) continue;
+                stacksZeroed |= bit;
+                boxFirst[0] = std::min(boxFirst[0], sx * kDim);
+                boxFirst[1] = std::min(boxFirst[1], sy * kDim);
+                boxLast[0] = std::max(boxLast[0], sx * kDim + kDim - 1);
+                boxLast[1] = std::max(boxLast[1], sy * kDim + kDim - 1);
+                for (int i = 0; i < kDim; ++i) {
+                    for (int j = 0; j < kDim; ++j) {
+                        const int row = (sx * kDim + i) * kColumnWidth + sy * kDim + j;
+                        std::fill_n(values + row * kColumnRowStride, height + 8, 0.0f);
+                    }
+                }
             }
-            const openvdb::Vec3d columnMin = origin.asVec3d() * voxelSize;
-            const openvdb::Vec3d columnMax =
-                (origin.asVec3d() + openvdb::Vec3d(kColumnWidth - 1, kColumnWidth - 1, height - 1)) * voxelSize;
+            const openvdb::Vec3d columnMin = (origin + openvdb::Coord(boxFirst[0], boxFirst[1], boxFirst[2])).asVec3d() * voxelSize;
+            const openvdb::Vec3d columnMax = (origin + openvdb::Coord(boxLast[0], boxLast[1], boxLast[2])).asVec3d() * voxelSize;
             ZSpan span;
             // The runs are listed first and walked here rather than in a visitor lambda:
             // a lambda is compiled for the baseline, so the AVX2 row code would not inline.
@@ -406,7 +428,7 @@ struct RasterizeColumnOp
                     for (int a = 0; a < 3; ++a) {
                         lo[a] = ceilToInt((p[a] - radius) * invH) - origin[a];
                         hi[a] = floorToInt((p[a] + radius) * invH) - origin[a];
-                        empty |= std::max(0, lo[a]) > std::min(extent[a] - 1, hi[a]);
+                        empty |= std::max(boxFirst[a], lo[a]) > std::min(boxLast[a], hi[a]);
                     }
                     if (empty) continue;
                     // The z-vectors: lanes from the first voxel in the column; lanes outside
@@ -425,9 +447,9 @@ struct RasterizeColumnOp
                                                                         : std::numeric_limits<float>::infinity();
                         }
                     }
-                    for (int i = std::max(0, lo[0]); i <= std::min(kColumnWidth - 1, hi[0]); ++i) {
+                    for (int i = std::max(boxFirst[0], lo[0]); i <= std::min(boxLast[0], hi[0]); ++i) {
                         const float dx = float(origin[0] + i) * h - p[0];
-                        for (int j = std::max(0, lo[1]); j <= std::min(kColumnWidth - 1, hi[1]); ++j) {
+                        for (int j = std::max(boxFirst[1], lo[1]); j <= std::min(boxLast[1], hi[1]); ++j) {
                             const float dy = float(origin[1] + j) * h - p[1];
                             // A row outside the support's disc gets an infinite distance, so
                             // its weights are r_e/∞ − 1 < 0, clamped to +0, which adds
