@@ -33,8 +33,8 @@ struct DensitySettings
 ///
 /// The result is a FloatGrid named "density", class GRID_FOG_VOLUME (φ grows inwards, so
 /// it is not a level set), background 0; exactly the voxels within r_e of a particle are
-/// active. Each column of up to 8 leaves stacked along z is filled by one task from the
-/// particles whose support overlaps it, visited in a fixed order, so values are
+/// active. Each column, up to 4 × 4 stacks of 8 leaves along z, is filled by one task from
+/// the particles whose support overlaps it, visited in a fixed order, so values are
 /// bit-identical for any thread count (and for any grouping of leaves into columns).
 /// Cost: O(N·(r_e/h)³) kernel evaluations; memory: the grid (≈ 4.5 bytes per active voxel).
 /// @param particles    the particle index (its cell size does not affect the result)
