@@ -52,6 +52,13 @@ namespace io_internal {
 
 namespace {
 
+/// "coordinate 1e39 on line 3 lies outside float's range (-3.4e38 to 3.4e38)" for a finite
+/// coordinate @a text (as written) that becomes infinite as a float, @a where it stands
+/// ("on line 3", "of particle 2"): the CSV and JSON readers' one message for it.
+std::string beyondFloatMessage(const std::string& text, const std::string& where)
+{
+    return "coordinate " + text + " " + where + " lies outside float's range (-3.4e38 to 3.4e38)";
+}
 
 /// @a text without the spaces, tabs and '\r' around it.
 std::string_view
@@ -448,8 +455,7 @@ parseTable(StreamReader& in, const std::string& path)
                 if (std::isfinite(value) && !std::isfinite(p[columns[i].component])) {
                     // Positions are float: said here, where the text is known, rather than as
                     // a "non-finite position" that the file does not hold.
-                    fail(path, "coordinate " + fieldText() + " on line " + std::to_string(line) +
-                               " lies outside float's range (-3.4e38 to 3.4e38)");
+                    fail(path, beyondFloatMessage(fieldText(), "on line " + std::to_string(line)));
                 }
                 continue;
             }
@@ -593,8 +599,7 @@ public:
         if (std::isfinite(value) && !std::isfinite(mPoint[mComponent])) {
             char text[32];
             const std::string shortest(text, std::to_chars(text, text + sizeof(text), value).ptr);
-            return reject("coordinate " + shortest + " of particle " + std::to_string(positions.size()) +
-                          " lies outside float's range (-3.4e38 to 3.4e38)");
+            return reject(beyondFloatMessage(shortest, "of particle " + std::to_string(positions.size())));
         }
         ++mComponent;
         return true;
