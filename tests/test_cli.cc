@@ -1238,6 +1238,13 @@ TEST_F(CliTest, AReportThatCannotBeWrittenIsAFailure)
     EXPECT_EQ(readText(errFile), "nonbloppy: cannot write standard output: No space left on device\n");
     EXPECT_EQ(runTo("help mesh", ">&-"), 1);
     EXPECT_EQ(readText(errFile), "nonbloppy: cannot write standard output: Bad file descriptor\n");
+    // mesh and convert flush their report before they end, so the write that failed was not
+    // the last one: the reason used to be lost there.
+    EXPECT_EQ(runTo("mesh " + quote(kCube) + " -o " + quote(out("full.obj")), ">/dev/full"), 1);
+    EXPECT_EQ(readText(errFile), "nonbloppy: cannot write standard output: No space left on device\n");
+    EXPECT_TRUE(fs::exists(out("full.obj")));  // the mesh itself is whole
+    EXPECT_EQ(runTo("convert " + quote(kCube) + " " + quote(out("full.ply")), ">/dev/full"), 1);
+    EXPECT_EQ(readText(errFile), "nonbloppy: cannot write standard output: No space left on device\n");
     // A command that failed says why, not that its report was lost too.
     EXPECT_EQ(runTo("inspect " + quote(in("missing.vtk")), ">/dev/full"), 1);
     EXPECT_EQ(readText(errFile), "nonbloppy: cannot open " + in("missing.vtk") + ": No such file or directory\n");

@@ -18,6 +18,7 @@
 #include <openvdb/Exceptions.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
@@ -29,6 +30,7 @@
 #include <new>
 #include <regex>
 #include <sstream>
+#include <streambuf>
 #include <string>
 #include <vector>
 
@@ -225,21 +227,67 @@ int run(int argc, char** argv)
     return fail("no command given; run 'nonbloppy --help'", kExitUsage);
 }
 
+/// std::cout's buffer while a command runs: it hands every write on to C's stdout, as the
+/// standard synchronized buffer does (stdio's lock keeps lines from several threads whole),
+/// and keeps the errno of the first write that failed. Without it the reason was lost when
+/// the failing write was not the last one: `mesh IN -o OUT > /dev/full` flushed its report
+/// before the end and said only "cannot write standard output".
+class StdoutKeepingFirstError : public std::streambuf
+{
+public:
+    /// errno of the first failed write, or 0.
+    int firstError() const { return mFirstError.load(std::memory_order_relaxed); }
+
+protected:
+    int_type overflow(int_type c) override
+    {
+        if (traits_type::eq_int_type(c, traits_type::eof())) return sync() == 0 ? traits_type::not_eof(c) : c;
+        if (std::putc(traits_type::to_char_type(c), stdout) == EOF) {
+            keep(errno);
+            return traits_type::eof();
+        }
+        return c;
+    }
+
+    std::streamsize xsputn(const char* text, std::streamsize count) override
+    {
+        const size_t written = std::fwrite(text, 1, size_t(count), stdout);
+        if (written < size_t(count)) keep(errno);
+        return std::streamsize(written);
+    }
+
+    int sync() override
+    {
+        if (std::fflush(stdout) == 0) return 0;
+        keep(errno);
+        return -1;
+    }
+
+private:
+    void keep(int error)
+    {
+        int none = 0;
+        if (error != 0) mFirstError.compare_exchange_strong(none, error, std::memory_order_relaxed);
+    }
+
+    std::atomic<int> mFirstError{0};
+};
+
 /// @a status, or kExitError after one line on stderr if what the command printed on stdout
 /// could not all be written (a full disk, a closed descriptor): a script reading
 /// `inspect --json > info.json` must not take an empty file for success. A reader that went
 /// away (EPIPE, '| head -1') asked for the rest to be dropped, and a failed command has
 /// already said why it failed.
-int finishStandardOutput(int status)
+int finishStandardOutput(int status, const StdoutKeepingFirstError& output)
 {
     errno = 0;
     std::cout.flush();
     const bool lost = !std::cout || std::fflush(stdout) != 0 || std::ferror(stdout);
-    int error = errno;
+    int error = output.firstError() != 0 ? output.firstError() : errno;
     if (!lost || status != 0) return status;
-    // errno is that of the last write; an earlier failed one (the buffer filled mid-run) left
-    // only stdout's error flag. A closed descriptor and a pipe without a reader (POLLERR) can
-    // still be told; other causes cannot.
+    // Writes that stdio failed on its own (its buffer filled inside a printf) leave only its
+    // error flag. A closed descriptor and a pipe without a reader (POLLERR) can still be
+    // told; other causes cannot.
     if (error == 0) {
         pollfd output{STDOUT_FILENO, 0, 0};
         if (::fcntl(STDOUT_FILENO, F_GETFD) == -1) error = errno;
@@ -287,5 +335,9 @@ int main(int argc, char** argv)
     mallopt(M_MMAP_THRESHOLD, 32 << 20);
     mallopt(M_TRIM_THRESHOLD, 256 << 20);
 #endif
-    return finishStandardOutput(runCommand(argc, argv));
+    StdoutKeepingFirstError output;
+    std::streambuf* const standard = std::cout.rdbuf(&output);
+    const int status = finishStandardOutput(runCommand(argc, argv), output);
+    std::cout.rdbuf(standard);  // the library's exit-time flush of std::cout must not find a dead buffer
+    return status;
 }
