@@ -572,9 +572,17 @@ TEST_F(CliTest, UnknownInputExtension)
 {
     const std::string path = in("particles.foo");
     writeText(path, "1 2 3\n");
-    expectFailure("mesh " + quote(path) + " -o " + quote(out("x.obj")),
-                  "unknown particle file extension '.foo' (" + path
-                      + "); expected .vtk, .vtu, .vtp, .ply, .xyz, .bgeo, .vdb, .csv, .txt or .json");
+    // A format nonbloppy cannot read is a command line that cannot run (exit 2), as an unknown
+    // output format is; it used to exit 1, telling scripts the file was at fault.
+    const std::string message = "unknown particle file extension '.foo' (" + path
+                                + "); expected .vtk, .vtu, .vtp, .ply, .xyz, .bgeo, .vdb, .csv, .txt or .json";
+    expectFailure("mesh " + quote(path) + " -o " + quote(out("x.obj")), message, 2);
+    expectFailure("convert " + quote(path) + " " + quote(out("x.ply")), message, 2);
+    const std::string houdini = in("particles.bgeo.sc");
+    writeText(houdini, "1 2 3\n");
+    const RunResult r = run("inspect " + quote(houdini));
+    EXPECT_EQ(r.exitCode, 2);
+    EXPECT_EQ(r.err.rfind("nonbloppy: unknown particle file extension '.sc' (" + houdini + "): Houdini's", 0), 0u) << r.err;
 }
 
 TEST_F(CliTest, TruncatedInput)
@@ -750,7 +758,7 @@ TEST_F(CliTest, InspectUnknownExtension)
     const std::string path = in("notes.md");
     writeText(path, "hello\n");
     const RunResult r = run("inspect " + quote(path));
-    EXPECT_EQ(r.exitCode, 1);
+    EXPECT_EQ(r.exitCode, 2);
     EXPECT_EQ(r.err, "nonbloppy: unknown file extension '.md' (" + path
                          + "); expected .vdb, .obj, .ply, .vtk, .vtu, .vtp, .xyz, .bgeo, .csv, .txt "
                            "or .json\n");

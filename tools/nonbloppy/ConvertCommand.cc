@@ -35,11 +35,12 @@ struct ConvertOptions
 
 int runConvert(const ConvertOptions& o)
 {
-    // Everything that can be checked before reading: a name for each file, the output
-    // format, and not overwriting the input.
+    // Everything that can be checked before reading: a name for each file, the two formats
+    // (exit 2, as for mesh), and not overwriting the input.
     requireFileName(o.input, "IN");
     requireFileName(o.output, "OUT");  // not "particle file name has no extension ()"
     requireAsUsage([&] { nonbloppy::requireParticleOutputFile(o.output); });
+    if (!nonbloppy::isParticleFile(o.input)) requireAsUsage([&] { nonbloppy::readParticles(o.input); });
     std::error_code ec;
     if (o.input == o.output || std::filesystem::equivalent(o.input, o.output, ec)) {
         throw UsageError("cannot write " + o.output + ": it is the input file");

@@ -5,6 +5,7 @@
 
 #include "Commands.h"
 #include "Json.h"
+#include "UsageError.h"
 
 #include <nonbloppy/Error.h>
 #include <nonbloppy/EstimateParameters.h>
@@ -587,9 +588,12 @@ int runInspect(const std::string& path, bool json)
     if (nonbloppy::isParticleFile(path)) {
         return inspectParticles(path, nonbloppy::readParticles(path), json);
     }
-    // Houdini's own caches: readParticles() refuses them saying which name to export instead.
-    if (ext == ".sc" || ext == ".gz" || ext == ".geo" || ext == ".hclassic") nonbloppy::readParticles(path);
-    throw nonbloppy::FileError("unknown file extension '" + ext + "' (" + path
+    // A format nonbloppy cannot read: exit 2, as for mesh and convert. Houdini's own caches:
+    // readParticles() refuses them saying which name to export instead.
+    if (ext == ".sc" || ext == ".gz" || ext == ".geo" || ext == ".hclassic") {
+        requireAsUsage([&] { nonbloppy::readParticles(path); });
+    }
+    throw UsageError("unknown file extension '" + ext + "' (" + path
                                + "); expected .vdb, .obj, .ply, .vtk, .vtu, .vtp, .xyz, .bgeo, "
                                  ".csv, .txt or .json");
 }

@@ -402,6 +402,10 @@ void validatePaths(const MeshOptions& o)
     requireFileName(o.output, "--output");  // not "mesh file name has no extension ()"
     // writeMesh()'s own check, which would say the same after all the work.
     requireAsUsage([&] { nonbloppy::requireMeshFile(o.output); });
+    // An input format nonbloppy cannot read, like an unknown output format, is a command line
+    // that cannot run whatever the file holds (exit 2); readParticles() says which, and what
+    // to export instead for Houdini's other caches, before it opens the file.
+    if (!nonbloppy::isParticleFile(o.input)) requireAsUsage([&] { nonbloppy::readParticles(o.input); });
     if (!o.vdbPath.empty() && lowerExtension(o.vdbPath) != ".vdb") {
         throw UsageError("--vdb file name must end in .vdb (" + o.vdbPath + ")");
     }
@@ -410,7 +414,6 @@ void validatePaths(const MeshOptions& o)
     if (::stat(o.input.c_str(), &info) != 0) {
         throw nonbloppy::FileError("cannot open " + o.input + ": " + std::strerror(errno));
     }
-    // An unknown input extension is reported by readParticles(), before it reads a byte.
 
     std::vector<std::string> outputs{o.output};
     if (!o.vdbPath.empty()) outputs.push_back(o.vdbPath);
