@@ -13,8 +13,9 @@
 /// is decompressed once (VdbSizeCheck, through a 64 KB window); OpenVDB then reads the same
 /// bytes through a 64 KB stream buffer (VdbStreamBuf). So the file is never held whole: peak
 /// memory is the PointDataGrid, then the particle arrays made from it. Grids that are not
-/// needed are skipped unread when the file says where they end. Points are visited leaf by
-/// leaf in tree order, so the particle order is the same on every run.
+/// needed are skipped unread when the file says where they end. The particles come in tree
+/// order, leaf by leaf: the leaves are converted in parallel, each into its own place, so the
+/// order is the same on every run and at any thread count.
 
 #include "ReadVdbPoints.h"
 
@@ -37,6 +38,8 @@
 #pragma GCC visibility pop
 
 #include <blosc.h>  // BLOSC_MAX_OVERHEAD
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 #include <zlib.h>
 
 #include <algorithm>
@@ -63,16 +66,38 @@ namespace {
 using openvdb::points::AttributeHandle;
 using openvdb::points::PointDataGrid;
 
+using PointLeaf = PointDataGrid::TreeType::LeafNodeType;
+
+/// A PointDataGrid's leaves in tree order, and where each one's points start in the
+/// particle arrays (start[n]; start.back() is the point count). The loops below fill each
+/// leaf's points in parallel at their place in tree order, so the particles come out in the
+/// same order whatever the thread count.
+struct PointLeaves
+{
+    std::vector<const PointLeaf*> leaves;
+    std::vector<size_t> start;
+
+    /// Calls @a visit(leaf, first point) for every leaf, leaves in parallel.
+    template<typename VisitT>
+    void forEach(const VisitT& visit) const
+    {
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, leaves.size(), 16),
+            [&](const tbb::blocked_range<size_t>& range) {
+                for (size_t n = range.begin(); n < range.end(); ++n) visit(*leaves[n], start[n]);
+            });
+    }
+};
+
 template<typename ValueT, typename StoredT, int ComponentsT>
 void
-copyAttribute(const PointDataGrid& grid, size_t arrayIndex, size_t count, ParticleAttribute& out)
+copyAttribute(const PointLeaves& table, size_t arrayIndex, ParticleAttribute& out)
 {
     out.components = ComponentsT;
-    out.bytes.resize(count * ComponentsT * sizeof(StoredT));
-    unsigned char* dst = out.bytes.data();
-    for (auto leaf = grid.tree().cbeginLeaf(); leaf; ++leaf) {
-        AttributeHandle<ValueT> handle(leaf->constAttributeArray(arrayIndex));
-        for (auto index = leaf->beginIndexAll(); index; ++index) {
+    out.bytes.resize(table.start.back() * ComponentsT * sizeof(StoredT));
+    table.forEach([&](const PointLeaf& leaf, size_t first) {
+        unsigned char* dst = out.bytes.data() + first * ComponentsT * sizeof(StoredT);
+        AttributeHandle<ValueT> handle(leaf.constAttributeArray(arrayIndex));
+        for (auto index = leaf.beginIndexAll(); index; ++index) {
             const ValueT value = handle.get(*index);
             StoredT stored[ComponentsT];
             if constexpr (ComponentsT == 1) {
@@ -88,7 +113,7 @@ copyAttribute(const PointDataGrid& grid, size_t arrayIndex, size_t count, Partic
             std::memcpy(dst, stored, sizeof(stored));
             dst += sizeof(stored);
         }
-    }
+    });
 }
 
 /// @a attributes with runs of scalars "<base>_0", "<base>_1", ... of one type joined into one
@@ -143,41 +168,52 @@ convertGrid(const PointDataGrid& grid, const std::string& path)
     }
     // Every leaf must share the descriptor (OpenVDB guarantees it for grids it wrote; a
     // corrupt file might not, and the handles below would then read the wrong arrays).
-    uint64_t count = 0;
-    for (auto leaf = grid.tree().cbeginLeaf(); leaf; ++leaf) {
-        // A voxel's points are those from the previous voxel's offset up to its own; a
-        // decreasing offset would make the index iterators below visit more points than
-        // pointCount() (the last offset) says, past the arrays and the output.
-        for (openvdb::Index n = 1; n < PointDataGrid::TreeType::LeafNodeType::SIZE; ++n) {
-            if (leaf->getValue(n) < leaf->getValue(n - 1)) {
-                fail(path, "corrupt point offsets in PointDataGrid '" + printable(grid.getName()) + "'");
+    // Checked in parallel, reported for the first such leaf in tree order.
+    PointLeaves table;
+    for (auto leaf = grid.tree().cbeginLeaf(); leaf; ++leaf) table.leaves.push_back(leaf.getLeaf());
+    enum : uint8_t { kSound, kDecreasingOffsets, kOtherDescriptor, kBadArray };
+    std::vector<uint8_t> problem(table.leaves.size(), kSound);
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, table.leaves.size(), 64),
+        [&](const tbb::blocked_range<size_t>& range) {
+            for (size_t n = range.begin(); n < range.end(); ++n) {
+                const PointLeaf& leaf = *table.leaves[n];
+                // A voxel's points are those from the previous voxel's offset up to its own; a
+                // decreasing offset would make the index iterators below visit more points than
+                // pointCount() (the last offset) says, past the arrays and the output.
+                for (openvdb::Index v = 1; v < PointLeaf::SIZE && problem[n] == kSound; ++v) {
+                    if (leaf.getValue(v) < leaf.getValue(v - 1)) problem[n] = kDecreasingOffsets;
+                }
+                if (problem[n] == kSound && !(leaf.attributeSet().descriptor() == descriptor)) {
+                    problem[n] = kOtherDescriptor;
+                }
+                for (size_t a = 0; a < descriptor.size() && problem[n] == kSound; ++a) {
+                    const openvdb::points::AttributeArray* array = leaf.attributeSet().getConst(a);
+                    if (!array || (array->size() != leaf.pointCount() && !array->isUniform())) problem[n] = kBadArray;
+                }
             }
-        }
-        if (!(leaf->attributeSet().descriptor() == descriptor)) {
-            fail(path, "leaves of PointDataGrid '" + printable(grid.getName()) +
-                 "' have different attributes");
-        }
-        for (size_t a = 0; a < descriptor.size(); ++a) {
-            const openvdb::points::AttributeArray* array = leaf->attributeSet().getConst(a);
-            if (!array || (array->size() != leaf->pointCount() && !array->isUniform())) {
-                fail(path, "corrupt attribute array in PointDataGrid '" + printable(grid.getName()) + "'");
-            }
-        }
-        count += leaf->pointCount();
+        });
+    const std::string gridName = printable(grid.getName());
+    for (const uint8_t found : problem) {
+        if (found == kDecreasingOffsets) fail(path, "corrupt point offsets in PointDataGrid '" + gridName + "'");
+        if (found == kOtherDescriptor) fail(path, "leaves of PointDataGrid '" + gridName + "' have different attributes");
+        if (found == kBadArray) fail(path, "corrupt attribute array in PointDataGrid '" + gridName + "'");
     }
+    table.start.assign(table.leaves.size() + 1, 0);
+    for (size_t n = 0; n < table.leaves.size(); ++n) table.start[n + 1] = table.start[n] + table.leaves[n]->pointCount();
+    const uint64_t count = table.start.back();
 
     requireMemoryForParticles(path, count, sizeof(openvdb::Vec3f));
     particles.positions.resize(size_t(count));
-    size_t n = 0;
     const openvdb::math::Transform& transform = grid.transform();
-    for (auto leaf = grid.tree().cbeginLeaf(); leaf; ++leaf) {
-        AttributeHandle<openvdb::Vec3f> handle(leaf->constAttributeArray(positionIndex));
-        for (auto index = leaf->beginIndexAll(); index; ++index) {
+    table.forEach([&](const PointLeaf& leaf, size_t first) {
+        AttributeHandle<openvdb::Vec3f> handle(leaf.constAttributeArray(positionIndex));
+        openvdb::Vec3f* out = particles.positions.data() + first;
+        for (auto index = leaf.beginIndexAll(); index; ++index) {
             const openvdb::Vec3d voxel = index.getCoord().asVec3d();
             const openvdb::Vec3d world = transform.indexToWorld(voxel + openvdb::Vec3d(handle.get(*index)));
-            particles.positions[n++] = openvdb::Vec3f(world);
+            *out++ = openvdb::Vec3f(world);
         }
-    }
+    });
 
     // Attributes in the order the descriptor numbers them.
     std::vector<std::pair<size_t, std::string>> arrays;
@@ -197,23 +233,22 @@ convertGrid(const PointDataGrid& grid, const std::string& path)
         const std::string valueType = descriptor.valueType(arrayIndex);
         ParticleAttribute attribute;
         attribute.name = name;
-        const size_t c = size_t(count);
-        if (valueType == "float") { attribute.type = ScalarType::Float32; copyAttribute<float, float, 1>(grid, arrayIndex, c, attribute); }
-        else if (valueType == "double") { attribute.type = ScalarType::Float64; copyAttribute<double, double, 1>(grid, arrayIndex, c, attribute); }
-        else if (valueType == "int8") { attribute.type = ScalarType::Int8; copyAttribute<int8_t, int8_t, 1>(grid, arrayIndex, c, attribute); }
-        else if (valueType == "int16") { attribute.type = ScalarType::Int16; copyAttribute<int16_t, int16_t, 1>(grid, arrayIndex, c, attribute); }
-        else if (valueType == "int32") { attribute.type = ScalarType::Int32; copyAttribute<int32_t, int32_t, 1>(grid, arrayIndex, c, attribute); }
-        else if (valueType == "int64") { attribute.type = ScalarType::Int64; copyAttribute<int64_t, int64_t, 1>(grid, arrayIndex, c, attribute); }
-        else if (valueType == "bool") { attribute.type = ScalarType::UInt8; copyAttribute<bool, uint8_t, 1>(grid, arrayIndex, c, attribute); }
-        else if (valueType == "vec3s") { attribute.type = ScalarType::Float32; copyAttribute<openvdb::Vec3f, float, 3>(grid, arrayIndex, c, attribute); }
-        else if (valueType == "vec3d") { attribute.type = ScalarType::Float64; copyAttribute<openvdb::Vec3d, double, 3>(grid, arrayIndex, c, attribute); }
-        else if (valueType == "vec3i") { attribute.type = ScalarType::Int32; copyAttribute<openvdb::Vec3i, int32_t, 3>(grid, arrayIndex, c, attribute); }
-        else if (valueType == "quats") { attribute.type = ScalarType::Float32; copyAttribute<openvdb::math::Quats, float, 4>(grid, arrayIndex, c, attribute); }
-        else if (valueType == "quatd") { attribute.type = ScalarType::Float64; copyAttribute<openvdb::math::Quatd, double, 4>(grid, arrayIndex, c, attribute); }
-        else if (valueType == "mat3s") { attribute.type = ScalarType::Float32; copyAttribute<openvdb::Mat3s, float, 9>(grid, arrayIndex, c, attribute); }
-        else if (valueType == "mat3d") { attribute.type = ScalarType::Float64; copyAttribute<openvdb::Mat3d, double, 9>(grid, arrayIndex, c, attribute); }
-        else if (valueType == "mat4s") { attribute.type = ScalarType::Float32; copyAttribute<openvdb::Mat4s, float, 16>(grid, arrayIndex, c, attribute); }
-        else if (valueType == "mat4d") { attribute.type = ScalarType::Float64; copyAttribute<openvdb::Mat4d, double, 16>(grid, arrayIndex, c, attribute); }
+        if (valueType == "float") { attribute.type = ScalarType::Float32; copyAttribute<float, float, 1>(table, arrayIndex, attribute); }
+        else if (valueType == "double") { attribute.type = ScalarType::Float64; copyAttribute<double, double, 1>(table, arrayIndex, attribute); }
+        else if (valueType == "int8") { attribute.type = ScalarType::Int8; copyAttribute<int8_t, int8_t, 1>(table, arrayIndex, attribute); }
+        else if (valueType == "int16") { attribute.type = ScalarType::Int16; copyAttribute<int16_t, int16_t, 1>(table, arrayIndex, attribute); }
+        else if (valueType == "int32") { attribute.type = ScalarType::Int32; copyAttribute<int32_t, int32_t, 1>(table, arrayIndex, attribute); }
+        else if (valueType == "int64") { attribute.type = ScalarType::Int64; copyAttribute<int64_t, int64_t, 1>(table, arrayIndex, attribute); }
+        else if (valueType == "bool") { attribute.type = ScalarType::UInt8; copyAttribute<bool, uint8_t, 1>(table, arrayIndex, attribute); }
+        else if (valueType == "vec3s") { attribute.type = ScalarType::Float32; copyAttribute<openvdb::Vec3f, float, 3>(table, arrayIndex, attribute); }
+        else if (valueType == "vec3d") { attribute.type = ScalarType::Float64; copyAttribute<openvdb::Vec3d, double, 3>(table, arrayIndex, attribute); }
+        else if (valueType == "vec3i") { attribute.type = ScalarType::Int32; copyAttribute<openvdb::Vec3i, int32_t, 3>(table, arrayIndex, attribute); }
+        else if (valueType == "quats") { attribute.type = ScalarType::Float32; copyAttribute<openvdb::math::Quats, float, 4>(table, arrayIndex, attribute); }
+        else if (valueType == "quatd") { attribute.type = ScalarType::Float64; copyAttribute<openvdb::math::Quatd, double, 4>(table, arrayIndex, attribute); }
+        else if (valueType == "mat3s") { attribute.type = ScalarType::Float32; copyAttribute<openvdb::Mat3s, float, 9>(table, arrayIndex, attribute); }
+        else if (valueType == "mat3d") { attribute.type = ScalarType::Float64; copyAttribute<openvdb::Mat3d, double, 9>(table, arrayIndex, attribute); }
+        else if (valueType == "mat4s") { attribute.type = ScalarType::Float32; copyAttribute<openvdb::Mat4s, float, 16>(table, arrayIndex, attribute); }
+        else if (valueType == "mat4d") { attribute.type = ScalarType::Float64; copyAttribute<openvdb::Mat4d, double, 16>(table, arrayIndex, attribute); }
         else continue;  // a type registered after OpenVDB 10's own (which are all above)
         particles.attributes.push_back(std::move(attribute));
     }

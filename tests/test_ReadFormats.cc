@@ -13,6 +13,7 @@
 #include <nonbloppy/WriteVdb.h>
 
 #include <openvdb/openvdb.h>
+#include <tbb/task_arena.h>
 
 #include <gtest/gtest.h>
 #include <zlib.h>
@@ -1252,4 +1253,50 @@ TEST_F(ReadFormatsTest, VdbPositionsComeBackBitForBit)
     size_t differing = 0;
     for (size_t n = 0; n < written.size(); ++n) differing += written[n] != read[n];
     EXPECT_EQ(differing, 0u) << "of " << written.size() << " positions";
+}
+
+TEST_F(ReadFormatsTest, VdbPointsReadTheSameInTreeOrderWhateverTheThreadCount)
+{
+    // The leaves are converted in parallel, each into its place: the particles and their
+    // attributes must come out in tree order, the same bytes at one thread and at four (more
+    // than the machine may have: TBB still splits the work into that many tasks). A real
+    // frame at a voxel size that gives it hundreds of leaves.
+    openvdb::initialize();
+    const ParticleSet frame = readParticles(dataPath("dam_break_frame_23_24389_particles.vtk"));
+    const std::vector<openvdb::Vec3R> positions(frame.positions.begin(), frame.positions.end());
+    const std::string file = path("frame.vdb");
+    const double voxelSize = 0.02;
+    nonbloppy_test::writeOpenVdbPoints(file, positions, voxelSize);
+    const auto readWith = [&](int threads) {
+        tbb::task_arena arena(threads);
+        return arena.execute([&] { return readParticles(file); });
+    };
+    const ParticleSet one = readWith(1), four = readWith(4);
+    ASSERT_EQ(one.size(), positions.size());
+    ASSERT_EQ(four.size(), positions.size());
+    EXPECT_EQ(std::memcmp(one.positions.data(), four.positions.data(), one.size() * sizeof(openvdb::Vec3f)), 0);
+    EXPECT_TRUE(attribute(one, "temperature").bytes == attribute(four, "temperature").bytes);
+
+    // Tree order: a leaf's points come together, and each point is the particle its
+    // temperature (number / 2) names.
+    std::vector<openvdb::Coord> leafOrigins;
+    const ParticleAttribute& temperature = attribute(four, "temperature");
+    size_t misplaced = 0;
+    for (size_t n = 0; n < four.size(); ++n) {
+        const openvdb::Vec3f& p = four.positions[n];
+        const openvdb::Coord voxel(openvdb::Vec3i(openvdb::math::Round(p[0] / voxelSize),
+                                                  openvdb::math::Round(p[1] / voxelSize),
+                                                  openvdb::math::Round(p[2] / voxelSize)));
+        const openvdb::Coord origin = voxel & ~7;
+        if (leafOrigins.empty() || leafOrigins.back() != origin) leafOrigins.push_back(origin);
+        const size_t i = size_t(temperature.asDouble(n) * 2.0);
+        ASSERT_LT(i, positions.size());
+        misplaced += !(std::abs(p[0] - positions[i][0]) < 1e-5 && std::abs(p[1] - positions[i][1]) < 1e-5
+                       && std::abs(p[2] - positions[i][2]) < 1e-5);
+    }
+    EXPECT_EQ(misplaced, 0u);
+    std::vector<openvdb::Coord> sorted = leafOrigins;
+    std::sort(sorted.begin(), sorted.end());
+    EXPECT_EQ(std::adjacent_find(sorted.begin(), sorted.end()), sorted.end()) << "a leaf's points are split";
+    EXPECT_GT(leafOrigins.size(), 200u) << "too few leaves to test the parallel loop";
 }
