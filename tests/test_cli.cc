@@ -578,6 +578,15 @@ TEST_F(CliTest, UnknownInputExtension)
                                 + "); expected .vtk, .vtu, .vtp, .ply, .xyz, .bgeo, .vdb, .csv, .txt or .json";
     expectFailure("mesh " + quote(path) + " -o " + quote(out("x.obj")), message, 2);
     expectFailure("convert " + quote(path) + " " + quote(out("x.ply")), message, 2);
+    // Told from the name alone: also for a file that is missing, and for a sequence with no
+    // frame on disk.
+    expectFailure("inspect " + quote(in("missing.md")),
+                  "unknown file extension '.md' (" + in("missing.md")
+                      + "); expected .vdb, .obj, .ply, .vtk, .vtu, .vtp, .xyz, .bgeo, .csv, .txt or .json", 2);
+    const std::string pattern = in("fluid_{}.foo");
+    expectFailure("mesh " + quote(pattern) + " -o " + quote(out("m_{}.obj")),
+                  "unknown particle file extension '.foo' (" + pattern
+                      + "); expected .vtk, .vtu, .vtp, .ply, .xyz, .bgeo, .vdb, .csv, .txt or .json", 2);
     const std::string houdini = in("particles.bgeo.sc");
     writeText(houdini, "1 2 3\n");
     const RunResult r = run("inspect " + quote(houdini));

@@ -562,6 +562,17 @@ int inspectVdb(const std::string& path, bool json)
 int runInspect(const std::string& path, bool json)
 {
     requireFileName(path, "FILE");
+    // A format nonbloppy cannot read: exit 2, as for mesh and convert, told from the name
+    // alone (before a missing file or a FIFO is). Houdini's own caches: readParticles()
+    // refuses them saying which name to export instead.
+    const std::string ext = lowerExtension(path);
+    if (ext != ".vdb" && ext != ".obj" && !nonbloppy::isParticleFile(path)) {
+        if (ext == ".sc" || ext == ".gz" || ext == ".geo" || ext == ".hclassic") {
+            requireAsUsage([&] { nonbloppy::readParticles(path); });
+        }
+        throw UsageError("unknown file extension '" + ext + "' (" + path
+                         + "); expected .vdb, .obj, .ply, .vtk, .vtu, .vtp, .xyz, .bgeo, .csv, .txt or .json");
+    }
     struct stat info;
     if (::stat(path.c_str(), &info) != 0) {
         throw nonbloppy::FileError("cannot open " + path + ": " + std::strerror(errno));
@@ -577,7 +588,6 @@ int runInspect(const std::string& path, bool json)
                                    "once; save it to a file first)");
     }
 
-    const std::string ext = lowerExtension(path);
     if (ext == ".vdb") return inspectVdb(path, json);
     if (ext == ".obj") return inspectMesh(path, nonbloppy::readMesh(path), json);
     // Both formats hold either particles or polygons: a file that declares polygons is a
@@ -585,17 +595,7 @@ int runInspect(const std::string& path, bool json)
     if ((ext == ".ply" || ext == ".vtk") && nonbloppy::declaresPolygons(path)) {
         return inspectMesh(path, nonbloppy::readMesh(path), json);
     }
-    if (nonbloppy::isParticleFile(path)) {
-        return inspectParticles(path, nonbloppy::readParticles(path), json);
-    }
-    // A format nonbloppy cannot read: exit 2, as for mesh and convert. Houdini's own caches:
-    // readParticles() refuses them saying which name to export instead.
-    if (ext == ".sc" || ext == ".gz" || ext == ".geo" || ext == ".hclassic") {
-        requireAsUsage([&] { nonbloppy::readParticles(path); });
-    }
-    throw UsageError("unknown file extension '" + ext + "' (" + path
-                               + "); expected .vdb, .obj, .ply, .vtk, .vtu, .vtp, .xyz, .bgeo, "
-                                 ".csv, .txt or .json");
+    return inspectParticles(path, nonbloppy::readParticles(path), json);
 }
 
 } // namespace

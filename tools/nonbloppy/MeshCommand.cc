@@ -1025,13 +1025,15 @@ int runSequence(const MeshOptions& o)
 
     FramePlan plan;
     try {
+        // An input format nonbloppy cannot read (exit 2) whether or not a frame exists.
+        if (!nonbloppy::isParticleFile(o.input)) requireAsUsage([&] { nonbloppy::readParticles(o.input); });
         plan = planFrames(input, requested);
         if (plan.frames.empty()) {
             throw nonbloppy::FileError(requested ? "none of the frames " + formatFrameList(*requested) + " of " +
                                                        o.input + " exist"
                                                  : "no file matches " + o.input);
         }
-    } catch (const nonbloppy::FileError& e) {
+    } catch (const nonbloppy::Error& e) {  // FileError, or UsageError for the format
         logEarlyFailure(o, input, e.what());
         throw;
     }

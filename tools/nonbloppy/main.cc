@@ -289,9 +289,9 @@ int finishStandardOutput(int status, const StdoutKeepingFirstError& output)
     // error flag. A closed descriptor and a pipe without a reader (POLLERR) can still be
     // told; other causes cannot.
     if (error == 0) {
-        pollfd output{STDOUT_FILENO, 0, 0};
+        pollfd descriptor{STDOUT_FILENO, 0, 0};
         if (::fcntl(STDOUT_FILENO, F_GETFD) == -1) error = errno;
-        else if (::poll(&output, 1, 0) == 1 && (output.revents & POLLERR)) error = EPIPE;
+        else if (::poll(&descriptor, 1, 0) == 1 && (descriptor.revents & POLLERR)) error = EPIPE;
     }
     if (error == EPIPE) return status;
     return fail(std::string("cannot write standard output") + (error ? std::string(": ") + std::strerror(error) : ""),
