@@ -627,16 +627,8 @@ ParticleSet
 readParticles(const std::string& path)
 {
     using namespace io_internal;
+    requireParticleFile(path);
     const std::string ext = readerExtension(path);
-    if (ext.empty()) {
-        throw FileError("particle file name has no extension (" + path +
-            "); expected " + kParticleExtensions);
-    }
-    if (!isParticleFile(path)) {
-        const std::string advice = houdiniAdvice(path);
-        throw FileError("unknown particle file extension '" + ext + "' (" + path + ")" +
-            (advice.empty() ? std::string("; expected ") + kParticleExtensions : advice));
-    }
 
     ParticleSet particles;
     // The readers refuse before allocating what a file's header or size announces beyond the
@@ -667,6 +659,22 @@ isParticleFile(const std::string& path)
     const std::string ext = readerExtension(path);
     return ext == ".vtk" || ext == ".ply" || ext == ".xyz" || ext == ".bgeo" || ext == ".vtu"
         || ext == ".vtp" || ext == ".csv" || ext == ".txt" || ext == ".json" || ext == ".vdb";
+}
+
+void
+requireParticleFile(const std::string& path)
+{
+    using namespace io_internal;
+    const std::string ext = readerExtension(path);
+    if (ext.empty()) {
+        throw FileError("particle file name has no extension (" + path +
+            "); expected " + kParticleExtensions);
+    }
+    if (!isParticleFile(path)) {
+        const std::string advice = houdiniAdvice(path);
+        throw FileError("unknown particle file extension '" + ext + "' (" + path + ")" +
+            (advice.empty() ? std::string("; expected ") + kParticleExtensions : advice));
+    }
 }
 
 } // namespace nonbloppy

@@ -504,6 +504,24 @@ TEST_F(ReadParticlesTest, MissingFileAndUnknownExtension)
     const std::string directory = path("dir.vtk");
     ASSERT_EQ(mkdir(directory.c_str(), 0755), 0);
     EXPECT_EQ(fileErrorOf(directory), "cannot read " + directory + ": Is a directory");
+
+    // requireParticleFile() refuses the same names with the same words, by the name alone
+    // (none of these files exists), and lets every name readParticles() takes through.
+    for (const std::string name : {"particles.foo", "particles", "cache.bgeo.sc", "cache.geo"}) {
+        SCOPED_TRACE(name);
+        std::string message;
+        try {
+            nonbloppy::requireParticleFile(path(name));
+        } catch (const FileError& e) {
+            message = e.what();
+        }
+        EXPECT_EQ(message, fileErrorOf(path(name)));
+        EXPECT_FALSE(message.empty());
+    }
+    for (const std::string name : {"a.vtk", "a.VTU", "a.vtp", "a.ply", "a.xyz", "a.bgeo", "a.bgeo.gz", "a.bhclassic",
+                                   "a.bhclassic.gz", "a.vdb", "a.csv", "a.txt", "a.json"}) {
+        EXPECT_NO_THROW(nonbloppy::requireParticleFile(path(name))) << name;
+    }
 }
 
 TEST_F(ReadParticlesTest, TruncatedRealFilesNameTheSection)

@@ -84,6 +84,14 @@ NONBLOPPY_API ParticleSet readParticles(const std::string& path);
 /// and `.bhclassic.gz` included).
 NONBLOPPY_API bool isParticleFile(const std::string& path);
 
+/// Refuses @a path as readParticles() would, by its extension alone, before any file is
+/// opened (so a caller can check a name given on a command line, or a frame pattern).
+/// Cost: O(length of @a path).
+/// @throw FileError "particle file name has no extension (x); expected .vtk, ...", or
+///        "unknown particle file extension '.foo' (x.foo); expected .vtk, ..."; for Houdini's
+///        JSON caches (`.bgeo.sc`, ...) the message says which name to export instead.
+NONBLOPPY_API void requireParticleFile(const std::string& path);
+
 } // namespace nonbloppy
 
 #endif // NONBLOPPY_READ_PARTICLES_H

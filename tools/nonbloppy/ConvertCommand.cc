@@ -40,7 +40,7 @@ int runConvert(const ConvertOptions& o)
     requireFileName(o.input, "IN");
     requireFileName(o.output, "OUT");  // not "particle file name has no extension ()"
     requireAsUsage([&] { nonbloppy::requireParticleOutputFile(o.output); });
-    if (!nonbloppy::isParticleFile(o.input)) requireAsUsage([&] { nonbloppy::readParticles(o.input); });
+    requireAsUsage([&] { nonbloppy::requireParticleFile(o.input); });
     std::error_code ec;
     if (o.input == o.output || std::filesystem::equivalent(o.input, o.output, ec)) {
         throw UsageError("cannot write " + o.output + ": it is the input file");

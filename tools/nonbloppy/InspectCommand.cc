@@ -563,12 +563,12 @@ int runInspect(const std::string& path, bool json)
 {
     requireFileName(path, "FILE");
     // A format nonbloppy cannot read: exit 2, as for mesh and convert, told from the name
-    // alone (before a missing file or a FIFO is). Houdini's own caches: readParticles()
+    // alone (before a missing file or a FIFO is). Houdini's own caches: requireParticleFile()
     // refuses them saying which name to export instead.
     const std::string ext = lowerExtension(path);
     if (ext != ".vdb" && ext != ".obj" && !nonbloppy::isParticleFile(path)) {
         if (ext == ".sc" || ext == ".gz" || ext == ".geo" || ext == ".hclassic") {
-            requireAsUsage([&] { nonbloppy::readParticles(path); });
+            requireAsUsage([&] { nonbloppy::requireParticleFile(path); });
         }
         throw UsageError("unknown file extension '" + ext + "' (" + path
                          + "); expected .vdb, .obj, .ply, .vtk, .vtu, .vtp, .xyz, .bgeo, .csv, .txt or .json");

@@ -403,9 +403,9 @@ void validatePaths(const MeshOptions& o)
     // writeMesh()'s own check, which would say the same after all the work.
     requireAsUsage([&] { nonbloppy::requireMeshFile(o.output); });
     // An input format nonbloppy cannot read, like an unknown output format, is a command line
-    // that cannot run whatever the file holds (exit 2); readParticles() says which, and what
-    // to export instead for Houdini's other caches, before it opens the file.
-    if (!nonbloppy::isParticleFile(o.input)) requireAsUsage([&] { nonbloppy::readParticles(o.input); });
+    // that cannot run whatever the file holds (exit 2), told with what to export instead
+    // for Houdini's other caches.
+    requireAsUsage([&] { nonbloppy::requireParticleFile(o.input); });
     if (!o.vdbPath.empty() && lowerExtension(o.vdbPath) != ".vdb") {
         throw UsageError("--vdb file name must end in .vdb (" + o.vdbPath + ")");
     }
@@ -1026,7 +1026,7 @@ int runSequence(const MeshOptions& o)
     FramePlan plan;
     try {
         // An input format nonbloppy cannot read (exit 2) whether or not a frame exists.
-        if (!nonbloppy::isParticleFile(o.input)) requireAsUsage([&] { nonbloppy::readParticles(o.input); });
+        requireAsUsage([&] { nonbloppy::requireParticleFile(o.input); });
         plan = planFrames(input, requested);
         if (plan.frames.empty()) {
             throw nonbloppy::FileError(requested ? "none of the frames " + formatFrameList(*requested) + " of " +
