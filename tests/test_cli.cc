@@ -574,8 +574,8 @@ TEST_F(CliTest, UnknownInputExtension)
     writeText(path, "1 2 3\n");
     // A format nonbloppy cannot read is a command line that cannot run (exit 2), as an unknown
     // output format is; it used to exit 1, telling scripts the file was at fault.
-    const std::string message = "unknown particle file extension '.foo' (" + path
-                                + "); expected .vtk, .vtu, .vtp, .ply, .xyz, .bgeo, .vdb, .csv, .txt or .json";
+    const std::string expected = "; expected .vtk, .vtu, .vtp, .ply, .xyz, .bgeo, .vdb, .csv, .txt or .json";
+    const std::string message = "unknown particle file extension '.foo' (" + path + ")" + expected;
     expectFailure("mesh " + quote(path) + " -o " + quote(out("x.obj")), message, 2);
     expectFailure("convert " + quote(path) + " " + quote(out("x.ply")), message, 2);
     // Told from the name alone: also for a file that is missing, and for a sequence with no
@@ -585,8 +585,7 @@ TEST_F(CliTest, UnknownInputExtension)
                       + "); expected .vdb, .obj, .ply, .vtk, .vtu, .vtp, .xyz, .bgeo, .csv, .txt or .json", 2);
     const std::string pattern = in("fluid_{}.foo");
     expectFailure("mesh " + quote(pattern) + " -o " + quote(out("m_{}.obj")),
-                  "unknown particle file extension '.foo' (" + pattern
-                      + "); expected .vtk, .vtu, .vtp, .ply, .xyz, .bgeo, .vdb, .csv, .txt or .json", 2);
+                  "unknown particle file extension '.foo' (" + pattern + ")" + expected, 2);
     const std::string houdini = in("particles.bgeo.sc");
     writeText(houdini, "1 2 3\n");
     const RunResult r = run("inspect " + quote(houdini));
