@@ -142,19 +142,30 @@ private:
 /// For each polygon i, every polygon j sharing a vertex with it (i itself included), once,
 /// in ascending order, with the part of the normal filter's weight that stays the same from
 /// round to round: area_j · (number of vertices shared) · exp(−|c_i − c_j|²/2σ_c²).
-/// Polygon i's are polygon[start[i] .. start[i + 1]).
+/// The lists are stored for the normal rounds' vector lanes: the polygons of group g (from
+/// g · lanes, one per lane) have their k-th neighbours side by side, in entries
+/// groupStart[g] + k · lanes + lane, for k up to the group's longest list; a shorter list's
+/// entries past its count are padding (the polygon itself, weight 0), which no round adds.
+/// A vector copy then loads each step's neighbours and weights with one contiguous load
+/// each instead of two gathers. With one lane this is a plain list per polygon.
 struct PolygonNeighbours
 {
-    std::vector<uint64_t> start;
+    size_t lanes = 1;
+    std::vector<uint32_t> count;        ///< neighbours of each polygon (padded to whole groups with zeros)
+    std::vector<uint64_t> groupStart;   ///< per group, and the total at the end
     UnwrittenVector<uint32_t> polygon;
     UnwrittenVector<float> weight;
+
+    /// Entry of polygon @a n's @a k-th neighbour.
+    uint64_t entry(size_t n, uint32_t k) const { return groupStart[n / lanes] + uint64_t(k) * lanes + n % lanes; }
 };
 
 PolygonNeighbours polygonNeighbours(const Polygons& polygons, const VertexPolygons& around,
                                     const UnwrittenVector<Vec3s>& centroid, const UnwrittenVector<float>& area,
-                                    float spatialScale, CancelPoll& poll)
+                                    float spatialScale, size_t lanes, CancelPoll& poll)
 {
     const size_t polygonCount = polygons.size();
+    const size_t groupCount = (polygonCount + lanes - 1) / lanes;
     // The polygons around i's corners, merged in ascending order: a polygon sharing k
     // vertices with i appears k times in a row. Calls @a visit(j, k) for each.
     auto forEachNeighbour = [&](size_t i, CornerListMerger& merger, auto&& visit) {
@@ -168,33 +179,48 @@ PolygonNeighbours polygonNeighbours(const Polygons& polygons, const VertexPolygo
         }
     };
     PolygonNeighbours out;
-    out.start.assign(polygonCount + 1, 0);
+    out.lanes = lanes;
+    out.count.assign(groupCount * lanes, 0);
+    out.groupStart.assign(groupCount + 1, 0);
     tbb::parallel_for(tbb::blocked_range<size_t>(0, polygonCount),
         [&](const tbb::blocked_range<size_t>& range) {
             CornerListMerger merger;
             for (size_t i = range.begin(); i < range.end(); ++i) {
                 if (poll.stoppedAt(i - range.begin())) return;
-                uint64_t count = 0;
+                uint32_t count = 0;
                 forEachNeighbour(i, merger, [&](uint32_t, float) { ++count; });
-                out.start[i + 1] = count;
+                out.count[i] = count;
             }
         });
     poll.throwIfStopped();
-    for (size_t i = 0; i < polygonCount; ++i) out.start[i + 1] += out.start[i];
-    requireMemoryForSmoothing(double(out.start.back()) * double(sizeof(uint32_t) + sizeof(float)), polygonCount);
-    out.polygon.resize(out.start.back());
-    out.weight.resize(out.start.back());
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, polygonCount),
+    for (size_t g = 0; g < groupCount; ++g) {
+        const uint32_t* counts = out.count.data() + g * lanes;
+        out.groupStart[g + 1] = out.groupStart[g] + uint64_t(*std::max_element(counts, counts + lanes)) * lanes;
+    }
+    requireMemoryForSmoothing(double(out.groupStart.back()) * double(sizeof(uint32_t) + sizeof(float)), polygonCount);
+    out.polygon.resize(out.groupStart.back());
+    out.weight.resize(out.groupStart.back());
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, groupCount),
         [&](const tbb::blocked_range<size_t>& range) {
             CornerListMerger merger;
-            for (size_t i = range.begin(); i < range.end(); ++i) {
-                if (poll.stoppedAt(i - range.begin())) return;
-                uint64_t e = out.start[i];
-                forEachNeighbour(i, merger, [&](uint32_t j, float shared) {
-                    out.polygon[e] = j;
-                    out.weight[e] = area[j] * shared * std::exp(-spatialScale * (centroid[j] - centroid[i]).lengthSqr());
-                    ++e;
-                });
+            for (size_t g = range.begin(); g < range.end(); ++g) {
+                if (poll.stoppedAt((g - range.begin()) * lanes)) return;
+                const uint64_t longest = (out.groupStart[g + 1] - out.groupStart[g]) / lanes;
+                for (size_t i = g * lanes; i < (g + 1) * lanes; ++i) {
+                    uint64_t k = 0;
+                    if (i < polygonCount) {
+                        forEachNeighbour(i, merger, [&](uint32_t j, float shared) {
+                            const uint64_t e = out.entry(i, uint32_t(k++));
+                            out.polygon[e] = j;
+                            out.weight[e] = area[j] * shared * std::exp(-spatialScale * (centroid[j] - centroid[i]).lengthSqr());
+                        });
+                    }
+                    for (; k < longest; ++k) {
+                        const uint64_t e = out.entry(i, uint32_t(k));
+                        out.polygon[e] = uint32_t(std::min(i, polygonCount - 1));
+                        out.weight[e] = 0.0f;
+                    }
+                }
             }
         });
     poll.throwIfStopped();
@@ -229,8 +255,9 @@ void measurePolygons(const Polygons& polygons, const std::vector<Vec3s>& points,
 }
 
 /// One normal round: every polygon's filtered normal from the previous round's normals
-/// (see smoothSurface()). The same operations in the same order for every polygon, so the
-/// bits do not depend on the threads, the ranges, or which copy of the loop runs.
+/// (see smoothSurface()), over ranges of the neighbour lists' groups (PolygonNeighbours).
+/// The same operations in the same order for every polygon, so the bits do not depend on
+/// the threads, the ranges, or which copy of the loop runs.
 struct NormalRoundOp
 {
     const PolygonNeighbours& neighbours;
@@ -238,18 +265,19 @@ struct NormalRoundOp
     UnwrittenVector<Vec3s>& filtered;
     float normalScale;
     CancelPoll& poll;
-    bool avx512;  ///< run the AVX-512F copy of the loop (InstructionSet.h)
-    bool avx2;    ///< else the AVX2 copy
+    bool avx512;  ///< run the AVX-512F copy of the loop (InstructionSet.h); lanes == 16
+    bool avx2;    ///< else the AVX2 copy; lanes == 8
 
-    void operator()(const tbb::blocked_range<size_t>& range) const
+    void operator()(const tbb::blocked_range<size_t>& groups) const
     {
 #if NONBLOPPY_HAS_AVX2_COPY
-        if (avx512) { filterAvx512(range); return; }
-        if (avx2) { filterAvx2(range); return; }
+        if (avx512) { filterAvx512(groups); return; }
+        if (avx2) { filterAvx2(groups); return; }
 #endif
-        for (size_t n = range.begin(); n < range.end(); ++n) {
-            if (poll.stoppedAt(n - range.begin())) return;
-            filterOne(n);
+        const size_t lanes = neighbours.lanes;
+        for (size_t g = groups.begin(); g < groups.end(); ++g) {
+            if (poll.stoppedAt((g - groups.begin()) * lanes)) return;
+            for (size_t n = g * lanes; n < std::min((g + 1) * lanes, normal.size()); ++n) filterOne(n);
         }
     }
 
@@ -257,7 +285,10 @@ struct NormalRoundOp
     {
         const Vec3s own = normal[n];
         float x = 0.0f, y = 0.0f, z = 0.0f;
-        for (uint64_t e = neighbours.start[n]; e < neighbours.start[n + 1]; ++e) {
+        const size_t lanes = neighbours.lanes;
+        const uint64_t first = neighbours.entry(n, 0);
+        for (uint32_t k = 0; k < neighbours.count[n]; ++k) {
+            const uint64_t e = first + uint64_t(k) * lanes;
             const Vec3s other = normal[neighbours.polygon[e]];
             const float dx = other[0] - own[0], dy = other[1] - own[1], dz = other[2] - own[2];
             const float w = neighbours.weight[e] * exp_internal::expNonPositive(-normalScale * (dx * dx + dy * dy + dz * dz));
@@ -270,41 +301,36 @@ struct NormalRoundOp
     }
 
 #if NONBLOPPY_HAS_AVX2_COPY
-    /// What a vector copy loads for @a Lanes polygons from n, one per lane: where each one's
-    /// neighbour list starts (from the first's, which gathers take as 32-bit offsets), its
-    /// length, the longest, and each polygon's own normal.
+    /// What a vector copy loads for the @a Lanes polygons of group @a g, one per lane: their
+    /// neighbour counts, the longest, and each polygon's own normal. Lanes past the last
+    /// polygon have no neighbours.
     template<int Lanes>
     struct LaneGroup
     {
-        alignas(64) int32_t offset[Lanes];
         alignas(64) int32_t count[Lanes];
         alignas(64) float ownX[Lanes];
         alignas(64) float ownY[Lanes];
         alignas(64) float ownZ[Lanes];
+        int lanes = Lanes;  ///< polygons in the group: fewer in the last one
         int32_t most = 0;
-        uint64_t first = 0;  ///< the first polygon's first entry
     };
 
-    /// Fill @a group for the polygons from @a n; false (nothing filled) when their lists
-    /// span more entries than 32-bit offsets reach.
     template<int Lanes>
-    __attribute__((always_inline)) inline bool loadGroup(size_t n, LaneGroup<Lanes>& group) const
+    __attribute__((always_inline)) inline void loadGroup(size_t g, LaneGroup<Lanes>& group) const
     {
-        group.first = neighbours.start[n];
-        if (neighbours.start[n + Lanes] - group.first > uint64_t(INT32_MAX)) return false;
-        group.most = 0;
+        const size_t n = g * Lanes;
+        group.lanes = int(std::min(size_t(Lanes), normal.size() - n));
+        group.most = int32_t((neighbours.groupStart[g + 1] - neighbours.groupStart[g]) / Lanes);
         for (int l = 0; l < Lanes; ++l) {
-            group.offset[l] = int32_t(neighbours.start[n + size_t(l)] - group.first);
-            group.count[l] = int32_t(neighbours.start[n + size_t(l) + 1] - neighbours.start[n + size_t(l)]);
-            group.most = std::max(group.most, group.count[l]);
-            group.ownX[l] = normal[n + size_t(l)][0];
-            group.ownY[l] = normal[n + size_t(l)][1];
-            group.ownZ[l] = normal[n + size_t(l)][2];
+            group.count[l] = int32_t(neighbours.count[n + size_t(l)]);  // zero past the last polygon
+            const Vec3s own = l < group.lanes ? normal[n + size_t(l)] : Vec3s(0.0f);
+            group.ownX[l] = own[0];
+            group.ownY[l] = own[1];
+            group.ownZ[l] = own[2];
         }
-        return true;
     }
 
-    /// The filtered normals of the @a lanes polygons from @a n, from their sums divided by
+    /// The filtered normals of the group's polygons from @a n, from their sums divided by
     /// their lengths (computed per lane as filterOne() does); a zero sum keeps the normal.
     void storeGroup(size_t n, int lanes, const float* unitX, const float* unitY, const float* unitZ,
                     const float* lengths) const
@@ -318,36 +344,38 @@ struct NormalRoundOp
     /// lane, so the same bits. The exponential's multiplies and adds dominate the AVX2 copy;
     /// sixteen lanes do twice as many per instruction. On the 64x benchmark input with
     /// `--spacing 0.0467157`, two threads, three alternating pairs against the AVX2 copy: the
-    /// smooth stage 3.15–3.17 → 2.82–2.86 s, the run 4.93–4.97 → 4.63–4.64 s.
-    NONBLOPPY_TARGET_AVX512 void filterAvx512(const tbb::blocked_range<size_t>& range) const
+    /// smooth stage 3.15–3.17 → 2.82–2.86 s, the run 4.93–4.97 → 4.63–4.64 s (Intel Xeon).
+    /// Each step's neighbours and weights come side by side from the lists (PolygonNeighbours)
+    /// where the lanes gathered them: on an AMD EPYC (Zen 4), whose gathers are slow, a normal
+    /// round 55 → 33 ms, the smooth stage 3.78–4.00 → 2.99–3.07 s, the run 5.53–5.94 → 4.81–4.97 s
+    /// (two alternating pairs, the same output bytes), peak RSS 569–571 → 579–582 MB.
+    NONBLOPPY_TARGET_AVX512 void filterAvx512(const tbb::blocked_range<size_t>& groups) const
     {
+        // Gathers take 32-bit offsets: a normal's three floats at 3·j.
         const bool gatherable = normal.size() <= size_t(INT32_MAX / 3);
         const uint32_t* polygonOf = neighbours.polygon.data();
         const float* weightOf = neighbours.weight.data();
         const float* normals = normal.empty() ? nullptr : normal[0].asPointer();
         const __m512 negativeScale = _mm512_set1_ps(-normalScale);
-        size_t n = range.begin();
-        for (; gatherable && n + 16 <= range.end(); n += 16) {
-            if (poll.stoppedAt(n - range.begin())) return;  // a multiple of 16
-            LaneGroup<16> group;
-            if (!loadGroup(n, group)) {
-                for (size_t m = n; m < n + 16; ++m) filterOne(m);
+        for (size_t g = groups.begin(); g < groups.end(); ++g) {
+            if (poll.stoppedAt((g - groups.begin()) * 16)) return;
+            const size_t n = g * 16;
+            if (!gatherable) {
+                for (size_t m = n; m < std::min(n + 16, normal.size()); ++m) filterOne(m);
                 continue;
             }
+            LaneGroup<16> group;
+            loadGroup(g, group);
             const __m512 ox = _mm512_load_ps(group.ownX), oy = _mm512_load_ps(group.ownY);
             const __m512 oz = _mm512_load_ps(group.ownZ);
-            const __m512i offsets = _mm512_load_si512(group.offset);
             const __m512i counts = _mm512_load_si512(group.count);
-            const int* polygonBase = reinterpret_cast<const int*>(polygonOf + group.first);
-            const float* weightBase = weightOf + group.first;
+            const uint32_t* polygonStep = polygonOf + neighbours.groupStart[g];
+            const float* weightStep = weightOf + neighbours.groupStart[g];
             __m512 x = _mm512_setzero_ps(), y = _mm512_setzero_ps(), z = _mm512_setzero_ps();
-            for (int32_t k = 0; k < group.most; ++k) {
-                const __m512i kk = _mm512_set1_epi32(k);
-                const __mmask16 active = _mm512_cmpgt_epi32_mask(counts, kk);  // k < count
-                const __m512i entry = _mm512_add_epi32(offsets, kk);
-                const __m512i other =
-                    _mm512_mask_i32gather_epi32(_mm512_setzero_si512(), active, entry, polygonBase, 4);
-                const __m512 base = _mm512_mask_i32gather_ps(_mm512_setzero_ps(), active, entry, weightBase, 4);
+            for (int32_t k = 0; k < group.most; ++k, polygonStep += 16, weightStep += 16) {
+                const __mmask16 active = _mm512_cmpgt_epi32_mask(counts, _mm512_set1_epi32(k));  // k < count
+                const __m512i other = _mm512_maskz_loadu_epi32(active, polygonStep);
+                const __m512 base = _mm512_maskz_loadu_ps(active, weightStep);
                 const __m512i at = _mm512_add_epi32(_mm512_add_epi32(other, other), other);  // 3·j
                 const __m512 nx = _mm512_mask_i32gather_ps(_mm512_setzero_ps(), active, at, normals, 4);
                 const __m512 ny = _mm512_mask_i32gather_ps(_mm512_setzero_ps(), active, at, normals + 1, 4);
@@ -369,17 +397,13 @@ struct NormalRoundOp
             _mm512_store_ps(unitY, _mm512_div_ps(y, length));
             _mm512_store_ps(unitZ, _mm512_div_ps(z, length));
             _mm512_store_ps(lengths, length);
-            storeGroup(n, 16, unitX, unitY, unitZ, lengths);
-        }
-        for (; n < range.end(); ++n) {
-            if (poll.stoppedAt(n - range.begin())) return;
-            filterOne(n);
+            storeGroup(n, group.lanes, unitX, unitY, unitZ, lengths);
         }
     }
 
-    /// Eight polygons at a time, a lane each, their neighbours gathered; polygons left over,
-    /// and groups whose neighbour lists lie too far apart for 32-bit offsets, one by one.
-    NONBLOPPY_TARGET_AVX2 void filterAvx2(const tbb::blocked_range<size_t>& range) const
+    /// Eight polygons at a time, a lane each: each step's neighbours and weights loaded side
+    /// by side, the neighbours' normals gathered.
+    NONBLOPPY_TARGET_AVX2 void filterAvx2(const tbb::blocked_range<size_t>& groups) const
     {
         // Gathers take 32-bit offsets: a normal's three floats at 3·j.
         const bool gatherable = normal.size() <= size_t(INT32_MAX / 3);
@@ -387,28 +411,27 @@ struct NormalRoundOp
         const float* weightOf = neighbours.weight.data();
         const float* normals = normal.empty() ? nullptr : normal[0].asPointer();
         const __m256 negativeScale = _mm256_set1_ps(-normalScale);
-        size_t n = range.begin();
-        for (; gatherable && n + 8 <= range.end(); n += 8) {
-            if (poll.stoppedAt(n - range.begin())) return;  // a multiple of 8
-            LaneGroup<8> group;
-            if (!loadGroup(n, group)) {
-                for (size_t m = n; m < n + 8; ++m) filterOne(m);
+        for (size_t g = groups.begin(); g < groups.end(); ++g) {
+            if (poll.stoppedAt((g - groups.begin()) * 8)) return;
+            const size_t n = g * 8;
+            if (!gatherable) {
+                for (size_t m = n; m < std::min(n + 8, normal.size()); ++m) filterOne(m);
                 continue;
             }
+            LaneGroup<8> group;
+            loadGroup(g, group);
             const __m256 ox = _mm256_load_ps(group.ownX), oy = _mm256_load_ps(group.ownY);
             const __m256 oz = _mm256_load_ps(group.ownZ);
-            const __m256i offsets = _mm256_load_si256(reinterpret_cast<const __m256i*>(group.offset));
             const __m256i counts = _mm256_load_si256(reinterpret_cast<const __m256i*>(group.count));
-            const int* polygonBase = reinterpret_cast<const int*>(polygonOf + group.first);
-            const float* weightBase = weightOf + group.first;
+            const uint32_t* polygonStep = polygonOf + neighbours.groupStart[g];
+            const float* weightStep = weightOf + neighbours.groupStart[g];
             __m256 x = _mm256_setzero_ps(), y = _mm256_setzero_ps(), z = _mm256_setzero_ps();
-            for (int32_t k = 0; k < group.most; ++k) {
-                const __m256i kk = _mm256_set1_epi32(k);
-                const __m256i activeBits = _mm256_cmpgt_epi32(counts, kk);  // k < count
+            for (int32_t k = 0; k < group.most; ++k, polygonStep += 8, weightStep += 8) {
+                const __m256i activeBits = _mm256_cmpgt_epi32(counts, _mm256_set1_epi32(k));  // k < count
                 const __m256 active = _mm256_castsi256_ps(activeBits);
-                const __m256i entry = _mm256_add_epi32(offsets, kk);
-                const __m256i other = _mm256_mask_i32gather_epi32(_mm256_setzero_si256(), polygonBase, entry, activeBits, 4);
-                const __m256 base = _mm256_mask_i32gather_ps(_mm256_setzero_ps(), weightBase, entry, active, 4);
+                // Padding entries are valid polygons with weight 0: loaded, never added.
+                const __m256i other = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(polygonStep));
+                const __m256 base = _mm256_and_ps(_mm256_loadu_ps(weightStep), active);
                 const __m256i at = _mm256_add_epi32(_mm256_add_epi32(other, other), other);  // 3·j
                 const __m256 nx = _mm256_mask_i32gather_ps(_mm256_setzero_ps(), normals, at, active, 4);
                 const __m256 ny = _mm256_mask_i32gather_ps(_mm256_setzero_ps(), normals + 1, at, active, 4);
@@ -429,11 +452,7 @@ struct NormalRoundOp
             _mm256_store_ps(unitY, _mm256_div_ps(y, length));
             _mm256_store_ps(unitZ, _mm256_div_ps(z, length));
             _mm256_store_ps(lengths, length);
-            storeGroup(n, 8, unitX, unitY, unitZ, lengths);
-        }
-        for (; n < range.end(); ++n) {
-            if (poll.stoppedAt(n - range.begin())) return;
-            filterOne(n);
+            storeGroup(n, group.lanes, unitX, unitY, unitZ, lengths);
         }
     }
 #endif
@@ -486,6 +505,7 @@ void surface_stages_internal::smoothSurfaceUnchecked(SurfaceMesh& mesh, const Sm
     CancelPoll poll(interrupter, "smooth surface");
     const bool avx512 = instruction_set_internal::useAvx512(set);
     const bool avx2 = instruction_set_internal::useAvx2(set);
+    const size_t lanes = avx512 ? 16 : avx2 ? 8 : 1;  // NormalRoundOp's copies
     const VertexPolygons around = vertexPolygons(polygons, mesh.points.size(), poll);
 
     UnwrittenVector<Vec3s> centroid(polygonCount), normal(polygonCount), filtered(polygonCount);
@@ -499,10 +519,10 @@ void surface_stages_internal::smoothSurfaceUnchecked(SurfaceMesh& mesh, const Sm
     const float normalScale = float(0.5 / (settings.normalWidth * settings.normalWidth));
     {
         const PolygonNeighbours neighbours =
-            polygonNeighbours(polygons, around, centroid, area, spatialScale, poll);
+            polygonNeighbours(polygons, around, centroid, area, spatialScale, lanes, poll);
         UnwrittenVector<float>().swap(area);
         for (int round = 0; round < settings.normalRounds; ++round) {
-            tbb::parallel_for(tbb::blocked_range<size_t>(0, polygonCount),
+            tbb::parallel_for(tbb::blocked_range<size_t>(0, neighbours.groupStart.size() - 1),
                               NormalRoundOp{neighbours, normal, filtered, normalScale, poll, avx512, avx2});
             poll.throwIfStopped();
             normal.swap(filtered);
