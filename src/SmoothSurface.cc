@@ -261,8 +261,11 @@ void measurePolygons(const Polygons& polygons, const std::vector<Vec3s>& points,
 struct NormalRoundOp
 {
     const PolygonNeighbours& neighbours;
+    /// The polygons' normals, and one more (zero) at the end: the AVX-512F copy loads 16
+    /// bytes from a normal's x, reading the next normal's x too.
     const UnwrittenVector<Vec3s>& normal;
-    UnwrittenVector<Vec3s>& filtered;
+    UnwrittenVector<Vec3s>& filtered;  ///< as normal
+    size_t polygonCount;
     float normalScale;
     CancelPoll& poll;
     bool avx512;  ///< run the AVX-512F copy of the loop (InstructionSet.h); lanes == 16
@@ -277,7 +280,7 @@ struct NormalRoundOp
         const size_t lanes = neighbours.lanes;
         for (size_t g = groups.begin(); g < groups.end(); ++g) {
             if (poll.stoppedAt((g - groups.begin()) * lanes)) return;
-            for (size_t n = g * lanes; n < std::min((g + 1) * lanes, normal.size()); ++n) filterOne(n);
+            for (size_t n = g * lanes; n < std::min((g + 1) * lanes, polygonCount); ++n) filterOne(n);
         }
     }
 
@@ -319,7 +322,7 @@ struct NormalRoundOp
     __attribute__((always_inline)) inline void loadGroup(size_t g, LaneGroup<Lanes>& group) const
     {
         const size_t n = g * Lanes;
-        group.lanes = int(std::min(size_t(Lanes), normal.size() - n));
+        group.lanes = int(std::min(size_t(Lanes), polygonCount - n));
         group.most = int32_t((neighbours.groupStart[g + 1] - neighbours.groupStart[g]) / Lanes);
         for (int l = 0; l < Lanes; ++l) {
             group.count[l] = int32_t(neighbours.count[n + size_t(l)]);  // zero past the last polygon
@@ -340,6 +343,17 @@ struct NormalRoundOp
         }
     }
 
+    /// The normals (x, y, z and one float more) of the polygons @a j[0], j[4], j[8] and j[12],
+    /// a quarter of the register each.
+    NONBLOPPY_TARGET_AVX512 static __attribute__((always_inline)) inline __m512 fourNormals(const float* normals,
+                                                                                            const uint32_t* j)
+    {
+        __m512 r = _mm512_castps128_ps512(_mm_loadu_ps(normals + 3 * size_t(j[0])));
+        r = _mm512_insertf32x4(r, _mm_loadu_ps(normals + 3 * size_t(j[4])), 1);
+        r = _mm512_insertf32x4(r, _mm_loadu_ps(normals + 3 * size_t(j[8])), 2);
+        return _mm512_insertf32x4(r, _mm_loadu_ps(normals + 3 * size_t(j[12])), 3);
+    }
+
     /// filterAvx2() with sixteen polygons at a time (AVX-512F): the same operations in each
     /// lane, so the same bits. The exponential's multiplies and adds dominate the AVX2 copy;
     /// sixteen lanes do twice as many per instruction. On the 64x benchmark input with
@@ -348,22 +362,20 @@ struct NormalRoundOp
     /// Each step's neighbours and weights come side by side from the lists (PolygonNeighbours)
     /// where the lanes gathered them: on an AMD EPYC (Zen 4), whose gathers are slow, a normal
     /// round 55 → 33 ms, the smooth stage 3.78–4.00 → 2.99–3.07 s, the run 5.53–5.94 → 4.81–4.97 s
-    /// (two alternating pairs, the same output bytes), peak RSS 569–571 → 579–582 MB.
+    /// (two alternating pairs, the same output bytes), peak RSS 569–571 → 579–582 MB. The
+    /// neighbours' normals loaded and transposed instead of gathered: smooth stage 2.88–2.89 →
+    /// 2.49–2.52 s, the run 4.61–4.73 → 4.27–4.36 s (three pairs); the AVX2 copy's normal
+    /// rounds and setup 1.84 → 1.47–1.52 s on the same machine.
     NONBLOPPY_TARGET_AVX512 void filterAvx512(const tbb::blocked_range<size_t>& groups) const
     {
         // Gathers take 32-bit offsets: a normal's three floats at 3·j.
-        const bool gatherable = normal.size() <= size_t(INT32_MAX / 3);
         const uint32_t* polygonOf = neighbours.polygon.data();
         const float* weightOf = neighbours.weight.data();
-        const float* normals = normal.empty() ? nullptr : normal[0].asPointer();
+        const float* normals = normal[0].asPointer();
         const __m512 negativeScale = _mm512_set1_ps(-normalScale);
         for (size_t g = groups.begin(); g < groups.end(); ++g) {
             if (poll.stoppedAt((g - groups.begin()) * 16)) return;
             const size_t n = g * 16;
-            if (!gatherable) {
-                for (size_t m = n; m < std::min(n + 16, normal.size()); ++m) filterOne(m);
-                continue;
-            }
             LaneGroup<16> group;
             loadGroup(g, group);
             const __m512 ox = _mm512_load_ps(group.ownX), oy = _mm512_load_ps(group.ownY);
@@ -374,12 +386,19 @@ struct NormalRoundOp
             __m512 x = _mm512_setzero_ps(), y = _mm512_setzero_ps(), z = _mm512_setzero_ps();
             for (int32_t k = 0; k < group.most; ++k, polygonStep += 16, weightStep += 16) {
                 const __mmask16 active = _mm512_cmpgt_epi32_mask(counts, _mm512_set1_epi32(k));  // k < count
-                const __m512i other = _mm512_maskz_loadu_epi32(active, polygonStep);
                 const __m512 base = _mm512_maskz_loadu_ps(active, weightStep);
-                const __m512i at = _mm512_add_epi32(_mm512_add_epi32(other, other), other);  // 3·j
-                const __m512 nx = _mm512_mask_i32gather_ps(_mm512_setzero_ps(), active, at, normals, 4);
-                const __m512 ny = _mm512_mask_i32gather_ps(_mm512_setzero_ps(), active, at, normals + 1, 4);
-                const __m512 nz = _mm512_mask_i32gather_ps(_mm512_setzero_ps(), active, at, normals + 2, 4);
+                // The neighbours' normals: one 16-byte load each (padding entries name real
+                // polygons), four to a register, transposed into x, y and z lanes. Gathers,
+                // slow on AMD's Zen 4, took 40% longer. (maskz forms: see expNonPositiveAvx512().)
+                const __m512 r0 = fourNormals(normals, polygonStep), r1 = fourNormals(normals, polygonStep + 1);
+                const __m512 r2 = fourNormals(normals, polygonStep + 2), r3 = fourNormals(normals, polygonStep + 3);
+                const __m512d xy01 = _mm512_castps_pd(_mm512_maskz_unpacklo_ps(0xFFFF, r0, r1));  // x0 x1 y0 y1 a quarter
+                const __m512d xy23 = _mm512_castps_pd(_mm512_maskz_unpacklo_ps(0xFFFF, r2, r3));
+                const __m512d zw01 = _mm512_castps_pd(_mm512_maskz_unpackhi_ps(0xFFFF, r0, r1));  // z0 z1 . . a quarter
+                const __m512d zw23 = _mm512_castps_pd(_mm512_maskz_unpackhi_ps(0xFFFF, r2, r3));
+                const __m512 nx = _mm512_castpd_ps(_mm512_maskz_unpacklo_pd(0xFF, xy01, xy23));
+                const __m512 ny = _mm512_castpd_ps(_mm512_maskz_unpackhi_pd(0xFF, xy01, xy23));
+                const __m512 nz = _mm512_castpd_ps(_mm512_maskz_unpacklo_pd(0xFF, zw01, zw23));
                 const __m512 dx = _mm512_sub_ps(nx, ox), dy = _mm512_sub_ps(ny, oy), dz = _mm512_sub_ps(nz, oz);
                 const __m512 d2 = _mm512_add_ps(_mm512_add_ps(_mm512_mul_ps(dx, dx), _mm512_mul_ps(dy, dy)),
                                                 _mm512_mul_ps(dz, dz));
@@ -401,23 +420,26 @@ struct NormalRoundOp
         }
     }
 
+    /// The normals (x, y, z and one float more) of the polygons @a j[0] and j[4], a half of
+    /// the register each.
+    NONBLOPPY_TARGET_AVX2 static __attribute__((always_inline)) inline __m256 twoNormals(const float* normals,
+                                                                                         const uint32_t* j)
+    {
+        return _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps(normals + 3 * size_t(j[0]))),
+                                    _mm_loadu_ps(normals + 3 * size_t(j[4])), 1);
+    }
+
     /// Eight polygons at a time, a lane each: each step's neighbours and weights loaded side
-    /// by side, the neighbours' normals gathered.
+    /// by side, and the neighbours' normals.
     NONBLOPPY_TARGET_AVX2 void filterAvx2(const tbb::blocked_range<size_t>& groups) const
     {
-        // Gathers take 32-bit offsets: a normal's three floats at 3·j.
-        const bool gatherable = normal.size() <= size_t(INT32_MAX / 3);
         const uint32_t* polygonOf = neighbours.polygon.data();
         const float* weightOf = neighbours.weight.data();
-        const float* normals = normal.empty() ? nullptr : normal[0].asPointer();
+        const float* normals = normal[0].asPointer();
         const __m256 negativeScale = _mm256_set1_ps(-normalScale);
         for (size_t g = groups.begin(); g < groups.end(); ++g) {
             if (poll.stoppedAt((g - groups.begin()) * 8)) return;
             const size_t n = g * 8;
-            if (!gatherable) {
-                for (size_t m = n; m < std::min(n + 8, normal.size()); ++m) filterOne(m);
-                continue;
-            }
             LaneGroup<8> group;
             loadGroup(g, group);
             const __m256 ox = _mm256_load_ps(group.ownX), oy = _mm256_load_ps(group.ownY);
@@ -429,13 +451,17 @@ struct NormalRoundOp
             for (int32_t k = 0; k < group.most; ++k, polygonStep += 8, weightStep += 8) {
                 const __m256i activeBits = _mm256_cmpgt_epi32(counts, _mm256_set1_epi32(k));  // k < count
                 const __m256 active = _mm256_castsi256_ps(activeBits);
-                // Padding entries are valid polygons with weight 0: loaded, never added.
-                const __m256i other = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(polygonStep));
                 const __m256 base = _mm256_and_ps(_mm256_loadu_ps(weightStep), active);
-                const __m256i at = _mm256_add_epi32(_mm256_add_epi32(other, other), other);  // 3·j
-                const __m256 nx = _mm256_mask_i32gather_ps(_mm256_setzero_ps(), normals, at, active, 4);
-                const __m256 ny = _mm256_mask_i32gather_ps(_mm256_setzero_ps(), normals + 1, at, active, 4);
-                const __m256 nz = _mm256_mask_i32gather_ps(_mm256_setzero_ps(), normals + 2, at, active, 4);
+                // The neighbours' normals as in filterAvx512(), two to a register.
+                const __m256 r0 = twoNormals(normals, polygonStep), r1 = twoNormals(normals, polygonStep + 1);
+                const __m256 r2 = twoNormals(normals, polygonStep + 2), r3 = twoNormals(normals, polygonStep + 3);
+                const __m256d xy01 = _mm256_castps_pd(_mm256_unpacklo_ps(r0, r1));  // x0 x1 y0 y1 a half
+                const __m256d xy23 = _mm256_castps_pd(_mm256_unpacklo_ps(r2, r3));
+                const __m256d zw01 = _mm256_castps_pd(_mm256_unpackhi_ps(r0, r1));  // z0 z1 . . a half
+                const __m256d zw23 = _mm256_castps_pd(_mm256_unpackhi_ps(r2, r3));
+                const __m256 nx = _mm256_castpd_ps(_mm256_unpacklo_pd(xy01, xy23));
+                const __m256 ny = _mm256_castpd_ps(_mm256_unpackhi_pd(xy01, xy23));
+                const __m256 nz = _mm256_castpd_ps(_mm256_unpacklo_pd(zw01, zw23));
                 const __m256 dx = _mm256_sub_ps(nx, ox), dy = _mm256_sub_ps(ny, oy), dz = _mm256_sub_ps(nz, oz);
                 const __m256 d2 = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(dx, dx), _mm256_mul_ps(dy, dy)),
                                                 _mm256_mul_ps(dz, dz));
@@ -508,7 +534,8 @@ void surface_stages_internal::smoothSurfaceUnchecked(SurfaceMesh& mesh, const Sm
     const size_t lanes = avx512 ? 16 : avx2 ? 8 : 1;  // NormalRoundOp's copies
     const VertexPolygons around = vertexPolygons(polygons, mesh.points.size(), poll);
 
-    UnwrittenVector<Vec3s> centroid(polygonCount), normal(polygonCount), filtered(polygonCount);
+    UnwrittenVector<Vec3s> centroid(polygonCount), normal(polygonCount + 1), filtered(polygonCount + 1);
+    normal[polygonCount] = filtered[polygonCount] = Vec3s(0.0f);  // read, never used (NormalRoundOp)
     UnwrittenVector<float> area(polygonCount);
     measurePolygons(polygons, mesh.points, centroid, area, normal, poll);
 
@@ -523,7 +550,7 @@ void surface_stages_internal::smoothSurfaceUnchecked(SurfaceMesh& mesh, const Sm
         UnwrittenVector<float>().swap(area);
         for (int round = 0; round < settings.normalRounds; ++round) {
             tbb::parallel_for(tbb::blocked_range<size_t>(0, neighbours.groupStart.size() - 1),
-                              NormalRoundOp{neighbours, normal, filtered, normalScale, poll, avx512, avx2});
+                              NormalRoundOp{neighbours, normal, filtered, polygonCount, normalScale, poll, avx512, avx2});
             poll.throwIfStopped();
             normal.swap(filtered);
         }
