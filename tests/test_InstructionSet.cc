@@ -20,6 +20,7 @@
 #include <cstring>
 #include <limits>
 #include <string>
+#include <vector>
 
 using namespace nonbloppy;
 using namespace nonbloppy::instruction_set_internal;
@@ -128,6 +129,54 @@ TEST_F(SameBitsTest, SmoothSurfaceOfTheRelaxedFrame)
     size_t moved = 0;
     for (size_t i = 0; i < extracted.points.size(); ++i) moved += automatic.points[i] != extracted.points[i];
     EXPECT_GT(moved, extracted.points.size() / 2);
+}
+
+TEST(SameBitsSmallMeshes, SmoothSurfaceOfMeshesSmallerThanTheLanes)
+{
+    // The vector copies take 8 or 16 polygons, and 8 vertices, a step: meshes of fewer,
+    // groups cut short at the end, a vertex on 17 polygons beside ones on two, and a vertex
+    // on none (it stays where it is) must give the baseline's bits too. The arrays' last
+    // normal and plane are read 16 and 32 bytes at a time (past them: padding).
+    if (!useAvx2(InstructionSet::Auto)) GTEST_SKIP() << "no AVX2 here: only the baseline copy runs";
+    std::vector<SurfaceMesh> meshes(3);
+    meshes[0].points = {{0, 0, 0}, {1, 0, 0.1f}, {0, 1, 0.2f}};
+    meshes[0].triangles = {{0, 1, 2}};
+    meshes[1].points = {{0, 0, 0}, {1, 0, 0.1f}, {1, 1, 0}, {0, 1, 0.2f}, {5, 5, 5}};  // 4: on no polygon
+    meshes[1].quads = {{0, 1, 2, 3}};
+    // A fan of 17 triangles around vertex 0 on a bumpy disc, and a quad strip beside it.
+    SurfaceMesh& fan = meshes[2];
+    fan.points.push_back({0, 0, 0.3f});
+    for (int k = 0; k < 17; ++k) {
+        const float angle = 6.2831853f * float(k) / 17.0f;
+        fan.points.push_back({std::cos(angle), std::sin(angle), 0.05f * float(k % 3)});
+    }
+    for (uint32_t k = 0; k < 17; ++k) fan.triangles.push_back({0, 1 + k, 1 + (k + 1) % 17});
+    for (uint32_t k = 0; k < 5; ++k) {
+        const uint32_t first = uint32_t(fan.points.size());
+        fan.points.push_back({3.0f + float(k), 0, 0.1f * float(k % 2)});
+        fan.points.push_back({3.0f + float(k), 1, 0});
+        if (k > 0) fan.quads.push_back({first - 2, first, first + 1, first - 1});
+    }
+    fan.points.push_back({9, 9, 9});  // on no polygon
+    SmoothSettings settings;
+    settings.spatialWidth = 0.7;
+    for (size_t m = 0; m < meshes.size(); ++m) {
+        SCOPED_TRACE(m);
+        SurfaceMesh automatic = meshes[m], avx2 = meshes[m], baseline = meshes[m];
+        smoothSurface(automatic, settings, nullptr, InstructionSet::Auto);
+        smoothSurface(avx2, settings, nullptr, InstructionSet::Avx2);
+        smoothSurface(baseline, settings, nullptr, InstructionSet::Baseline);
+        const size_t bytes = baseline.points.size() * sizeof(openvdb::Vec3s);
+        EXPECT_EQ(std::memcmp(automatic.points.data(), baseline.points.data(), bytes), 0);
+        EXPECT_EQ(std::memcmp(avx2.points.data(), baseline.points.data(), bytes), 0);
+        if (m > 0) EXPECT_EQ(automatic.points.back(), meshes[m].points.back());  // on no polygon
+    }
+    // The fan moved: its bumps are flattened towards their faces' filtered planes.
+    SurfaceMesh smoothed = meshes[2];
+    smoothSurface(smoothed, settings, nullptr, InstructionSet::Baseline);
+    size_t moved = 0;
+    for (size_t i = 0; i < 18; ++i) moved += smoothed.points[i] != meshes[2].points[i];
+    EXPECT_GT(moved, 9u);
 }
 
 #if NONBLOPPY_HAS_AVX2_COPY
