@@ -139,25 +139,41 @@ private:
     std::vector<uint32_t> mFirst, mSecond, mResult;
 };
 
-/// For each polygon i, every polygon j sharing a vertex with it (i itself included), once,
-/// in ascending order, with the part of the normal filter's weight that stays the same from
-/// round to round: area_j · (number of vertices shared) · exp(−|c_i − c_j|²/2σ_c²).
-/// The lists are stored for the normal rounds' vector lanes: the polygons of group g (from
-/// g · lanes, one per lane) have their k-th neighbours side by side, in entries
-/// groupStart[g] + k · lanes + lane, for k up to the group's longest list; a shorter list's
-/// entries past its count are padding (the polygon itself, weight 0), which no round adds.
-/// A vector copy then loads each step's neighbours and weights with one contiguous load
-/// each instead of two gathers. With one lane this is a plain list per polygon.
-struct PolygonNeighbours
+/// Lists of polygon numbers, one per item (a polygon's neighbours, a vertex's polygons),
+/// stored for the rounds' vector lanes: the items of group g (from g · lanes, one per lane)
+/// have their k-th entries side by side, in entry groupStart[g] + k · lanes + lane, for k up
+/// to the group's longest list; a shorter list's entries past its count are padding (a real
+/// polygon), which no round adds. A vector copy then loads a step's entries with one
+/// contiguous load instead of a gather. With one lane this is a plain list per item.
+struct LaneLists
 {
     size_t lanes = 1;
-    std::vector<uint32_t> count;        ///< neighbours of each polygon (padded to whole groups with zeros)
-    std::vector<uint64_t> groupStart;   ///< per group, and the total at the end
+    std::vector<uint32_t> count;       ///< entries of each item (padded to whole groups with zeros)
+    std::vector<uint64_t> groupStart;  ///< per group, and the total at the end
     UnwrittenVector<uint32_t> polygon;
-    UnwrittenVector<float> weight;
 
-    /// Entry of polygon @a n's @a k-th neighbour.
+    /// Entry of item @a n's @a k-th polygon.
     uint64_t entry(size_t n, uint32_t k) const { return groupStart[n / lanes] + uint64_t(k) * lanes + n % lanes; }
+
+    /// groupStart from count: each group as long as its longest list.
+    void startGroups()
+    {
+        const size_t groupCount = count.size() / lanes;
+        groupStart.assign(groupCount + 1, 0);
+        for (size_t g = 0; g < groupCount; ++g) {
+            const uint32_t* counts = count.data() + g * lanes;
+            groupStart[g + 1] = groupStart[g] + uint64_t(*std::max_element(counts, counts + lanes)) * lanes;
+        }
+    }
+};
+
+/// For each polygon i, every polygon j sharing a vertex with it (i itself included), once,
+/// in ascending order (LaneLists, padded with the polygon itself), with the part of the
+/// normal filter's weight that stays the same from round to round, in the same entries:
+/// area_j · (number of vertices shared) · exp(−|c_i − c_j|²/2σ_c²), 0 for padding.
+struct PolygonNeighbours : LaneLists
+{
+    UnwrittenVector<float> weight;
 };
 
 PolygonNeighbours polygonNeighbours(const Polygons& polygons, const VertexPolygons& around,
@@ -181,7 +197,6 @@ PolygonNeighbours polygonNeighbours(const Polygons& polygons, const VertexPolygo
     PolygonNeighbours out;
     out.lanes = lanes;
     out.count.assign(groupCount * lanes, 0);
-    out.groupStart.assign(groupCount + 1, 0);
     tbb::parallel_for(tbb::blocked_range<size_t>(0, polygonCount),
         [&](const tbb::blocked_range<size_t>& range) {
             CornerListMerger merger;
@@ -193,10 +208,7 @@ PolygonNeighbours polygonNeighbours(const Polygons& polygons, const VertexPolygo
             }
         });
     poll.throwIfStopped();
-    for (size_t g = 0; g < groupCount; ++g) {
-        const uint32_t* counts = out.count.data() + g * lanes;
-        out.groupStart[g + 1] = out.groupStart[g] + uint64_t(*std::max_element(counts, counts + lanes)) * lanes;
-    }
+    out.startGroups();
     requireMemoryForSmoothing(double(out.groupStart.back()) * double(sizeof(uint32_t) + sizeof(float)), polygonCount);
     out.polygon.resize(out.groupStart.back());
     out.weight.resize(out.groupStart.back());
@@ -227,34 +239,17 @@ PolygonNeighbours polygonNeighbours(const Polygons& polygons, const VertexPolygo
     return out;
 }
 
-/// The polygons around each vertex (VertexPolygons' lists, in the same order), stored for
-/// the vertex rounds' vector lanes as PolygonNeighbours stores its lists: vertex v's k-th
-/// polygon in entry groupStart[v / lanes] + k · lanes + v % lanes, for k up to the group's
-/// longest list; entries past count[v] are padding (polygon 0), which no round adds.
-struct VertexLanes
-{
-    size_t lanes = 1;
-    std::vector<uint32_t> count;       ///< polygons around each vertex (padded to whole groups with zeros)
-    std::vector<uint64_t> groupStart;  ///< per group, and the total at the end
-    UnwrittenVector<uint32_t> polygon;
-
-    /// Entry of vertex @a v's @a k-th polygon.
-    uint64_t entry(size_t v, uint32_t k) const { return groupStart[v / lanes] + uint64_t(k) * lanes + v % lanes; }
-};
-
-VertexLanes vertexLanes(const VertexPolygons& around, size_t lanes, size_t polygonCount, CancelPoll& poll)
+/// The polygons around each vertex, VertexPolygons' lists in the same order as LaneLists
+/// (padded with polygon 0).
+LaneLists vertexLanes(const VertexPolygons& around, size_t lanes, size_t polygonCount, CancelPoll& poll)
 {
     const size_t vertexCount = around.start.size() - 1;
     const size_t groupCount = (vertexCount + lanes - 1) / lanes;
-    VertexLanes out;
+    LaneLists out;
     out.lanes = lanes;
     out.count.assign(groupCount * lanes, 0);
     for (size_t v = 0; v < vertexCount; ++v) out.count[v] = uint32_t(around.start[v + 1] - around.start[v]);
-    out.groupStart.assign(groupCount + 1, 0);
-    for (size_t g = 0; g < groupCount; ++g) {
-        const uint32_t* counts = out.count.data() + g * lanes;
-        out.groupStart[g + 1] = out.groupStart[g] + uint64_t(*std::max_element(counts, counts + lanes)) * lanes;
-    }
+    out.startGroups();
     requireMemoryForSmoothing(double(out.groupStart.back()) * double(sizeof(uint32_t)), polygonCount);
     out.polygon.resize(out.groupStart.back());
     tbb::parallel_for(tbb::blocked_range<size_t>(0, groupCount), [&](const tbb::blocked_range<size_t>& range) {
@@ -537,11 +532,11 @@ struct Plane
 };
 
 /// One vertex round: every vertex moved by the mean over its polygons of n (n · (c − v)),
-/// over ranges of VertexLanes' groups. Each lane does moveOne()'s operations in its order,
+/// over ranges of vertexLanes()' groups. Each lane does moveOne()'s operations in its order,
 /// so the bits do not depend on the threads or on the copy that runs.
 struct VertexRoundOp
 {
-    const VertexLanes& around;
+    const LaneLists& around;
     /// The polygons' planes, and one more at the end: the AVX-512F copy loads 32 bytes from
     /// a plane's start, reading 8 bytes of the next one.
     const UnwrittenVector<Plane>& planes;
@@ -819,7 +814,7 @@ void surface_stages_internal::smoothSurfaceUnchecked(SurfaceMesh& mesh, const Sm
     UnwrittenVector<Vec3s>().swap(normal);
     UnwrittenVector<Vec3s>().swap(filtered);
     UnwrittenVector<Vec3s>().swap(centroid);
-    const VertexLanes vertexLists = vertexLanes(around, avx512 || avx2 ? 8 : 1, polygonCount, poll);
+    const LaneLists vertexLists = vertexLanes(around, avx512 || avx2 ? 8 : 1, polygonCount, poll);
     around = VertexPolygons();  // its lists are in vertexLists now
     std::vector<Vec3s> next(mesh.points.size());
     for (int round = 0; round < settings.vertexRounds; ++round) {
