@@ -69,10 +69,10 @@ struct SmoothSettings
 /// AVX2, sixteen where it has AVX-512F), per vertex round one pass over the faces around each
 /// vertex. Parallel over faces and vertices. Scratch about 145 bytes per quad. On the 64x
 /// benchmark input's surface (2.39M vertices, 2.37M quads, `--spacing 0.0467157`, two
-/// threads) the defaults take 2.22–2.32 s on an AVX-512 AMD EPYC (Zen 4) VM: setup about
+/// threads) the defaults take 2.07–2.10 s on an AVX-512 AMD EPYC (Zen 4) VM: setup about
 /// 0.4 s, the 35 normal rounds about 23 ms each (55 ms when each lane gathered its
-/// neighbours' indices, weights and normals, 3.78–4.00 s in all), the 40 vertex rounds about
-/// 25 ms each (31 ms one vertex at a time). Deterministic: each element reads only
+/// neighbours' indices, weights and normals, 3.49–4.00 s in all), the 40 vertex rounds about
+/// 22 ms each (31 ms one vertex at a time). Deterministic: each element reads only
 /// the previous round, in a fixed order, so the result is the same bits for any thread count.
 /// @param mesh         vertices moved; polygon indices must be valid (see measureMesh())
 /// @param settings     the filter's widths and rounds; spatialWidth has no default

@@ -364,7 +364,7 @@ int main(int argc, char** argv)
        << "the 90° edges stay (row *− smoothing*: the ball goes from 1.4× to 2.3× closer than blobs, "
        << "the box from 1.5× to 2.3×). On by default with the volume correction, that is when the "
        << "spacing is given; without it the smoothing alone leaves box and slab no closer. Cost: it "
-       << "costs 0.6–1.3 times as much as the rest of the pipeline when it runs (about 9 exponentials per quad per round; README, Fidelity).\n"
+       << "costs 0.5–1.2 times as much as the rest of the pipeline when it runs (about 9 exponentials per quad per round; README, Fidelity).\n"
        << "- **step cap** (RelaxSettings::maxStep, s/2) and **fold repair** (repairFolds()): guards for "
        << "sparse, splashing particles and large blends. The fold repair also checks the volume correction "
           "and the smoothing, each against the surface it started from (on the dam-break frame at "
