@@ -456,7 +456,6 @@ struct NormalRoundOp
     /// rounds and setup 1.84 → 1.47–1.52 s on the same machine.
     NONBLOPPY_TARGET_AVX512 void filterAvx512(const tbb::blocked_range<size_t>& groups) const
     {
-        // Gathers take 32-bit offsets: a normal's three floats at 3·j.
         const uint32_t* polygonOf = neighbours.polygon.data();
         const float* weightOf = neighbours.weight.data();
         const float* normals = normal[0].asPointer();
