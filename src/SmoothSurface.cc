@@ -342,6 +342,17 @@ void measurePolygons(const Polygons& polygons, const std::vector<Vec3s>& points,
     poll.throwIfStopped();
 }
 
+/// Call @a fn(n) for the items (polygons, vertices) of a range of LaneLists' groups, one at a
+/// time: the plain copy of a round. Asks @a poll as often as the vector copies do.
+template<typename FnT>
+void forEachItemOf(const tbb::blocked_range<size_t>& groups, size_t lanes, size_t itemCount, CancelPoll& poll, FnT&& fn)
+{
+    for (size_t g = groups.begin(); g < groups.end(); ++g) {
+        if (poll.stoppedAt((g - groups.begin()) * lanes)) return;
+        for (size_t n = g * lanes; n < std::min((g + 1) * lanes, itemCount); ++n) fn(n);
+    }
+}
+
 /// One normal round: every polygon's filtered normal from the previous round's normals
 /// (see smoothSurface()), over ranges of the neighbour lists' groups (PolygonNeighbours).
 /// The same operations in the same order for every polygon, so the bits do not depend on
@@ -365,11 +376,7 @@ struct NormalRoundOp
         if (avx512) { filterAvx512(groups); return; }
         if (avx2) { filterAvx2(groups); return; }
 #endif
-        const size_t lanes = neighbours.lanes;
-        for (size_t g = groups.begin(); g < groups.end(); ++g) {
-            if (poll.stoppedAt((g - groups.begin()) * lanes)) return;
-            for (size_t n = g * lanes; n < std::min((g + 1) * lanes, polygonCount); ++n) filterOne(n);
-        }
+        forEachItemOf(groups, neighbours.lanes, polygonCount, poll, [&](size_t n) { filterOne(n); });
     }
 
     void filterOne(size_t n) const
@@ -599,11 +606,7 @@ struct VertexRoundOp
         if (avx512) { moveAvx512(groups); return; }
         if (avx2) { moveAvx2(groups); return; }
 #endif
-        const size_t lanes = around.lanes;
-        for (size_t g = groups.begin(); g < groups.end(); ++g) {
-            if (poll.stoppedAt((g - groups.begin()) * lanes)) return;
-            for (size_t v = g * lanes; v < std::min((g + 1) * lanes, points.size()); ++v) moveOne(v);
-        }
+        forEachItemOf(groups, around.lanes, points.size(), poll, [&](size_t v) { moveOne(v); });
     }
 
     void moveOne(size_t v) const
