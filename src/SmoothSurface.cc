@@ -360,7 +360,7 @@ void forEachItemOf(const tbb::blocked_range<size_t>& groups, size_t lanes, size_
 struct NormalRoundOp
 {
     const PolygonNeighbours& neighbours;
-    /// The polygons' normals, and one more (zero) at the end: the AVX-512F copy loads 16
+    /// The polygons' normals, and one more (zero) at the end: the vector copies load 16
     /// bytes from a normal's x, reading the next normal's x too.
     const UnwrittenVector<Vec3s>& normal;
     UnwrittenVector<Vec3s>& filtered;  ///< as normal
@@ -591,7 +591,7 @@ struct Plane
 struct VertexRoundOp
 {
     const LaneLists& around;
-    /// The polygons' planes, and one more at the end: the AVX-512F copy loads 32 bytes from
+    /// The polygons' planes, and one more at the end: the vector copies load 32 bytes from
     /// a plane's start, reading 8 bytes of the next one.
     const UnwrittenVector<Plane>& planes;
     const std::vector<Vec3s>& points;
