@@ -2,7 +2,7 @@
 # Speed and memory of `nonbloppy mesh` against OpenVDB's own particle mesher, measured in one run
 # on the same inputs: the real dam-break frame tiled into 1, 64 and 512 disjoint copies.
 #
-#   bash tests/bench/run_benchmark.sh [--quick] [--runs N] [--out DIR] [--keep-meshes]
+#   bash tests/bench/run_benchmark.sh [--quick] [--runs N] [--out DIR] [--keep-meshes] [--update-readme]
 #
 #   --quick   skip the 512x input (12.5M particles) and the t/threads scans run once each
 #   --runs N  rounds over the inputs, each running both tools in turn on each input (default 3;
@@ -11,6 +11,10 @@
 #   --keep-meshes  keep both tools' last meshes in DIR; by default they are removed at the end
 #             (2.1 GB after a full run, most of it the two 512x meshes), the inputs kept for the
 #             next run
+#   --update-readme  put the run's summary (DIR/summary.md: the machine, the commit, the main
+#             table and the targets met or missed) into README.md between its benchmark
+#             markers (tests/bench/update_readme.sh), so that the README shows the latest run
+#             as it was measured, never copied by hand
 #
 # The peer is `vdb_tool` from Debian's libopenvdb-tools:
 #   vdb_tool -read IN.ply -points2ls voxel=0.025 radius=2 width=3 -ls2mesh adapt=0 -write OUT.ply
@@ -26,6 +30,7 @@ cd "$(dirname "$0")/../.."
 runs=3
 quick=0
 keep_meshes=0
+update_readme=0
 out=/tmp/nonbloppy-bench
 while (($#)); do
   case "$1" in
@@ -33,6 +38,7 @@ while (($#)); do
     --runs) runs="$2"; shift ;;
     --out) out="$2"; shift ;;
     --keep-meshes) keep_meshes=1 ;;
+    --update-readme) update_readme=1 ;;
     *) echo "run_benchmark.sh: unknown option '$1'" >&2; exit 2 ;;
   esac
   shift
@@ -82,17 +88,34 @@ declare -A copies_of=([1]=1 [64]=4 [512]=8)
 sizes=(1 64 512)
 ((quick)) && sizes=(1 64)
 
+# What the run measured: the command, when, on what, and which code (a commit with local
+# changes says so: its figures are not that commit's; changes to the README and docs/, which
+# --update-readme makes itself, do not count).
+command_line="bash tests/bench/run_benchmark.sh$( ((quick)) && printf ' --quick') --runs $runs"
+started=$(date -u '+%Y-%m-%d %H:%M UTC')
+cpu_model=$(awk -F': ' '/^model name/ {print $2; exit}' /proc/cpuinfo)
+flags=$(awk -F': ' '/^flags/ {print " " $2 " "; exit}' /proc/cpuinfo)
+case "$flags" in *" avx512f "*) isa="AVX-512" ;; *" avx2 "*) isa="AVX2" ;; *) isa="no AVX2" ;; esac
+machine="$(nproc) cores of ${cpu_model:-an unnamed CPU} ($isa), $(awk '/MemTotal/ {printf "%.0f GiB", $2 / 1048576}' /proc/meminfo)"
+commit=$(git rev-parse --short HEAD 2>/dev/null || echo "no git")
+[ -n "$(git status --porcelain --untracked-files=no -- . ':!README.md' ':!docs' 2>/dev/null)" ] && commit="$commit with local changes"
+
 say "# nonbloppy benchmark"
 say ""
-say "Command: \`bash tests/bench/run_benchmark.sh$( ((quick)) && printf ' --quick')  --runs $runs\`, $(date -u +%Y-%m-%d), $(nproc) cores, $(awk '/MemTotal/ {printf "%.0f GiB", $2 / 1048576}' /proc/meminfo)."
+say "Command: \`$command_line\`, $started, commit $commit, on $machine."
 say "Input: \`tests/data/dam_break_frame_23_24389_particles.vtk\` tiled by \`nonbloppy_tile --copies N\` (binary PLY)."
 say "nonbloppy: \`mesh IN -o OUT.ply ${nb_args[*]}\`; vdb_tool: \`-points2ls voxel=0.025 radius=2 width=3 -ls2mesh adapt=0\`."
 say "Median of $runs runs each, in rounds over the inputs, the two tools alternating."
 say ""
-say "| input | particles | tool | wall s | CPU s | peak RSS MiB | particles/s | wall ratio | RSS ratio |"
-say "| --- | --- | --- | --- | --- | --- | --- | --- | --- |"
+main_header=("| input | particles | tool | wall s | CPU s | peak RSS MiB | particles/s | wall ratio | RSS ratio |"
+             "| --- | --- | --- | --- | --- | --- | --- | --- | --- |")
+main_rows=()
+# group_digits N: N with thousands separated by commas (12487168 -> 12,487,168).
+group_digits() { printf '%s' "$1" | sed ':a;s/\B[0-9]\{3\}\>/,&/;ta'; }
+say "${main_header[0]}"
+say "${main_header[1]}"
 
-declare -A nb_wall nb_cpu pair_ratios
+declare -A nb_wall nb_cpu pair_ratios wall_ratio_of rss_ratio_of
 for size in "${sizes[@]}"; do
   input="$out/dam_break_x${size}.ply"
   [ -s "$input" ] || "$tile" "$frame" "$input" --copies "${copies_of[$size]}" > /dev/null
@@ -124,9 +147,13 @@ for size in "${sizes[@]}"; do
   pair_ratios[$size]=$(paste -d' ' "$out/nb_$size" "$out/vt_$size" \
     | awk '{printf "%s%.3f", (NR > 1 ? " " : ""), $1 / $4}')
   ratio_rss=$(awk -v a="$nbm" -v b="$vtm" 'BEGIN {printf "%.2f", a / b}')
+  wall_ratio_of[$size]=$ratio_wall
+  rss_ratio_of[$size]=$ratio_rss
   rate() { awk -v n="$particles" -v t="$1" 'BEGIN {printf "%.3gM", n / t / 1e6}'; }
-  say "| ${size}x | $particles | nonbloppy | $nbw | $nbc | $((nbm / 1024)) | $(rate "$nbw") | $ratio_wall | $ratio_rss |"
-  say "| ${size}x | $particles | vdb_tool | $vtw | $vtc | $((vtm / 1024)) | $(rate "$vtw") | | |"
+  main_rows+=("| ${size}x | $(group_digits "$particles") | nonbloppy | $nbw | $nbc | $(group_digits $((nbm / 1024))) | $(rate "$nbw") | $ratio_wall | $ratio_rss |"
+               "| ${size}x | $(group_digits "$particles") | vdb_tool | $vtw | $vtc | $(group_digits $((vtm / 1024))) | $(rate "$vtw") | | |")
+  say "${main_rows[-2]}"
+  say "${main_rows[-1]}"
 done
 
 say ""
@@ -218,7 +245,9 @@ say "| t = 2, --threads 1 (median of $thread_pairs) | $threads1 |"
 say "| t = 2, --threads 2 (median of $thread_pairs) | $threads2 |"
 say ""
 per_iteration() { awk -v a="$1" -v b="$2" 'BEGIN {printf "%.1f%%", 100 * (a - b) / 4 / b}'; }
-say "Each relaxation iteration costs $(per_iteration "${t_fixed[4]}" "${t_fixed[0]}") of the t = 0 run with r_0 fixed ($(per_iteration "${t_wall[4]}" "${t_wall[0]}") with r_0 calibrated for each t, which also grows the surface)."
+iteration_fixed=$(per_iteration "${t_fixed[4]}" "${t_fixed[0]}")
+iteration_calibrated=$(per_iteration "${t_wall[4]}" "${t_wall[0]}")
+say "Each relaxation iteration costs $iteration_fixed of the t = 0 run with r_0 fixed ($iteration_calibrated with r_0 calibrated for each t, which also grows the surface)."
 # thread_ratios NAME: one-thread over two-thread time of each pair for stage NAME ("wall":
 # the whole run), then their median.
 thread_ratios() {
@@ -231,7 +260,9 @@ thread_ratios() {
 }
 # median_of [FORMAT]: the median of the numbers on standard input (two decimals by default).
 median_of() { sort -g | awk -v f="${1:-%.2f}" '{v[NR] = $1} END {if (NR) printf f, (NR % 2 ? v[(NR + 1) / 2] : (v[NR / 2] + v[NR / 2 + 1]) / 2)}'; }
-say "Two threads against one, median of the $thread_pairs pairs' ratios: $(thread_ratios wall | median_of)x (pairs: $(thread_ratios wall | awk '{printf "%s%.2f", (NR > 1 ? " " : ""), $1}')). Per stage:"
+two_threads=$(thread_ratios wall | median_of)
+two_thread_pairs=$(thread_ratios wall | awk '{printf "%s%.2f", (NR > 1 ? " " : ""), $1}')
+say "Two threads against one, median of the $thread_pairs pairs' ratios: ${two_threads}x (pairs: $two_thread_pairs). Per stage:"
 say ""
 # Cores busy: the stage's process CPU time over its wall time, as nonbloppy prints it. Below 2
 # at two threads, a stage waits on something serial; at ~2 with a ratio below 2, each core
@@ -309,7 +340,48 @@ for ((r = 0; r < paper_runs; ++r)); do
 done
 compute=$(median 1 "$out/nb_paper.compute")
 say ""
-say "Paper comparison: the 24,389-particle frame computes in ${compute} s (stages other than reading and writing, 2 threads, median of $paper_runs runs of nonbloppy alone; each: $(tr '\n' ' ' < "$out/nb_paper.compute")s), that is $(awk -v c="$compute" 'BEGIN {printf "%.3f", c * 14272 / 24389}') s for 14,272 particles (paper: about 15 s, t = 2)."
+paper_seconds=$(awk -v c="$compute" 'BEGIN {printf "%.3f", c * 14272 / 24389}')
+say "Paper comparison: the 24,389-particle frame computes in ${compute} s (stages other than reading and writing, 2 threads, median of $paper_runs runs of nonbloppy alone; each: $(tr '\n' ' ' < "$out/nb_paper.compute")s), that is $paper_seconds s for 14,272 particles (paper: about 15 s, t = 2)."
+
+# The summary: what the README shows (--update-readme), also at the end of the report. Each
+# target of the performance issue, its figure in this run, and whether this run met it.
+# verdict VALUE OP LIMIT: "met" or "**missed**" (OP: le, lt or ge).
+verdict() { awk -v v="${1%\%}" -v op="$2" -v l="$3" 'BEGIN {
+  ok = (op == "le" ? v <= l : op == "lt" ? v < l : v >= l); printf "%s", ok ? "met" : "**missed**"}'; }
+linearity=-
+if [ -n "${nb_wall[512]:-}" ]; then
+  linearity=$(awk -v a="${nb_wall[512]}" -v b="${nb_wall[64]}" 'BEGIN {printf "%.2f", (a / 512) / (b / 64)}')
+fi
+summary="$out/summary.md"
+{
+  echo "**Latest run**: \`$command_line\`, $started, commit $commit, on $machine."
+  echo "$( ((runs == 1)) && echo "One run" || echo "Medians of $runs runs"), the two tools alternating on each input (the dam-break frame tiled into"
+  echo "disjoint copies, binary PLY); nonbloppy \`${nb_args[*]}\`, vdb_tool"
+  echo "\`-points2ls voxel=0.025 radius=2 width=3 -ls2mesh adapt=0\`."
+  echo ""
+  printf '%s\n' "${main_header[@]}" "${main_rows[@]}"
+  echo ""
+  echo "| target | this run | |"
+  echo "| --- | --- | --- |"
+  echo "| wall time ≤ 0.25x vdb_tool's, 64x | ${wall_ratio_of[64]} (pairs ${pair_ratios[64]}) | $(verdict "${wall_ratio_of[64]}" le 0.25) |"
+  if [ "$linearity" != - ]; then
+    echo "| wall time ≤ 0.25x vdb_tool's, 512x | ${wall_ratio_of[512]} (pairs ${pair_ratios[512]}) | $(verdict "${wall_ratio_of[512]}" le 0.25) |"
+  fi
+  echo "| peak RSS ≤ 0.75x vdb_tool's | 64x ${rss_ratio_of[64]}$([ "$linearity" != - ] && printf ', 512x %s' "${rss_ratio_of[512]}") | $(verdict "$(printf '%s\n' "${rss_ratio_of[64]}" "${rss_ratio_of[512]:-0}" | sort -g | tail -1)" le 0.75) |"
+  if [ "$linearity" != - ]; then
+    echo "| per-particle time at 512x within 15% of 64x | $linearity | $(awk -v l="$linearity" 'BEGIN {printf "%s", (l >= 0.85 && l <= 1.15) ? "met" : "**missed**"}') |"
+  else
+    echo "| per-particle time at 512x within 15% of 64x | not measured (--quick) | |"
+  fi
+  echo "| one relaxation iteration ≤ 15% of the t = 0 run | $iteration_fixed with r_0 held ($iteration_calibrated with r_0 calibrated for each t) | $(verdict "$iteration_fixed" le 15) |"
+  echo "| two threads ≥ 1.8x one | ${two_threads}x (pairs $two_thread_pairs) | $(verdict "$two_threads" ge 1.8) |"
+  echo "| paper's frame (14,272 particles, t = 2) < 0.05 s of compute | $paper_seconds s | $(verdict "$paper_seconds" lt 0.05) |"
+} > "$summary"
+say ""
+say "## Summary"
+say ""
+tee -a "$report" < "$summary"
+if ((update_readme)); then bash tests/bench/update_readme.sh "$summary" README.md; fi
 if ((!keep_meshes)); then
   rm -f "$out"/nb_x*.ply "$out"/vt_x*.ply "$out/scan.ply" "$out/nb_paper.ply"
 fi
