@@ -91,7 +91,7 @@ sizes=(1 64 512)
 # What the run measured: the command, when, on what, and which code (a commit with local
 # changes says so: its figures are not that commit's; changes to the README and docs/, which
 # --update-readme makes itself, do not count).
-command_line="bash tests/bench/run_benchmark.sh$( ((quick)) && printf ' --quick') --runs $runs"
+command_line="bash tests/bench/run_benchmark.sh$( ((quick)) && printf ' --quick' || true) --runs $runs"
 started=$(date -u '+%Y-%m-%d %H:%M UTC')
 cpu_model=$(awk -F': ' '/^model name/ {print $2; exit}' /proc/cpuinfo)
 flags=$(awk -F': ' '/^flags/ {print " " $2 " "; exit}' /proc/cpuinfo)
