@@ -134,7 +134,6 @@ protected:
         return runAfter("ulimit -v " + std::to_string(kilobytes) + " && ", args);
     }
 
-private:
     /// run() with the shell command @a prefix before it.
     RunResult runAfter(const std::string& prefix, const std::string& args) const
     {

@@ -18,16 +18,19 @@
 #include <nonbloppy/WriteVdb.h>
 #include <openvdb/openvdb.h>
 #include <openvdb/version.h>
+#include <tbb/info.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <fstream>
 #include <limits>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include <sys/stat.h>
+#include <unistd.h>
 
 namespace {
 
@@ -518,6 +521,79 @@ TEST_F(CliTest, VdbPrintReadsTheCache)
     const std::string printed = readText(dir() + "/vdb_print.txt");
     EXPECT_NE(printed.find("density"), std::string::npos) << printed;
     EXPECT_NE(printed.find("effective_radius"), std::string::npos) << printed;
+}
+
+/// A child of this process's CPU cgroup limited to half a CPU, for as long as it lives; its
+/// directory empty where the machine does not let a test make one (not root, a read-only
+/// or delegated cgroup file system, no cpu controller there).
+class HalfCpuCgroup
+{
+public:
+    HalfCpuCgroup()
+    {
+        std::string unified, cpuV1;
+        bool hasV1 = false;
+        std::ifstream cgroups("/proc/self/cgroup");
+        for (std::string line; std::getline(cgroups, line);) {
+            if (line.rfind("0::", 0) == 0) unified = line.substr(3);
+            const size_t cpu = line.find(":cpu,");
+            const size_t only = line.find(":cpu:");
+            if (cpu != std::string::npos || only != std::string::npos) {
+                hasV1 = true;
+                cpuV1 = line.substr(line.find(':', (only != std::string::npos ? only : cpu) + 1) + 1);
+            }
+        }
+        const std::string name = "/nonbloppy_test_" + std::to_string(::getpid());
+        std::string dir = hasV1 ? "/sys/fs/cgroup/cpu" + cpuV1 + name : "/sys/fs/cgroup" + unified + name;
+        if (::mkdir(dir.c_str(), 0755) != 0) return;
+        mDir = dir;
+        const bool limited = hasV1 ? writeFile(mDir + "/cpu.cfs_period_us", "100000") &&
+                                         writeFile(mDir + "/cpu.cfs_quota_us", "50000")
+                                   : writeFile(mDir + "/cpu.max", "50000 100000");
+        if (!limited) {
+            ::rmdir(mDir.c_str());
+            mDir.clear();
+        }
+    }
+    ~HalfCpuCgroup()
+    {
+        if (!mDir.empty()) ::rmdir(mDir.c_str());  // empty again once the commands ended
+    }
+    const std::string& dir() const { return mDir; }
+
+private:
+    static bool writeFile(const std::string& path, const std::string& text)
+    {
+        std::ofstream file(path);
+        file << text << std::flush;
+        return bool(file);
+    }
+    std::string mDir;
+};
+
+TEST_F(CliTest, ThreadsDefaultToTheCpuLimitOfTheCgroup)
+{
+    // docker run --cpus 0.5, or a Kubernetes pod's limits.cpu: TBB would start a worker per
+    // core all the same, which the kernel then throttles. mesh and convert run as many as
+    // the limit rounds up to unless --threads says otherwise; the output does not change.
+    if (tbb::info::default_concurrency() < 2) GTEST_SKIP() << "one core: no limit to lower";
+    const HalfCpuCgroup cgroup;
+    if (cgroup.dir().empty()) GTEST_SKIP() << "cannot make a cgroup with a CPU limit here";
+    const std::string enter = "echo $$ > " + quote(cgroup.dir() + "/cgroup.procs") + " && exec ";
+    const RunResult limited = runAfter(enter, "mesh " + quote(kCube) + " -o " + quote(out("limited.obj")));
+    ASSERT_EQ(limited.exitCode, 0) << limited.err;
+    EXPECT_NE(limited.out.find("\n  threads              1              (the cgroup's CPU limit, 0.5 CPUs)\n"),
+              std::string::npos) << limited.out;
+    const RunResult given = runAfter(enter, "mesh " + quote(kCube) + " -o " + quote(out("given.obj")) + " --threads 2");
+    ASSERT_EQ(given.exitCode, 0) << given.err;
+    EXPECT_NE(given.out.find("\n  threads              2              (given)\n"), std::string::npos) << given.out;
+    const RunResult free = run("mesh " + quote(kCube) + " -o " + quote(out("free.obj")));
+    ASSERT_EQ(free.exitCode, 0) << free.err;
+    EXPECT_NE(free.out.find("              (default)\n"), std::string::npos) << free.out;
+    EXPECT_EQ(readText(out("limited.obj")), readText(out("free.obj")));
+    EXPECT_EQ(readText(out("given.obj")), readText(out("free.obj")));
+    const RunResult converted = runAfter(enter, "convert " + quote(kCube) + " " + quote(out("cube.ply")));
+    EXPECT_EQ(converted.exitCode, 0) << converted.err;
 }
 
 TEST_F(CliTest, OutputDoesNotDependOnThreadCount)

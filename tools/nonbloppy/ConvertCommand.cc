@@ -7,6 +7,7 @@
 #include "Commands.h"
 
 #include "BackgroundRemover.h"
+#include "CpuLimit.h"
 #include "Interrupts.h"
 #include "OutputCleanup.h"
 
@@ -50,6 +51,10 @@ int runConvert(const ConvertOptions& o)
     // IN is read, before anything is written, or once OUT is written, which is then undone.
     // It used to kill the process, leaving the writer's temporary file beside OUT.
     SignalHandlerScope signals;
+    // The readers and writers run in parallel: no more workers than the CPUs a container or
+    // job grants (CpuLimit.h).
+    std::string threadsOrigin;
+    const std::unique_ptr<tbb::global_control> threadLimit = limitWorkers(0, threadsOrigin);
     const WarningPrinter printer;
     const nonbloppy::ParticleSet particles = [&] {
         const InputReadScope reading;  // may block (a FIFO): see kStuckReadSeconds

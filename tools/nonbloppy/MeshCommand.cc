@@ -8,6 +8,7 @@
 
 #include "BackgroundRemover.h"
 #include "BatchRun.h"
+#include "CpuLimit.h"
 #include "FrameSequence.h"
 #include "Interrupts.h"
 #include "Json.h"
@@ -440,7 +441,7 @@ void validate(const MeshOptions& o)
 std::string origin(bool given, const char* otherwise) { return given ? "(given)" : otherwise; }
 
 void printSummary(const MeshOptions& o, const nonbloppy::SurfaceResult& result,
-                  const nonbloppy::StageTimings& timings, int threads)
+                  const nonbloppy::StageTimings& timings, int threads, const std::string& threadsOrigin)
 {
     const nonbloppy::ResolvedParameters& p = result.parameters;
     const nonbloppy::SurfaceMesh& mesh = result.mesh;
@@ -481,7 +482,7 @@ void printSummary(const MeshOptions& o, const nonbloppy::SurfaceResult& result,
             o.noSmooth ? "(--no-smooth)" : p.smoothSurface ? "(with the volume offset)" : "(needs --spacing)");
     }
     row("region leaves", std::to_string(p.regionLeaves), origin(o.regionLeavesOpt->count() > 0, "(default)"));
-    row("threads", std::to_string(threads), origin(o.threadsOpt->count() > 0, "(default)"));
+    row("threads", std::to_string(threads), threadsOrigin);
 
     out << "result\n";
     if (result.density) {
@@ -1054,11 +1055,9 @@ int runSequence(const MeshOptions& o)
         throw;
     }
 
-    std::unique_ptr<tbb::global_control> threadLimit;
-    if (o.threadsOpt->count() > 0) {
-        threadLimit = std::make_unique<tbb::global_control>(
-            tbb::global_control::max_allowed_parallelism, static_cast<size_t>(o.threads));
-    }
+    std::string threadsOrigin;
+    const std::unique_ptr<tbb::global_control> threadLimit =
+        limitWorkers(o.threadsOpt->count() > 0 ? o.threads : 0, threadsOrigin);
     SignalHandlerScope signals;
 
     BatchSettings settings;
@@ -1154,11 +1153,9 @@ int runMesh(const MeshOptions& o)
     if (!o.vdbPath.empty()) requireNoPlaceholder(o.vdbPath, "--vdb", o);
     validate(o);
 
-    std::unique_ptr<tbb::global_control> threadLimit;
-    if (o.threadsOpt->count() > 0) {
-        threadLimit = std::make_unique<tbb::global_control>(
-            tbb::global_control::max_allowed_parallelism, static_cast<size_t>(o.threads));
-    }
+    std::string threadsOrigin;
+    const std::unique_ptr<tbb::global_control> threadLimit =
+        limitWorkers(o.threadsOpt->count() > 0 ? o.threads : 0, threadsOrigin);
     const int threads = static_cast<int>(
         tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
 
@@ -1180,7 +1177,7 @@ int runMesh(const MeshOptions& o)
             sampler->stop();
             std::cerr << sampler->report(outcome.timings, outcome.result.particleCount);
         }
-        if (!o.quiet) printSummary(o, outcome.result, outcome.timings, threads);
+        if (!o.quiet) printSummary(o, outcome.result, outcome.timings, threads, threadsOrigin);
         return 0;
     } catch (const nonbloppy::CancelledError&) {
         // meshFrame() has removed what was written; the library leaves nothing behind.
@@ -1257,7 +1254,7 @@ Command setupMeshCommand(CLI::App& parent)
         "its vertices in another order (with --spacing, whose smoothing sums in that order, to the last bits) "
         "(default: " + std::to_string(nonbloppy::kDefaultRegionLeaves) + ")")->group(kGroupAdvanced);
     o.threadsOpt = cmd->add_option("--threads", o.threads,
-        "Worker threads (default: all cores); results do not depend on it")
+        "Worker threads (default: all cores, or as many as a container's or job's CPU limit rounds up to); results do not depend on it")
         ->group(kGroupAdvanced);
 
     o.vdbPath.clear();

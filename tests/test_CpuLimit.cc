@@ -1,0 +1,112 @@
+// SPDX-License-Identifier: Apache-2.0
+// The CPU limit of a container or batch job (tools/nonbloppy/CpuLimit.h), read from cgroup
+// file systems laid out in a scratch directory as the kernel, Docker, Kubernetes and Slurm
+// lay them out.
+#include "CpuLimit.h"
+#include "TestUtil.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <optional>
+#include <string>
+
+namespace {
+
+using nonbloppy_tool::cgroupCpuLimit;
+using nonbloppy_tool::formatCpus;
+using nonbloppy_test::ScratchDirTest;
+using nonbloppy_test::writeBytes;
+
+class CpuLimitTest : public ScratchDirTest
+{
+protected:
+    /// The file @a name under the fake mount root, with its directories.
+    void file(const std::string& name, const std::string& text) const
+    {
+        std::filesystem::create_directories(std::filesystem::path(path("sys/" + name)).parent_path());
+        writeBytes(path("sys/" + name), text);
+    }
+    std::optional<double> limit(const std::string& procSelfCgroup) const
+    {
+        writeBytes(path("cgroup"), procSelfCgroup);
+        return cgroupCpuLimit(path("cgroup"), path("sys"));
+    }
+};
+
+TEST_F(CpuLimitTest, CgroupV2QuotaOverPeriod)
+{
+    // docker run --cpus 1.5: the container's cpu.max.
+    file("system.slice/docker-1.scope/cpu.max", "150000 100000\n");
+    EXPECT_EQ(limit("0::/system.slice/docker-1.scope\n"), 1.5);
+    file("system.slice/docker-1.scope/cpu.max", "max 100000\n");
+    EXPECT_EQ(limit("0::/system.slice/docker-1.scope\n"), std::nullopt);
+}
+
+TEST_F(CpuLimitTest, TheLowestLimitOnThePathToTheRootBinds)
+{
+    // Kubernetes: limits.cpu on the pod, nothing on the container below it.
+    file("kubepods/burstable/pod7/cpu.max", "400000 100000\n");
+    file("kubepods/burstable/pod7/ctr1/cpu.max", "max 100000\n");
+    file("kubepods/burstable/cpu.max", "max 100000\n");
+    EXPECT_EQ(limit("0::/kubepods/burstable/pod7/ctr1\n"), 4.0);
+    // A tighter child wins over its parent; a looser one does not.
+    file("kubepods/burstable/pod7/ctr1/cpu.max", "50000 100000\n");
+    EXPECT_EQ(limit("0::/kubepods/burstable/pod7/ctr1\n"), 0.5);
+    file("kubepods/burstable/pod7/ctr1/cpu.max", "800000 100000\n");
+    EXPECT_EQ(limit("0::/kubepods/burstable/pod7/ctr1/\n"), 4.0);
+}
+
+TEST_F(CpuLimitTest, AContainersOwnCgroupMountedAsTheRoot)
+{
+    // Inside a container with its own cgroup namespace the path is "/", and without one the
+    // host's path, which the container's mount does not hold: the root's files then count.
+    file("cpu.max", "200000 100000\n");
+    EXPECT_EQ(limit("0::/\n"), 2.0);
+    EXPECT_EQ(limit("0::/system.slice/docker-2.scope\n"), 2.0);
+}
+
+TEST_F(CpuLimitTest, CgroupV1CpuController)
+{
+    // Slurm with cgroup v1 (ConstrainCores sets a cpuset, which TBB sees; a CPU quota is
+    // what TBB misses), the controller mounted under its joined name.
+    file("cpu,cpuacct/slurm/uid_0/job_12/cpu.cfs_quota_us", "300000\n");
+    file("cpu,cpuacct/slurm/uid_0/job_12/cpu.cfs_period_us", "100000\n");
+    file("memory/slurm/uid_0/job_12/memory.limit_in_bytes", "1073741824\n");
+    const std::string cgroups = "12:memory:/slurm/uid_0/job_12\n4:cpu,cpuacct:/slurm/uid_0/job_12\n0::/\n";
+    EXPECT_EQ(limit(cgroups), 3.0);
+    file("cpu,cpuacct/slurm/uid_0/job_12/cpu.cfs_quota_us", "-1\n");
+    EXPECT_EQ(limit(cgroups), std::nullopt);
+    // A parent's quota, and the controller mounted as plain "cpu" (this machine's layout).
+    std::filesystem::remove_all(path("sys/cpu,cpuacct"));
+    file("cpu/nb/cpu.cfs_quota_us", "50000\n");
+    file("cpu/nb/cpu.cfs_period_us", "100000\n");
+    file("cpu/nb/inner/cpu.cfs_quota_us", "-1\n");
+    file("cpu/nb/inner/cpu.cfs_period_us", "100000\n");
+    file("cpu/cpu.cfs_quota_us", "-1\n");
+    file("cpu/cpu.cfs_period_us", "100000\n");
+    EXPECT_EQ(limit("3:cpuset:/\n2:cpu:/nb/inner\n1:cpuacct:/nb/inner\n0::/\n"), 0.5);
+}
+
+TEST_F(CpuLimitTest, NoLimitWhereNothingIsReadable)
+{
+    // No cgroup file system, an unreadable /proc/self/cgroup, text that is no limit.
+    EXPECT_EQ(cgroupCpuLimit(path("missing"), path("sys-missing")), std::nullopt);
+    file("cpu.max", "200000 100000\n");
+    EXPECT_EQ(cgroupCpuLimit(path("missing"), path("sys")), 2.0);  // the root's, as in a container
+    for (const char* text : {"", "max", "100000", "0 100000", "-5 100000", "abc 100000", "100000 0", "1e999 1"}) {
+        SCOPED_TRACE(text);
+        file("cpu.max", text);
+        EXPECT_EQ(limit("0::/\n"), std::nullopt);
+    }
+}
+
+TEST(CpuLimit, FormatCpus)
+{
+    EXPECT_EQ(formatCpus(1.0), "1 CPU");
+    EXPECT_EQ(formatCpus(0.5), "0.5 CPUs");
+    EXPECT_EQ(formatCpus(4.0), "4 CPUs");
+    EXPECT_EQ(formatCpus(2.345), "2.35 CPUs");
+}
+
+} // namespace
