@@ -535,17 +535,26 @@ public:
         bool hasV1 = false;
         std::ifstream cgroups("/proc/self/cgroup");
         for (std::string line; std::getline(cgroups, line);) {
+            // "ID:CONTROLLERS:PATH"
+            const size_t first = line.find(':'), second = line.find(':', first + 1);
+            if (first == std::string::npos || second == std::string::npos) continue;
+            const std::string controllers = "," + line.substr(first + 1, second - first - 1) + ",";
             if (line.rfind("0::", 0) == 0) unified = line.substr(3);
-            const size_t cpu = line.find(":cpu,");
-            const size_t only = line.find(":cpu:");
-            if (cpu != std::string::npos || only != std::string::npos) {
+            if (controllers.find(",cpu,") != std::string::npos) {
                 hasV1 = true;
-                cpuV1 = line.substr(line.find(':', (only != std::string::npos ? only : cpu) + 1) + 1);
+                cpuV1 = line.substr(second + 1);
             }
         }
         const std::string name = "/nonbloppy_test_" + std::to_string(::getpid());
         std::string dir = hasV1 ? "/sys/fs/cgroup/cpu" + cpuV1 + name : "/sys/fs/cgroup" + unified + name;
         if (::mkdir(dir.c_str(), 0755) != 0) return;
+        // A cgroup file system fills a new directory with its files; a plain one (a tmpfs
+        // where the layout is another) does not, and the test would limit nothing.
+        if (::access((dir + "/cgroup.procs").c_str(), F_OK) != 0) {
+            std::error_code ec;
+            std::filesystem::remove_all(dir, ec);
+            return;
+        }
         mDir = dir;
         const bool limited = hasV1 ? writeFile(mDir + "/cpu.cfs_period_us", "100000") &&
                                          writeFile(mDir + "/cpu.cfs_quota_us", "50000")
