@@ -398,7 +398,7 @@ TEST_F(CliTest, InspectListsAMeshsAttributesOnlyWhenTheyCanBeRead)
     writeText(out("nan.ply"), header + "0 0 0 1\n1 0 0 2\nnan 1 0 3\n3 0 1 2\n");
     RunResult r = run("inspect " + quote(out("fine.ply")));
     ASSERT_EQ(r.exitCode, 0) << r.err;
-    EXPECT_NE(r.out.find("\n  attributes       temp  float32\n"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("\n  attributes       temp  float32  1 .. 3\n"), std::string::npos) << r.out;
     r = run("inspect " + quote(out("nan.ply")));
     ASSERT_EQ(r.exitCode, 0) << r.err;
     EXPECT_NE(r.out.find("\n  attributes       - (the particle readers refuse this file)\n"), std::string::npos) << r.out;
@@ -412,7 +412,8 @@ TEST_F(CliTest, InspectListsAMeshsAttributesOnlyWhenTheyCanBeRead)
     r = run("inspect " + quote(out("normals.vtk")));
     ASSERT_EQ(r.exitCode, 0) << r.err;
     EXPECT_NE(r.out.find("(with normals)"), std::string::npos) << r.out;
-    EXPECT_NE(r.out.find("\n  attributes       vel  float32 x3\n"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("\n  attributes       vel  float32 x3  x 1 .. 7, y 2 .. 8, z 3 .. 9\n"), std::string::npos)
+        << r.out;
     EXPECT_EQ(r.out.find("Normals"), std::string::npos) << r.out;
 }
 
@@ -475,7 +476,28 @@ TEST_F(CliTest, InspectParticleFile)
     ASSERT_EQ(text.exitCode, 0) << text.err;
     // Whole rows: the file's name holds "24389" too.
     EXPECT_NE(text.out.find("\n  particles        24389\n"), std::string::npos) << text.out;
-    EXPECT_NE(text.out.find("\n                   velocity  float32 x3\n"), std::string::npos) << text.out;
+    EXPECT_NE(text.out.find("\n  attributes       id  uint32  0 .. 24388\n"
+                            "                   velocity  float32 x3  x -2.9102397 .. 4.807553, y -3.0431576 .. 8.40207, "
+                            "z -1.9850667 .. 2.7985563\n"),
+              std::string::npos)
+        << text.out;
+    // Those ranges are the file's own, to the float (the JSON report's, against the reader).
+    const nonbloppy::ParticleSet dam = nonbloppy::readParticles(kData + "/dam_break_frame_23_24389_particles.vtk");
+    const nonbloppy::ParticleAttribute* velocity = dam.findAttribute("velocity");
+    ASSERT_NE(velocity, nullptr);
+    const nlohmann::json damJson =
+        nlohmann::json::parse(run("inspect --json " + quote(kData + "/dam_break_frame_23_24389_particles.vtk")).out);
+    ASSERT_EQ(damJson["attributes"][1]["name"], "velocity");
+    for (int c = 0; c < 3; ++c) {
+        double low = velocity->asDouble(0, c), high = low;
+        for (size_t n = 1; n < velocity->size(); ++n) {
+            low = std::min(low, velocity->asDouble(n, c));
+            high = std::max(high, velocity->asDouble(n, c));
+        }
+        EXPECT_EQ(damJson["attributes"][1]["min"][c].get<float>(), float(low)) << c;
+        EXPECT_EQ(damJson["attributes"][1]["max"][c].get<float>(), float(high)) << c;
+    }
+    EXPECT_EQ(damJson["attributes"][1]["non_finite"], 0);
 
     // The text's box too, each coordinate as the shortest text of its float: at six digits a
     // box 0.7 wide at x = 1e6 lost its width ("(1e+06, ...) -> (1e+06, ...)").
@@ -489,6 +511,44 @@ TEST_F(CliTest, InspectParticleFile)
     ASSERT_EQ(farText.exitCode, 0) << farText.err;
     EXPECT_NE(farText.out.find("\n  bounding box     (1e+06, 0, 0) -> (1000000.7, 0.7, 0.7)\n"), std::string::npos)
         << farText.out;
+}
+
+TEST_F(CliTest, InspectGivesEachAttributesRangeExactlyAndCountsValuesThatAreNotFinite)
+{
+    // A cache from a simulation that blew up holds NaN velocities; ids past 2^53 and the
+    // ends of the 64-bit ranges must come out as they are, not rounded through a double.
+    nonbloppy::ParticleSet particles;
+    particles.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+    const float nan = std::numeric_limits<float>::quiet_NaN(), inf = std::numeric_limits<float>::infinity();
+    particles.attributes.push_back(nonbloppy::ParticleAttribute::of(
+        "id", 1, std::vector<int64_t>{(int64_t(1) << 53) + 1, std::numeric_limits<int64_t>::min(), 7, -1}));
+    particles.attributes.push_back(nonbloppy::ParticleAttribute::of(
+        "key", 1, std::vector<uint64_t>{0, std::numeric_limits<uint64_t>::max(), 5, 6}));
+    particles.attributes.push_back(nonbloppy::ParticleAttribute::of("flag", 1, std::vector<int8_t>{-128, 3, 127, 0}));
+    particles.attributes.push_back(nonbloppy::ParticleAttribute::of(
+        "v", 2, std::vector<float>{1.5f, nan, nan, nan, -inf, nan, -0.25f, nan}));
+    nonbloppy::writeParticles(particles, in("odd.vtu"));
+    const RunResult text = run("inspect " + quote(in("odd.vtu")));
+    ASSERT_EQ(text.exitCode, 0) << text.err;
+    EXPECT_NE(text.out.find("\n  attributes       id  int64  -9223372036854775808 .. 9007199254740993\n"
+                            "                   key  uint64  0 .. 18446744073709551615\n"
+                            "                   flag  int8  -128 .. 127\n"
+                            "                   v  float32 x2  0 -0.25 .. 1.5, 6 not finite\n"),
+              std::string::npos)
+        << text.out;
+    const RunResult json = run("inspect --json " + quote(in("odd.vtu")));
+    ASSERT_EQ(json.exitCode, 0) << json.err;
+    const nlohmann::json document = nlohmann::json::parse(json.out);
+    const nlohmann::json& attributes = document["attributes"];
+    EXPECT_EQ(attributes[0]["min"][0].get<int64_t>(), std::numeric_limits<int64_t>::min());
+    EXPECT_EQ(attributes[0]["max"][0].get<int64_t>(), (int64_t(1) << 53) + 1);
+    EXPECT_EQ(attributes[1]["max"][0].get<uint64_t>(), std::numeric_limits<uint64_t>::max());
+    EXPECT_EQ(attributes[2]["min"][0].get<int>(), -128);
+    EXPECT_EQ(attributes[3]["min"][0].get<float>(), -0.25f);
+    EXPECT_TRUE(attributes[3]["min"][1].is_null()) << json.out;  // component 1 has no finite value
+    EXPECT_TRUE(attributes[3]["max"][1].is_null()) << json.out;
+    EXPECT_EQ(attributes[3]["non_finite"].get<int>(), 6);
+    EXPECT_EQ(attributes[0]["non_finite"].get<int>(), 0);
 }
 
 TEST_F(CliTest, InspectJsonIsValidForNamesThatAreNotUtf8)

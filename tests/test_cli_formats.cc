@@ -205,13 +205,18 @@ TEST_F(CliFormatsTest, MeshAttributesReachPlyAndVtk)
         // inspect lists them (not the normals), as it lists a particle file's.
         const RunResult shown = run("inspect " + quote(mesh));
         ASSERT_EQ(shown.exitCode, 0) << shown.err;
-        EXPECT_NE(shown.out.find("\n  attributes       velocity  float32 x3\n"
-                                 "                   pressure  float32\n"), std::string::npos) << shown.out;
+        EXPECT_NE(shown.out.find("\n  attributes       velocity  float32 x3  x "), std::string::npos) << shown.out;
+        EXPECT_NE(shown.out.find("\n                   pressure  float32  0 .. "), std::string::npos) << shown.out;
         const RunResult json = run("inspect --json " + quote(mesh));
         ASSERT_EQ(json.exitCode, 0) << json.err;
-        const nlohmann::json report = nlohmann::json::parse(json.out);
+        nlohmann::json report = nlohmann::json::parse(json.out);
         ASSERT_EQ(report.at("attributes").size(), 2u) << json.out;
+        for (const char* key : {"min", "max", "non_finite"}) report["attributes"][0].erase(key);
         EXPECT_EQ(report["attributes"][0], (nlohmann::json{{"name", "velocity"}, {"type", "float32"}, {"components", 3}}));
+        // The vertices' pressure range, as the particle reader sees the file's values.
+        EXPECT_EQ(report["attributes"][1]["max"][0].get<float>(), float(maxPressure));
+        EXPECT_EQ(report["attributes"][1]["non_finite"], 0);
+        for (const char* key : {"min", "max", "non_finite"}) report["attributes"][1].erase(key);
         EXPECT_EQ(report["attributes"][1], (nlohmann::json{{"name", "pressure"}, {"type", "float32"}, {"components", 1}}));
     }
     const RunResult obj = run("mesh -q " + quote(source) + " -o " + quote(path("m.obj")) + " --attributes all");

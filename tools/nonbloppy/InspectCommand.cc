@@ -21,6 +21,9 @@
 #include <openvdb/points/PointDataGrid.h>
 #include <openvdb/tools/Count.h>
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_reduce.h>
+
 #include <algorithm>
 #include <cerrno>
 #include <charconv>
@@ -33,6 +36,7 @@
 #include <new>
 #include <optional>
 #include <sstream>
+#include <type_traits>
 #include <string>
 #include <vector>
 
@@ -165,30 +169,162 @@ void printRow(const std::string& label, const std::string& value)
 // Particle files
 
 /// The "attributes" rows: name, type and components, one attribute a row, or "none".
-void printAttributes(const std::vector<nonbloppy::ParticleAttribute>& attributes)
+/// What inspect says of one attribute: its name, type and components, and per component the
+/// smallest and largest value that is finite, with the count of values that are not (NaN or
+/// infinite, which a simulation that blew up writes). The values themselves are not kept.
+struct AttributeSummary
+{
+    std::string name;
+    nonbloppy::ScalarType type = nonbloppy::ScalarType::Float32;
+    int components = 1;
+    /// Per component, the shortest text that reads back as the value (integers exact, floats
+    /// in their own type's digits), valid JSON; empty where no value is finite (or none).
+    std::vector<std::string> low, high;
+    size_t nonFinite = 0;
+};
+
+/// The value @a v as the shortest text that reads back to it: "24388", "-0.125", "3.4e+38".
+template<typename T>
+std::string shortestText(T v)
+{
+    char digits[48];
+    return std::string(digits, std::to_chars(digits, digits + sizeof(digits), v).ptr);
+}
+
+/// The per-component range of @a a's values, stored as T (its type). Cost: one pass over the
+/// values, in parallel over particles; min and max do not depend on the order.
+template<typename T>
+void summarizeValues(const nonbloppy::ParticleAttribute& a, AttributeSummary& summary)
+{
+    const size_t components = size_t(std::max(1, a.components));
+    const size_t count = a.bytes.size() / sizeof(T) / components;
+    struct Range
+    {
+        std::vector<T> low, high;
+        std::vector<bool> any;
+        size_t nonFinite = 0;
+    };
+    const auto empty = [&] { return Range{std::vector<T>(components), std::vector<T>(components), std::vector<bool>(components), 0}; };
+    const Range range = tbb::parallel_reduce(
+        tbb::blocked_range<size_t>(0, count, 65536), empty(),
+        [&](const tbb::blocked_range<size_t>& particles, Range r) {
+            for (size_t i = particles.begin(); i < particles.end(); ++i) {
+                for (size_t c = 0; c < components; ++c) {
+                    T v;
+                    std::memcpy(&v, a.bytes.data() + (i * components + c) * sizeof(T), sizeof(T));
+                    if constexpr (std::is_floating_point_v<T>) {
+                        if (!std::isfinite(v)) {
+                            ++r.nonFinite;
+                            continue;
+                        }
+                    }
+                    if (!r.any[c]) {
+                        r.low[c] = r.high[c] = v;
+                        r.any[c] = true;
+                    } else {
+                        r.low[c] = std::min(r.low[c], v);
+                        r.high[c] = std::max(r.high[c], v);
+                    }
+                }
+            }
+            return r;
+        },
+        [&](Range r, const Range& other) {
+            for (size_t c = 0; c < components; ++c) {
+                if (!other.any[c]) continue;
+                r.low[c] = r.any[c] ? std::min(r.low[c], other.low[c]) : other.low[c];
+                r.high[c] = r.any[c] ? std::max(r.high[c], other.high[c]) : other.high[c];
+                r.any[c] = true;
+            }
+            r.nonFinite += other.nonFinite;
+            return r;
+        });
+    summary.nonFinite = range.nonFinite;
+    for (size_t c = 0; c < components; ++c) {
+        // int8 and uint8 print as numbers, not characters.
+        using Printed = std::conditional_t<std::is_integral_v<T> && sizeof(T) == 1, int, T>;
+        summary.low.push_back(range.any[c] ? shortestText(Printed(range.low[c])) : std::string());
+        summary.high.push_back(range.any[c] ? shortestText(Printed(range.high[c])) : std::string());
+    }
+}
+
+AttributeSummary summarize(const nonbloppy::ParticleAttribute& a)
+{
+    AttributeSummary summary{a.name, a.type, a.components, {}, {}, 0};
+    using nonbloppy::ScalarType;
+    switch (a.type) {
+    case ScalarType::Int8: summarizeValues<int8_t>(a, summary); break;
+    case ScalarType::UInt8: summarizeValues<uint8_t>(a, summary); break;
+    case ScalarType::Int16: summarizeValues<int16_t>(a, summary); break;
+    case ScalarType::UInt16: summarizeValues<uint16_t>(a, summary); break;
+    case ScalarType::Int32: summarizeValues<int32_t>(a, summary); break;
+    case ScalarType::UInt32: summarizeValues<uint32_t>(a, summary); break;
+    case ScalarType::Int64: summarizeValues<int64_t>(a, summary); break;
+    case ScalarType::UInt64: summarizeValues<uint64_t>(a, summary); break;
+    case ScalarType::Float32: summarizeValues<float>(a, summary); break;
+    case ScalarType::Float64: summarizeValues<double>(a, summary); break;
+    }
+    return summary;
+}
+
+std::vector<AttributeSummary> summarize(const std::vector<nonbloppy::ParticleAttribute>& attributes)
+{
+    std::vector<AttributeSummary> summaries;
+    for (const nonbloppy::ParticleAttribute& a : attributes) summaries.push_back(summarize(a));
+    return summaries;
+}
+
+/// The name of component @a c of @a components: x, y, z for three, else its number.
+std::string componentName(size_t c, int components)
+{
+    return components == 3 ? std::string(1, char('x' + c)) : std::to_string(c);
+}
+
+/// One row per attribute: "velocity  float32 x3  x -1.5 .. 2.25, y 0 .. 1, z -3 .. 3",
+/// "id  uint32  0 .. 24388", then ", 12 not finite" where values are NaN or infinite.
+void printAttributes(const std::vector<AttributeSummary>& attributes)
 {
     if (attributes.empty()) {
         printRow("attributes", "none");
         return;
     }
     bool first = true;
-    for (const nonbloppy::ParticleAttribute& a : attributes) {
+    for (const AttributeSummary& a : attributes) {
         std::string text = a.name + "  " + nonbloppy::scalarTypeName(a.type);
         if (a.components != 1) text += " x" + std::to_string(a.components);
+        std::string ranges;
+        for (size_t c = 0; c < a.low.size(); ++c) {
+            if (a.low[c].empty()) continue;
+            if (!ranges.empty()) ranges += ", ";
+            if (a.components != 1) ranges += componentName(c, a.components) + " ";
+            ranges += a.low[c] + " .. " + a.high[c];
+        }
+        if (a.nonFinite > 0) ranges += std::string(ranges.empty() ? "" : ", ") + std::to_string(a.nonFinite) + " not finite";
+        if (!ranges.empty()) text += "  " + ranges;
         printRow(first ? "attributes" : "", text);
         first = false;
     }
 }
 
-/// The "attributes" array of the JSON report: {"name", "type", "components"} each.
-void writeAttributes(JsonWriter& w, const std::vector<nonbloppy::ParticleAttribute>& attributes)
+/// The "attributes" array of the JSON report: {"name", "type", "components", "min", "max",
+/// "non_finite"} each; "min" and "max" hold a number per component, null where none is
+/// finite.
+void writeAttributes(JsonWriter& w, const std::vector<AttributeSummary>& attributes)
 {
     w.beginArray("attributes");
-    for (const nonbloppy::ParticleAttribute& a : attributes) {
+    for (const AttributeSummary& a : attributes) {
         w.beginObject();
         w.string("name", a.name);
         w.string("type", nonbloppy::scalarTypeName(a.type));
         w.integer("components", a.components);
+        const auto list = [](const std::vector<std::string>& values) {
+            std::string json = "[";
+            for (size_t c = 0; c < values.size(); ++c) json += (c ? ", " : "") + (values[c].empty() ? "null" : values[c]);
+            return json + "]";
+        };
+        w.raw("min", list(a.low));
+        w.raw("max", list(a.high));
+        w.integer("non_finite", static_cast<long long>(a.nonFinite));
         w.endObject();
     }
     w.endArray();
@@ -218,7 +354,7 @@ int inspectParticles(const std::string& path, const nonbloppy::ParticleSet& part
         w.boundingBox(bbox);
         if (spacing) w.number("spacing", *spacing);
         else w.raw("spacing", "null");
-        writeAttributes(w, particles.attributes);
+        writeAttributes(w, summarize(particles.attributes));
         w.beginArray("not_read");
         for (const std::string& skipped : particles.skipped) w.string(nullptr, skipped);
         w.endArray();
@@ -236,7 +372,7 @@ int inspectParticles(const std::string& path, const nonbloppy::ParticleSet& part
     printRow("spacing", spacing ? formatNumber(*spacing) + " (estimated: volume per particle inside the fluid, "
                                                            "or the median neighbour distance where no particle is surrounded)"
                                 : "- (" + spacingNote + ")");
-    printAttributes(particles.attributes);
+    printAttributes(summarize(particles.attributes));
     if (!particles.skipped.empty()) printRow("not read", joinedSkipped(particles));
     std::cout.flush();
     return 0;
@@ -249,11 +385,11 @@ int inspectParticles(const std::string& path, const nonbloppy::ParticleSet& part
 /// none) other than its normals, as the particle readers see them. Cost: a second read of
 /// the file, as particles. Unknown (nullopt) where the particle readers refuse the file
 /// (a NaN vertex, say) that readMesh() read.
-std::optional<std::vector<nonbloppy::ParticleAttribute>> meshVertexAttributes(const std::string& path,
-                                                                              const nonbloppy::SurfaceMesh& mesh)
+std::optional<std::vector<AttributeSummary>> meshVertexAttributes(const std::string& path,
+                                                                  const nonbloppy::SurfaceMesh& mesh)
 {
     const std::string ext = lowerExtension(path);
-    if (ext != ".ply" && ext != ".vtk") return std::vector<nonbloppy::ParticleAttribute>();
+    if (ext != ".ply" && ext != ".vtk") return std::vector<AttributeSummary>();
     std::vector<nonbloppy::ParticleAttribute> attributes;
     try {
         attributes = nonbloppy::readParticles(path).attributes;
@@ -285,13 +421,12 @@ std::optional<std::vector<nonbloppy::ParticleAttribute>> meshVertexAttributes(co
             if (normals != attributes.end()) attributes.erase(normals);
         }
     }
-    for (nonbloppy::ParticleAttribute& a : attributes) a.bytes = {};  // only the names and types are shown
-    return attributes;
+    return summarize(attributes);
 }
 
 int inspectMesh(const std::string& path, const nonbloppy::SurfaceMesh& mesh, bool json)
 {
-    const std::optional<std::vector<nonbloppy::ParticleAttribute>> attributes = meshVertexAttributes(path, mesh);
+    const std::optional<std::vector<AttributeSummary>> attributes = meshVertexAttributes(path, mesh);
     const nonbloppy::MeshMeasures m = nonbloppy::measureMesh(mesh);
     const auto bbox = boundingBox(mesh.points);
 
