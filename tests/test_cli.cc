@@ -551,6 +551,40 @@ TEST_F(CliTest, InspectGivesEachAttributesRangeExactlyAndCountsValuesThatAreNotF
     EXPECT_EQ(attributes[0]["non_finite"].get<int>(), 0);
 }
 
+TEST_F(CliTest, MeshWarnsOfVerticesWhoseCarriedAttributeIsNotFinite)
+{
+    // One NaN temperature among 1,000 particles spreads to every vertex within r_e of it:
+    // said once, with the count the written mesh holds; the finite attribute is not named.
+    std::string csv = "x,y,z,temp,speed\n";
+    for (int i = 0; i < 10; ++i) {
+        for (int j = 0; j < 10; ++j) {
+            for (int k = 0; k < 10; ++k) {
+                const bool bad = i == 5 && j == 5 && k == 9;  // on the top face
+                csv += std::to_string(0.05 * i) + "," + std::to_string(0.05 * j) + "," + std::to_string(0.05 * k) + ","
+                       + (bad ? std::string("nan") : std::to_string(1.0 + 0.1 * i)) + ",2.0\n";
+            }
+        }
+    }
+    writeText(in("hot.csv"), csv);
+    const RunResult r = run("mesh -q " + quote(in("hot.csv")) + " -o " + quote(out("hot.ply")) + " --attributes all");
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    const nonbloppy::ParticleSet mesh = nonbloppy::readParticles(out("hot.ply"));
+    const nonbloppy::ParticleAttribute* temp = mesh.findAttribute("temp");
+    ASSERT_NE(temp, nullptr);
+    size_t notFinite = 0;
+    for (size_t n = 0; n < temp->size(); ++n) notFinite += !std::isfinite(temp->asDouble(n));
+    ASSERT_GT(notFinite, 0u);
+    ASSERT_LT(notFinite, mesh.size() / 10);
+    EXPECT_EQ(r.err, "nonbloppy: warning: " + std::to_string(notFinite) + " of the " + std::to_string(mesh.size())
+                         + " vertices of " + out("hot.ply") + " have a NaN or infinite 'temp': particles of "
+                         + in("hot.csv") + " near them hold such values (nonbloppy inspect counts them)\n");
+    // Finite values everywhere: no word.
+    const RunResult fine = run("mesh -q " + quote(kData + "/dam_break_frame_23_24389_particles.vtk") + " -o "
+                               + quote(out("dam.ply")) + " --attributes all");
+    ASSERT_EQ(fine.exitCode, 0) << fine.err;
+    EXPECT_EQ(fine.err, "");
+}
+
 TEST_F(CliTest, InspectJsonIsValidForNamesThatAreNotUtf8)
 {
     // A Latin-1 file name ("café" with é as the byte 0xe9) was copied into the JSON as it was:

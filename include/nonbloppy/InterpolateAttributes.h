@@ -52,8 +52,10 @@ NONBLOPPY_API std::vector<const ParticleAttribute*> checkAttributes(const Partic
 /// MeshAttribute::integer and held in MeshAttribute::integers (means as floats in
 /// MeshAttribute::values). The type is the file's (readParticles()); CSV declares none, and
 /// a column of whole numbers there reads as Int64: write 300.0, not 300, for a quantity to
-/// be averaged. A vertex with no particle within r_e gets 0. Every component is
-/// interpolated independently. An attribute already on the mesh under the same name is
+/// be averaged. A vertex with no particle within r_e gets 0. A NaN or infinite value is
+/// averaged as it is: every vertex within r_e of its particle gets NaN (or an infinity) in
+/// that component (`nonbloppy mesh` warns of such vertices, `nonbloppy inspect` counts such
+/// values in the particle file). Every component is interpolated independently. An attribute already on the mesh under the same name is
 /// replaced (also on a mesh without vertices).
 /// Cost: a ParticleIndex of the particles with cells of r_e (O(N), not interruptible); the
 /// vertices grouped by cells of 1.5 r_e (a parallel radix sort); per group, its particles

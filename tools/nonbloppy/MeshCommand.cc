@@ -532,6 +532,7 @@ struct OnceWarnings
     std::atomic<bool> meshInput{false};
     std::atomic<bool> attributesNotRead{false};
     std::atomic<bool> normalsMissing{false};
+    std::atomic<bool> attributesNotFinite{false};
     OutputWarnings outputs;  ///< those of --attributes, --vdb-surface and --vdb-points
     /// Each frame meshed and its parameters, for warnIfLengthsMoved() at the end of the run.
     std::mutex frameLengthsMutex;
@@ -822,6 +823,36 @@ void warnIfNormalsMissing(const nonbloppy::SurfaceResult& result, const std::str
                                                      : "");
 }
 
+/// Once per run: vertices whose carried attribute (--attributes) is NaN or infinite. The
+/// particles' values are averaged as they are, so one NaN velocity in a cache from a
+/// simulation that blew up makes every vertex within r_e of it NaN, which a renderer's motion
+/// blur does not survive; `nonbloppy inspect IN` counts such values per attribute.
+void warnIfAttributesNotFinite(const nonbloppy::SurfaceResult& result, const std::string& input,
+                               const std::string& output, OnceWarnings& once)
+{
+    if (once.attributesNotFinite.load()) return;
+    const nonbloppy::SurfaceMesh& mesh = result.mesh;
+    for (const nonbloppy::MeshAttribute& a : mesh.attributes) {
+        if (a.integer || a.components < 1) continue;
+        const size_t components = size_t(a.components);
+        const size_t vertices = tbb::parallel_reduce(
+            tbb::blocked_range<size_t>(0, a.values.size() / components, 65536), size_t(0),
+            [&](const tbb::blocked_range<size_t>& range, size_t count) {
+                for (size_t v = range.begin(); v < range.end(); ++v) {
+                    const float* value = a.values.data() + v * components;
+                    count += std::any_of(value, value + components, [](float x) { return !std::isfinite(x); });
+                }
+                return count;
+            },
+            std::plus<size_t>());
+        if (vertices == 0 || once.attributesNotFinite.exchange(true)) continue;
+        warning(once) << vertices << " of the " << mesh.points.size() << " vertices of " << output << " have a NaN or "
+                      << "infinite '" << a.name << "': particles of " << input
+                      << " near them hold such values (nonbloppy inspect counts them)";
+        return;
+    }
+}
+
 /// The warnings about one meshed frame (@a f: its options, paths included), each printed
 /// once per run.
 void warnAboutFrame(const MeshOptions& f, const FrameOutcome& outcome, OnceWarnings& once)
@@ -831,6 +862,7 @@ void warnAboutFrame(const MeshOptions& f, const FrameOutcome& outcome, OnceWarni
     warnIfEmpty(outcome.result, f.output, once);
     warnIfNormalsMissing(outcome.result, f.output, once);
     warnIfMeshInput(f.input, outcome.faces, once);
+    warnIfAttributesNotFinite(outcome.result, f.input, f.output, once);
 }
 
 // ---------------------------------------------------------------------------------------
