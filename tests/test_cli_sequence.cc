@@ -599,7 +599,7 @@ TEST_F(CliSequenceTest, LogHasOneObjectPerFrameAndASummary)
     for (const char* field : {"{\"summary\": true, ", "\"frames_done\": 2, ", "\"frames_failed\": 0, ",
                               "\"frames_skipped\": 0, ", "\"frames_missing\": 0, ",
                               "\"interrupted\": false", "\"total_seconds\": ",
-                              "\"particles\": 4732, ", "\"particles_per_second\": "}) {
+                              "\"particles\": 4732, ", "\"particles_per_second\": ", "\"frame_jobs\": 1, \"threads\": "}) {
         EXPECT_NE(summary.find(field), std::string::npos) << field << "\n" << summary;
     }
 }

@@ -218,6 +218,7 @@ public:
                 + ", \"failed\": " + list(failedFrames) + ", \"missing\": " + list(mSettings.missing)
                 + ", \"interrupted\": " + (wasInterrupted ? "true" : "false")
                 + ", \"frame_jobs\": " + std::to_string(mSettings.frameJobs)
+                + (mSettings.threads > 0 ? ", \"threads\": " + std::to_string(mSettings.threads) : std::string())
                 + ", \"total_seconds\": " + jsonNumber(total)
                 + ", \"cpu_seconds\": " + jsonNumber(nonbloppy::processCpuSeconds())
                 + ", \"particles\": " + std::to_string(mParticles)

@@ -52,6 +52,7 @@ class WarningPrinter;
 struct BatchSettings
 {
     int frameJobs = 1;          ///< frames meshed at once (each uses the shared TBB arena)
+    int threads = 0;            ///< the workers they share, for the log's summary (0: not said)
     bool skipExisting = false;  ///< skip a frame whose outputs all exist
     bool keepGoing = false;     ///< go on after a failed frame
     bool quiet = false;         ///< print nothing but errors

@@ -1094,6 +1094,8 @@ int runSequence(const MeshOptions& o)
 
     BatchSettings settings;
     settings.frameJobs = o.frameJobs;
+    settings.threads = static_cast<int>(
+        tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
     settings.skipExisting = o.skipExisting;
     settings.keepGoing = o.keepGoing;
     settings.quiet = o.quiet;
