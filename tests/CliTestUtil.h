@@ -170,7 +170,10 @@ protected:
     }
 
     /// Starts `nonbloppy ARGS` (unquoted arguments) with stdout to /dev/null and stderr to
-    /// @a errFile; returns its pid, or 0 (a failure added) if it could not be started.
+    /// @a errFile; returns its pid, or 0 (a failure added) if it could not be started. The
+    /// stop signals start at their default action and unblocked, as from a terminal, whatever
+    /// the suite inherited: under `nohup` SIGHUP is ignored, which the tool keeps (as nohup
+    /// means it to), and the SIGHUP test failed; a background job of a script ignores SIGINT.
     pid_t spawnCli(const std::vector<std::string>& args, const std::string& errFile) const
     {
         std::vector<std::string> full = {kCli};
@@ -182,8 +185,18 @@ protected:
         posix_spawn_file_actions_init(&actions);
         posix_spawn_file_actions_addopen(&actions, 1, "/dev/null", O_WRONLY, 0);
         posix_spawn_file_actions_addopen(&actions, 2, errFile.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+        posix_spawnattr_t attributes;
+        posix_spawnattr_init(&attributes);
+        sigset_t defaults, none;
+        sigemptyset(&defaults);
+        for (const int signal : {SIGHUP, SIGINT, SIGTERM}) sigaddset(&defaults, signal);
+        sigemptyset(&none);
+        posix_spawnattr_setsigdefault(&attributes, &defaults);
+        posix_spawnattr_setsigmask(&attributes, &none);
+        posix_spawnattr_setflags(&attributes, POSIX_SPAWN_SETSIGDEF | POSIX_SPAWN_SETSIGMASK);
         pid_t pid = 0;
-        const int spawned = posix_spawn(&pid, kCli.c_str(), &actions, nullptr, argv.data(), environ);
+        const int spawned = posix_spawn(&pid, kCli.c_str(), &actions, &attributes, argv.data(), environ);
+        posix_spawnattr_destroy(&attributes);
         posix_spawn_file_actions_destroy(&actions);
         if (spawned != 0) ADD_FAILURE() << "posix_spawn failed: " << spawned;
         return spawned == 0 ? pid : 0;
