@@ -94,6 +94,9 @@ TEST_F(CpuLimitTest, NoLimitWhereNothingIsReadable)
     EXPECT_EQ(cgroupCpuLimit(path("missing"), path("sys-missing")), std::nullopt);
     file("cpu.max", "200000 100000\n");
     EXPECT_EQ(cgroupCpuLimit(path("missing"), path("sys")), 2.0);  // the root's, as in a container
+    // A path without its leading slash, which no kernel writes, names no directory: the
+    // root's limit, and no exception.
+    EXPECT_EQ(limit("0::kube\n"), 2.0);
     for (const char* text : {"", "max", "100000", "0 100000", "-5 100000", "abc 100000", "100000 0", "1e999 1"}) {
         SCOPED_TRACE(text);
         file("cpu.max", text);

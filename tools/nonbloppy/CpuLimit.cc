@@ -111,7 +111,8 @@ std::optional<double> cgroupCpuLimit(const std::string& procSelfCgroup, const st
         const std::optional<double> limit = limitIn(base + path, hasV1);
         if (limit && (!lowest || *limit < *lowest)) lowest = limit;
         if (path.empty()) break;
-        path.erase(path.rfind('/'));
+        const size_t parent = path.rfind('/');
+        path.erase(parent == std::string::npos ? 0 : parent);
     }
     return lowest;
 }
