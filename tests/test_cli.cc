@@ -549,6 +549,14 @@ TEST_F(CliTest, InspectGivesEachAttributesRangeExactlyAndCountsValuesThatAreNotF
     EXPECT_TRUE(attributes[3]["max"][1].is_null()) << json.out;
     EXPECT_EQ(attributes[3]["non_finite"].get<int>(), 6);
     EXPECT_EQ(attributes[0]["non_finite"].get<int>(), 0);
+    // -0 and +0 are equal, and std::min keeps whichever it met first, which the threads
+    // decide: the range is -0 .. 0 in either order.
+    writeText(in("zeros1.csv"), "x,y,z,t\n0,0,0,0.0\n1,0,0,-0.0\n");
+    writeText(in("zeros2.csv"), "x,y,z,t\n0,0,0,-0.0\n1,0,0,0.0\n");
+    for (const char* name : {"zeros1.csv", "zeros2.csv"}) {
+        const RunResult zeros = run("inspect " + quote(in(name)));
+        EXPECT_NE(zeros.out.find("\n  attributes       t  float64  -0 .. 0\n"), std::string::npos) << zeros.out;
+    }
 }
 
 TEST_F(CliTest, MeshWarnsOfVerticesWhoseCarriedAttributeIsNotFinite)

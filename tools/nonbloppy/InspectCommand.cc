@@ -168,7 +168,6 @@ void printRow(const std::string& label, const std::string& value)
 // ---------------------------------------------------------------------------------------
 // Particle files
 
-/// The "attributes" rows: name, type and components, one attribute a row, or "none".
 /// What inspect says of one attribute: its name, type and components, and per component the
 /// smallest and largest value that is finite, with the count of values that are not (NaN or
 /// infinite, which a simulation that blew up writes). The values themselves are not kept.
@@ -191,11 +190,22 @@ std::string shortestText(T v)
     return std::string(digits, std::to_chars(digits, digits + sizeof(digits), v).ptr);
 }
 
+/// Whether @a a orders before @a b, -0 before +0: std::min of the two equal zeros keeps
+/// whichever came first, and the parallel reduction's order depends on the threads.
+template<typename T>
+bool before(T a, T b)
+{
+    if constexpr (std::is_floating_point_v<T>) return a < b || (a == b && std::signbit(a) && !std::signbit(b));
+    return a < b;
+}
+
 /// The per-component range of @a a's values, stored as T (its type). Cost: one pass over the
-/// values, in parallel over particles; min and max do not depend on the order.
+/// values, in parallel over particles; the result does not depend on the order.
 template<typename T>
 void summarizeValues(const nonbloppy::ParticleAttribute& a, AttributeSummary& summary)
 {
+    const auto lower = [](T x, T y) { return before(y, x) ? y : x; };
+    const auto higher = [](T x, T y) { return before(x, y) ? y : x; };
     const size_t components = size_t(std::max(1, a.components));
     const size_t count = a.bytes.size() / sizeof(T) / components;
     struct Range
@@ -222,8 +232,8 @@ void summarizeValues(const nonbloppy::ParticleAttribute& a, AttributeSummary& su
                         r.low[c] = r.high[c] = v;
                         r.any[c] = true;
                     } else {
-                        r.low[c] = std::min(r.low[c], v);
-                        r.high[c] = std::max(r.high[c], v);
+                        r.low[c] = lower(r.low[c], v);
+                        r.high[c] = higher(r.high[c], v);
                     }
                 }
             }
@@ -232,8 +242,8 @@ void summarizeValues(const nonbloppy::ParticleAttribute& a, AttributeSummary& su
         [&](Range r, const Range& other) {
             for (size_t c = 0; c < components; ++c) {
                 if (!other.any[c]) continue;
-                r.low[c] = r.any[c] ? std::min(r.low[c], other.low[c]) : other.low[c];
-                r.high[c] = r.any[c] ? std::max(r.high[c], other.high[c]) : other.high[c];
+                r.low[c] = r.any[c] ? lower(r.low[c], other.low[c]) : other.low[c];
+                r.high[c] = r.any[c] ? higher(r.high[c], other.high[c]) : other.high[c];
                 r.any[c] = true;
             }
             r.nonFinite += other.nonFinite;
