@@ -223,7 +223,8 @@ public:
                 + ", \"cpu_seconds\": " + jsonNumber(nonbloppy::processCpuSeconds())
                 + ", \"particles\": " + std::to_string(mParticles)
                 + ", \"particles_per_second\": " + jsonNumber(rate)
-                + ", \"peak_rss_bytes\": " + std::to_string(peakResidentBytes()) + "}");
+                + ", \"peak_rss_bytes\": " + std::to_string(peakResidentBytes())
+                + ", \"rss_bytes\": " + std::to_string(currentResidentBytes()) + "}");
         if (mLog) {
             const bool warned = !mLogError.empty();
             if (!warned && (std::fflush(mLog) != 0 || std::ferror(mLog))) mLogError = std::strerror(errno);
