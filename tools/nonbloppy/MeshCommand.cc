@@ -845,7 +845,8 @@ void warnIfAttributesNotFinite(const nonbloppy::SurfaceResult& result, const std
                 return count;
             },
             std::plus<size_t>());
-        if (vertices == 0 || once.attributesNotFinite.exchange(true)) continue;
+        if (vertices == 0) continue;
+        if (once.attributesNotFinite.exchange(true)) return;  // another frame said it meanwhile
         warning(once) << vertices << " of the " << mesh.points.size() << " vertices of " << output << " have a NaN or "
                       << "infinite '" << a.name << "': particles of " << input
                       << " near them hold such values (nonbloppy inspect counts them)";
