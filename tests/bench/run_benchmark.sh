@@ -343,14 +343,19 @@ say ""
 paper_seconds=$(awk -v c="$compute" 'BEGIN {printf "%.3f", c * 14272 / 24389}')
 say "Paper comparison: the 24,389-particle frame computes in ${compute} s (stages other than reading and writing, 2 threads, median of $paper_runs runs of nonbloppy alone; each: $(tr '\n' ' ' < "$out/nb_paper.compute")s), that is $paper_seconds s for 14,272 particles (paper: about 15 s, t = 2)."
 
-# The summary: what the README shows (--update-readme), also at the end of the report. Each
-# target of the performance issue, its figure in this run, and whether this run met it.
-# verdict VALUE OP LIMIT: "met" or "**missed**" (OP: le, lt or ge).
-verdict() { awk -v v="${1%\%}" -v op="$2" -v l="$3" 'BEGIN {
-  ok = (op == "le" ? v <= l : op == "lt" ? v < l : v >= l); printf "%s", ok ? "met" : "**missed**"}'; }
+# The summary: what the README shows (--update-readme), also at the end of the report: the
+# run, the main table, and each target of the performance issue with its figure in this run
+# and whether this run met it (targets_table.sh).
 linearity=-
 if [ -n "${nb_wall[512]:-}" ]; then
   linearity=$(awk -v a="${nb_wall[512]}" -v b="${nb_wall[64]}" 'BEGIN {printf "%.2f", (a / 512) / (b / 64)}')
+fi
+figures=(wall64="${wall_ratio_of[64]}" pairs64="${pair_ratios[64]}" rss64="${rss_ratio_of[64]}"
+         iteration_fixed="$iteration_fixed" iteration_calibrated="$iteration_calibrated"
+         two_threads="$two_threads" two_thread_pairs="$two_thread_pairs" paper_seconds="$paper_seconds")
+if [ "$linearity" != - ]; then
+  figures+=(wall512="${wall_ratio_of[512]}" pairs512="${pair_ratios[512]}" rss512="${rss_ratio_of[512]}"
+            linearity="$linearity")
 fi
 summary="$out/summary.md"
 {
@@ -361,21 +366,7 @@ summary="$out/summary.md"
   echo ""
   printf '%s\n' "${main_header[@]}" "${main_rows[@]}"
   echo ""
-  echo "| target | this run | |"
-  echo "| --- | --- | --- |"
-  echo "| wall time ≤ 0.25x vdb_tool's, 64x | ${wall_ratio_of[64]} (pairs ${pair_ratios[64]}) | $(verdict "${wall_ratio_of[64]}" le 0.25) |"
-  if [ "$linearity" != - ]; then
-    echo "| wall time ≤ 0.25x vdb_tool's, 512x | ${wall_ratio_of[512]} (pairs ${pair_ratios[512]}) | $(verdict "${wall_ratio_of[512]}" le 0.25) |"
-  fi
-  echo "| peak RSS ≤ 0.75x vdb_tool's | 64x ${rss_ratio_of[64]}$([ "$linearity" != - ] && printf ', 512x %s' "${rss_ratio_of[512]}") | $(verdict "$(printf '%s\n' "${rss_ratio_of[64]}" "${rss_ratio_of[512]:-0}" | sort -g | tail -1)" le 0.75) |"
-  if [ "$linearity" != - ]; then
-    echo "| per-particle time at 512x within 15% of 64x | $linearity | $(awk -v l="$linearity" 'BEGIN {printf "%s", (l >= 0.85 && l <= 1.15) ? "met" : "**missed**"}') |"
-  else
-    echo "| per-particle time at 512x within 15% of 64x | not measured (--quick) | |"
-  fi
-  echo "| one relaxation iteration ≤ 15% of the t = 0 run | $iteration_fixed with r_0 held ($iteration_calibrated with r_0 calibrated for each t) | $(verdict "$iteration_fixed" le 15) |"
-  echo "| two threads ≥ 1.8x one | ${two_threads}x (pairs $two_thread_pairs) | $(verdict "$two_threads" ge 1.8) |"
-  echo "| paper's frame (14,272 particles, t = 2) < 0.05 s of compute | $paper_seconds s | $(verdict "$paper_seconds" lt 0.05) |"
+  bash tests/bench/targets_table.sh "${figures[@]}"
 } > "$summary"
 say ""
 say "## Summary"
