@@ -291,8 +291,10 @@ say "With the spacing given (\`--spacing $spacing\`, the value estimated above):
 say ""
 say "| 64x input | wall s | peak RSS MiB | smooth surface s |"
 say "| --- | --- | --- | --- |"
-say "| \`--spacing $spacing\` | $(median 1 "$out/scan_spacing") | $(( $(median 3 "$out/scan_spacing") / 1024 )) | $(median_of %.3f < "$out/scan_spacing.smooth") |"
-say "| \`--spacing $spacing --no-smooth\` | $(median 1 "$out/scan_nosmooth") | $(( $(median 3 "$out/scan_nosmooth") / 1024 )) | - |"
+spacing_wall=$(median 1 "$out/scan_spacing"); spacing_rss=$(( $(median 3 "$out/scan_spacing") / 1024 ))
+spacing_smooth=$(median_of %.3f < "$out/scan_spacing.smooth"); nosmooth_wall=$(median 1 "$out/scan_nosmooth")
+say "| \`--spacing $spacing\` | $spacing_wall | $spacing_rss | $spacing_smooth |"
+say "| \`--spacing $spacing --no-smooth\` | $nosmooth_wall | $(( $(median 3 "$out/scan_nosmooth") / 1024 )) | - |"
 rm -f "$out/scan_spacing.smooth"
 
 # Sequences: one `mesh` call over frames, as a cache is meshed, against the single-frame runs
@@ -325,6 +327,10 @@ sequence_row() {  # sequence_row LABEL WALL RSS_KB
 }
 sequence_row "one frame at a time, written while the next is meshed" "$(median 1 "$out/seq_behind")" "$(median 3 "$out/seq_behind")"
 sequence_row "--frame-jobs 2" "$(median 1 "$out/seq_jobs2")" "$(median 3 "$out/seq_jobs2")"
+# per_frame LOG: a sequence's wall time per frame over the single-frame run's (the summary's).
+per_frame() { awk -v w="$(median 1 "$1")" -v n="$seq_frames" -v one="${nb_wall[64]}" 'BEGIN {printf "%.2f", w / n / one}'; }
+sequence_behind=$(per_frame "$out/seq_behind"); sequence_jobs2=$(per_frame "$out/seq_jobs2")
+sequence_behind_rss=$(( $(median 3 "$out/seq_behind") / 1024 )); sequence_jobs2_rss=$(( $(median 3 "$out/seq_jobs2") / 1024 ))
 sequence_row "$seq_frames separate runs" "$(awk -v w="${nb_wall[64]}" -v n="$seq_frames" 'BEGIN {print w * n}')" "$(median 3 "$out/nb_64")"
 
 # The paper's figure: 14,272 particles, t = 2, about 15 s on a 2008 desktop. Compute time of the
@@ -367,6 +373,12 @@ summary="$out/summary.md"
   printf '%s\n' "${main_header[@]}" "${main_rows[@]}"
   echo ""
   bash tests/bench/targets_table.sh "${figures[@]}"
+  echo ""
+  # Measured in the same run, with no target: what --spacing adds, and a sequence's frames.
+  echo "Also measured on the 64x input (no targets): with \`--spacing $spacing\` (volume correction"
+  echo "and smoothing) $spacing_wall s and $spacing_rss MiB, $spacing_smooth s of it the smoothing, $nosmooth_wall s with"
+  echo "\`--no-smooth\`; $seq_frames frames in one call, each written while the next is meshed, $sequence_behind of a"
+  echo "single-frame run per frame at $sequence_behind_rss MiB, and $sequence_jobs2 with \`--frame-jobs 2\` at $sequence_jobs2_rss MiB."
 } > "$summary"
 say ""
 say "## Summary"
