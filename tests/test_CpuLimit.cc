@@ -86,6 +86,11 @@ TEST_F(CpuLimitTest, CgroupV1CpuController)
     file("cpu/cpu.cfs_quota_us", "-1\n");
     file("cpu/cpu.cfs_period_us", "100000\n");
     EXPECT_EQ(limit("3:cpuset:/\n2:cpu:/nb/inner\n1:cpuacct:/nb/inner\n0::/\n"), 0.5);
+    // Where that cgroup lies, as the tests that make a real one use it.
+    const std::optional<nonbloppy_tool::CpuCgroup> where = nonbloppy_tool::cpuCgroup(path("cgroup"), path("sys"));
+    ASSERT_TRUE(where);
+    EXPECT_TRUE(where->v1);
+    EXPECT_EQ(where->directory(), path("sys/cpu/nb/inner"));
 }
 
 TEST_F(CpuLimitTest, NoLimitWhereNothingIsReadable)

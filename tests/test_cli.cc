@@ -9,6 +9,7 @@
 
 #include "../src/AtomicFile.h"
 #include "CliTestUtil.h"
+#include "CpuLimit.h"
 #include "TestUtil.h"  // NONBLOPPY_TEST_ASAN
 
 #include <nonbloppy/EstimateParameters.h>
@@ -633,22 +634,11 @@ class HalfCpuCgroup
 public:
     HalfCpuCgroup()
     {
-        std::string unified, cpuV1;
-        bool hasV1 = false;
-        std::ifstream cgroups("/proc/self/cgroup");
-        for (std::string line; std::getline(cgroups, line);) {
-            // "ID:CONTROLLERS:PATH"
-            const size_t first = line.find(':'), second = line.find(':', first + 1);
-            if (first == std::string::npos || second == std::string::npos) continue;
-            const std::string controllers = "," + line.substr(first + 1, second - first - 1) + ",";
-            if (line.rfind("0::", 0) == 0) unified = line.substr(3);
-            if (controllers.find(",cpu,") != std::string::npos) {
-                hasV1 = true;
-                cpuV1 = line.substr(second + 1);
-            }
-        }
-        const std::string name = "/nonbloppy_test_" + std::to_string(::getpid());
-        std::string dir = hasV1 ? "/sys/fs/cgroup/cpu" + cpuV1 + name : "/sys/fs/cgroup" + unified + name;
+        // Where the tool looks for the limit (CpuLimit.h): a child of the suite's cgroup.
+        const std::optional<nonbloppy_tool::CpuCgroup> parent = nonbloppy_tool::cpuCgroup();
+        if (!parent) return;
+        const bool v1 = parent->v1;
+        const std::string dir = parent->directory() + "/nonbloppy_test_" + std::to_string(::getpid());
         if (::mkdir(dir.c_str(), 0755) != 0) return;
         // A cgroup file system fills a new directory with its files; a plain one (a tmpfs
         // where the layout is another) does not, and the test would limit nothing.
@@ -658,7 +648,7 @@ public:
             return;
         }
         mDir = dir;
-        const bool limited = hasV1 ? writeFile(mDir + "/cpu.cfs_period_us", "100000") &&
+        const bool limited = v1 ? writeFile(mDir + "/cpu.cfs_period_us", "100000") &&
                                          writeFile(mDir + "/cpu.cfs_quota_us", "50000")
                                    : writeFile(mDir + "/cpu.max", "50000 100000");
         if (!limited) {

@@ -65,7 +65,7 @@ std::optional<double> limitIn(const std::string& dir, bool v1)
 
 } // namespace
 
-std::optional<double> cgroupCpuLimit(const std::string& procSelfCgroup, const std::string& mountRoot)
+std::optional<CpuCgroup> cpuCgroup(const std::string& procSelfCgroup, const std::string& mountRoot)
 {
     // Lines "ID:CONTROLLERS:PATH": v2's is "0::PATH"; a v1 hierarchy with the cpu controller
     // lists it among others ("4:cpu,cpuacct:/PATH").
@@ -87,32 +87,40 @@ std::optional<double> cgroupCpuLimit(const std::string& procSelfCgroup, const st
             }
         }
     }
-    std::string base = mountRoot, path = unifiedPath;
+    CpuCgroup cgroup;
+    cgroup.v1 = hasV1;
+    cgroup.path = hasV1 ? v1Path : unifiedPath;
     if (hasV1) {
         // Mounted as cpu (often a link to cpu,cpuacct) or under the joined name.
-        base.clear();
         for (const char* name : {"/cpu", "/cpu,cpuacct", "/cpuacct,cpu"}) {
             if (isDirectory(mountRoot + name)) {
-                base = mountRoot + name;
+                cgroup.hierarchy = mountRoot + name;
                 break;
             }
         }
-        if (base.empty()) return std::nullopt;
-        path = v1Path;
-    } else if (!isDirectory(mountRoot)) {
+        if (cgroup.hierarchy.empty()) return std::nullopt;
+    } else if (isDirectory(mountRoot)) {
+        cgroup.hierarchy = mountRoot;
+    } else {
         return std::nullopt;
     }
-    while (!path.empty() && path.back() == '/') path.pop_back();
-    if (!isDirectory(base + path)) path.clear();  // a container's own cgroup mounted as the root
+    while (!cgroup.path.empty() && cgroup.path.back() == '/') cgroup.path.pop_back();
+    if (!isDirectory(cgroup.directory())) cgroup.path.clear();  // a container's own cgroup mounted as the root
+    return cgroup;
+}
 
+std::optional<double> cgroupCpuLimit(const std::string& procSelfCgroup, const std::string& mountRoot)
+{
+    std::optional<CpuCgroup> cgroup = cpuCgroup(procSelfCgroup, mountRoot);
+    if (!cgroup) return std::nullopt;
     // The lowest limit from the process's cgroup up to the root.
     std::optional<double> lowest;
     for (;;) {
-        const std::optional<double> limit = limitIn(base + path, hasV1);
+        const std::optional<double> limit = limitIn(cgroup->directory(), cgroup->v1);
         if (limit && (!lowest || *limit < *lowest)) lowest = limit;
-        if (path.empty()) break;
-        const size_t parent = path.rfind('/');
-        path.erase(parent == std::string::npos ? 0 : parent);
+        if (cgroup->path.empty()) break;
+        const size_t parent = cgroup->path.rfind('/');
+        cgroup->path.erase(parent == std::string::npos ? 0 : parent);
     }
     return lowest;
 }

@@ -22,14 +22,33 @@
 
 namespace nonbloppy_tool {
 
+/// This process's cgroup for the cpu controller, as @a procSelfCgroup names it under
+/// @a mountRoot.
+struct CpuCgroup
+{
+    /// The hierarchy's directory: @a mountRoot for v2, its cpu controller's directory for v1
+    /// (`cpu`, or the joined `cpu,cpuacct`).
+    std::string hierarchy;
+    /// The process's cgroup in it, "/kubepods/pod7/ctr1"; empty where that directory is
+    /// missing, as inside a container whose own cgroup is mounted as the root.
+    std::string path;
+    bool v1 = false;  ///< the limit is spelled cpu.cfs_quota_us over cpu.cfs_period_us, not cpu.max
+
+    std::string directory() const { return hierarchy + path; }
+};
+
+/// Where the cgroup of this process lies (see CpuCgroup); nullopt without a cgroup file
+/// system under @a mountRoot. Cost: a read of @a procSelfCgroup and a few stat calls.
+std::optional<CpuCgroup> cpuCgroup(const std::string& procSelfCgroup = "/proc/self/cgroup",
+                                   const std::string& mountRoot = "/sys/fs/cgroup");
+
 /// The CPU bandwidth the cgroup of this process may use, in CPUs (quota over period: 0.5 is
 /// half of one CPU's time, 4 four CPUs'), the lowest along its path up to the hierarchy's
 /// root, since a parent's limit binds its children (Kubernetes sets the pod's, above the
 /// container's). cgroup v2 `cpu.max` ("max" is none), or, where a v1 hierarchy has the cpu
-/// controller, `cpu.cfs_quota_us` (-1 is none) over `cpu.cfs_period_us`. The path is the one
-/// @a procSelfCgroup names under @a mountRoot; where that is missing, as inside a container
-/// whose cgroup is mounted as the root, the root's own files. nullopt without a limit or a
-/// readable cgroup file system. Cost: a few small file reads.
+/// controller, `cpu.cfs_quota_us` (-1 is none) over `cpu.cfs_period_us`, from cpuCgroup()
+/// up. nullopt without a limit or a readable cgroup file system. Cost: a few small file
+/// reads.
 std::optional<double> cgroupCpuLimit(const std::string& procSelfCgroup = "/proc/self/cgroup",
                                      const std::string& mountRoot = "/sys/fs/cgroup");
 
