@@ -161,9 +161,14 @@ for size in "${sizes[@]}"; do
   say "Wall ratio of each alternating pair, ${size}x: ${pair_ratios[$size]}."
 done
 say ""
+# The linearity target's figure: per-particle wall time at 512x over that at 64x.
+linearity=-
+if [ -n "${nb_wall[512]:-}" ]; then
+  linearity=$(awk -v a="${nb_wall[512]}" -v b="${nb_wall[64]}" 'BEGIN {printf "%.2f", (a / 512) / (b / 64)}')
+fi
 say "Per-particle wall time, 512x relative to 64x (1.00 = linear): $(
-  if [ -n "${nb_wall[512]:-}" ]; then
-    awk -v a="${nb_wall[512]}" -v b="${nb_wall[64]}" 'BEGIN {printf "%.2f", (a / 512) / (b / 64)}'
+  if [ "$linearity" != - ]; then
+    printf '%s' "$linearity"
     printf '; per-particle CPU time (user + system): '
     awk -v a="${nb_cpu[512]}" -v b="${nb_cpu[64]}" 'BEGIN {printf "%.2f", (a / 512) / (b / 64)}'
     printf '; each round (512x and 64x runs of one round): '
@@ -352,10 +357,6 @@ say "Paper comparison: the 24,389-particle frame computes in ${compute} s (stage
 # The summary: what the README shows (--update-readme), also at the end of the report: the
 # run, the main table, and each target of the performance issue with its figure in this run
 # and whether this run met it (targets_table.sh).
-linearity=-
-if [ -n "${nb_wall[512]:-}" ]; then
-  linearity=$(awk -v a="${nb_wall[512]}" -v b="${nb_wall[64]}" 'BEGIN {printf "%.2f", (a / 512) / (b / 64)}')
-fi
 figures=(wall64="${wall_ratio_of[64]}" pairs64="${pair_ratios[64]}" rss64="${rss_ratio_of[64]}"
          iteration_fixed="$iteration_fixed" iteration_calibrated="$iteration_calibrated"
          two_threads="$two_threads" two_thread_pairs="$two_thread_pairs" paper_seconds="$paper_seconds")
