@@ -561,6 +561,14 @@ TEST_F(CliSequenceTest, SplitRangesGiveTheSameFiles)
     }
 }
 
+/// The number after "@a key": in a --log line; -1 if the line has no such key.
+double numberAfter(const std::string& line, const std::string& key)
+{
+    const std::string marker = "\"" + key + "\": ";
+    const size_t at = line.find(marker);
+    return at == std::string::npos ? -1.0 : std::strtod(line.c_str() + at + marker.size(), nullptr);
+}
+
 TEST_F(CliSequenceTest, LogHasOneObjectPerFrameAndASummary)
 {
     makeFrames({kCube, kCube});
@@ -587,10 +595,6 @@ TEST_F(CliSequenceTest, LogHasOneObjectPerFrameAndASummary)
     // which holds each frame's (and the start, and the writing of the log). Not their sum: the
     // first frame's files are written while the second frame runs, and the CPU time of that
     // overlap counts in both frames (CI saw the sum exceed the summary by 49 us).
-    const auto numberAfter = [](const std::string& line, const std::string& key) {
-        const size_t at = line.find("\"" + key + "\": ");
-        return at == std::string::npos ? -1.0 : std::stod(line.substr(at + key.size() + 4));
-    };
     const double frame1Cpu = numberAfter(logLines[0], "cpu_seconds"), frame2Cpu = numberAfter(frame2, "cpu_seconds");
     EXPECT_GT(frame1Cpu, 0.0) << logLines[0];
     EXPECT_GT(frame2Cpu, 0.0) << frame2;
@@ -680,14 +684,6 @@ TEST_F(CliSequenceTest, VerbosePrintsBytesPerParticle)
     EXPECT_NE(r.err.find("getrusage ru_maxrss"), std::string::npos) << r.err;
 }
 
-/// The @a key ("peak_rss_bytes", "rss_bytes") of a --log line, in MiB; -1 if absent.
-double residentMiB(const std::string& log, const std::string& key = "peak_rss_bytes")
-{
-    const std::string marker = "\"" + key + "\": ";
-    const size_t at = log.rfind(marker);
-    return at == std::string::npos ? -1.0 : std::strtod(log.c_str() + at + marker.size(), nullptr) / (1024.0 * 1024.0);
-}
-
 TEST_F(CliSequenceTest, ASequencePeaksNoHigherAfterItsSecondFrame)
 {
 #ifdef NONBLOPPY_TEST_ASAN
@@ -717,8 +713,9 @@ TEST_F(CliSequenceTest, ASequencePeaksNoHigherAfterItsSecondFrame)
     const std::vector<std::string> logLines = lines(readText(out("run.jsonl")));
     ASSERT_EQ(logLines.size(), 5u);
     ASSERT_NE(logLines[1].find("{\"frame\": 2, "), std::string::npos) << logLines[1];
-    const double second = residentMiB(logLines[1]);
-    const double all = residentMiB(logLines[4]);
+    const double mebibyte = 1024.0 * 1024.0;
+    const double second = numberAfter(logLines[1], "peak_rss_bytes") / mebibyte;
+    const double all = numberAfter(logLines[4], "peak_rss_bytes") / mebibyte;
     ASSERT_GT(second, 0.0);
     ASSERT_GT(all, 0.0);  // -1: the log has no peak_rss_bytes
     EXPECT_LT(all, 1.1 * second) << "second frame done " << second << " MiB, all four " << all << " MiB";
@@ -727,7 +724,7 @@ TEST_F(CliSequenceTest, ASequencePeaksNoHigherAfterItsSecondFrame)
     // stages freed must be back with the system, not kept in glibc's heap for a next frame.
     // Measured: 42-51 MiB at the end against peaks of 116-127 (0.36-0.40); with the
     // per-frame malloc_trim taken out, 74-81 MiB against 120-127 (0.61-0.65).
-    const double end = residentMiB(logLines[4], "rss_bytes");
+    const double end = numberAfter(logLines[4], "rss_bytes") / mebibyte;
     ASSERT_GT(end, 0.0) << logLines[4];  // -1: the summary has no rss_bytes
     EXPECT_LT(end, 0.5 * all) << "resident at the end " << end << " MiB, peak " << all << " MiB";
 }
