@@ -53,8 +53,7 @@ int runConvert(const ConvertOptions& o)
     SignalHandlerScope signals;
     // The readers and writers run in parallel: no more workers than the CPUs a container or
     // job grants (CpuLimit.h).
-    std::string threadsOrigin;
-    const std::unique_ptr<tbb::global_control> threadLimit = limitWorkers(0, threadsOrigin);
+    const std::unique_ptr<tbb::global_control> threadLimit = limitWorkers(0);
     const WarningPrinter printer;
     const nonbloppy::ParticleSet particles = [&] {
         const InputReadScope reading;  // may block (a FIFO): see kStuckReadSeconds

@@ -10,6 +10,7 @@
 #include <cstdio>
 #include <fstream>
 #include <sstream>
+#include <utility>
 #include <vector>
 
 namespace nonbloppy_tool {
@@ -144,18 +145,21 @@ std::string formatCpus(double cpus)
     return text;
 }
 
-std::unique_ptr<tbb::global_control> limitWorkers(int given, std::string& origin)
+std::unique_ptr<tbb::global_control> limitWorkers(int given, std::string* origin)
 {
+    const auto tell = [origin](std::string text) {
+        if (origin) *origin = std::move(text);
+    };
     if (given > 0) {
-        origin = "(given)";
+        tell("(given)");
         return std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, size_t(given));
     }
     const DefaultThreads fallback = defaultThreads();
     if (!fallback.cpuLimit) {
-        origin = "(default)";
+        tell("(default)");
         return nullptr;
     }
-    origin = "(the cgroup's CPU limit, " + formatCpus(*fallback.cpuLimit) + ")";
+    tell("(the cgroup's CPU limit, " + formatCpus(*fallback.cpuLimit) + ")");
     return std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
                                                  size_t(fallback.threads));
 }

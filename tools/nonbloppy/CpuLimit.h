@@ -68,9 +68,9 @@ std::string formatCpus(double cpus);
 
 /// The workers of a command: @a given threads where the user gave --threads (> 0), else
 /// defaultThreads(). Returns the TBB limit to hold for the command's run (null where TBB's
-/// default stands) and sets @a origin to how the count came about, for the summary:
+/// default stands) and, if asked, sets @a origin to how the count came about, for the summary:
 /// "(given)", "(default)" or "(the cgroup's CPU limit, 0.5 CPUs)".
-std::unique_ptr<tbb::global_control> limitWorkers(int given, std::string& origin);
+std::unique_ptr<tbb::global_control> limitWorkers(int given, std::string* origin = nullptr);
 
 } // namespace nonbloppy_tool
 

@@ -1088,9 +1088,7 @@ int runSequence(const MeshOptions& o)
         throw;
     }
 
-    std::string threadsOrigin;
-    const std::unique_ptr<tbb::global_control> threadLimit =
-        limitWorkers(o.threadsOpt->count() > 0 ? o.threads : 0, threadsOrigin);
+    const std::unique_ptr<tbb::global_control> threadLimit = limitWorkers(o.threadsOpt->count() > 0 ? o.threads : 0);
     SignalHandlerScope signals;
 
     BatchSettings settings;
@@ -1190,7 +1188,7 @@ int runMesh(const MeshOptions& o)
 
     std::string threadsOrigin;
     const std::unique_ptr<tbb::global_control> threadLimit =
-        limitWorkers(o.threadsOpt->count() > 0 ? o.threads : 0, threadsOrigin);
+        limitWorkers(o.threadsOpt->count() > 0 ? o.threads : 0, &threadsOrigin);
     const int threads = static_cast<int>(
         tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
 
