@@ -9,9 +9,9 @@
 
 #include "../src/AtomicFile.h"
 #include "CliTestUtil.h"
-#include "CpuLimit.h"
 #include "TestUtil.h"  // NONBLOPPY_TEST_ASAN
 
+#include <nonbloppy/CgroupLimits.h>
 #include <nonbloppy/EstimateParameters.h>
 #include <nonbloppy/ReadParticles.h>
 #include <nonbloppy/ReadVdb.h>
@@ -24,8 +24,10 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <limits>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -67,6 +69,10 @@ protected:
         return run("mesh " + quote(kCube) + " -o " + quote(out(name + ".obj")) + " --vdb "
                    + quote(out(name + ".vdb")) + " " + extra);
     }
+    std::string writeSparseParticles() const;
+    /// The arguments that mesh writeSparseParticles()'s file.
+    std::string meshSparseParticles(const std::string& input) const;
+    double expectSparseParticlesRefused(const RunResult& r, const std::string& input) const;
 };
 
 } // namespace
@@ -171,6 +177,44 @@ std::string expectMemoryRefusal(const RunResult& r, const std::string& head, con
     return r.err;
 }
 
+/// 4096 particles 3 apart, in.../sparse.csv, whose density grid at meshSparseParticles()'s
+/// parameters takes 5.57 GB to 11.1 GB. Returns the file's path.
+std::string CliTest::writeSparseParticles() const
+{
+    std::string csv = "x,y,z\n";
+    for (int i = 0; i < 16 * 16 * 16; ++i) {
+        csv += std::to_string(3 * (i % 16)) + "," + std::to_string(3 * (i / 16 % 16)) + "," + std::to_string(3 * (i / 256))
+               + "\n";
+    }
+    const std::string input = in("sparse.csv");
+    writeText(input, csv);
+    return input;
+}
+
+std::string CliTest::meshSparseParticles(const std::string& input) const
+{
+    return "mesh " + quote(input) + " -o " + quote(out("s.ply")) + " --radius 1 --voxel-size 0.0325 --threshold 2"
+           " --threads 2";
+}
+
+/// The refusal of meshSparseParticles(): the message as the memory checks word it, nothing
+/// written. Returns what it says the process can still take, in GB (0 where unreadable).
+double CliTest::expectSparseParticlesRefused(const RunResult& r, const std::string& input) const
+{
+    const std::string head = "nonbloppy: " + input + ": the density grid (up to 5088448 leaves of 8^3 voxels) of "
+                             "these particles at --voxel-size 0.0325 and --radius 1 would take 5.57 GB to 11.1 GB, more "
+                             "than the ";
+    const std::string tail = " this process can still take: give a larger --voxel-size or a smaller --radius\n";
+    const std::string message = expectMemoryRefusal(r, head, tail, dir() + "/out");
+    if (message.rfind(head, 0) != 0 || message.size() <= head.size() + tail.size()) return 0.0;
+    size_t digits = 0;
+    double headroom = std::stod(message.substr(head.size()), &digits);  // in GB, or MB below 1 GB
+    const std::string unit = message.substr(head.size() + digits, 3);
+    if (unit == " MB") headroom /= 1000.0;
+    else EXPECT_EQ(unit, " GB") << message;
+    return headroom;
+}
+
 TEST_F(CliTest, ADensityGridLargerThanTheMemoryIsRefusedBeforeItIsAllocated)
 {
 #if defined(NONBLOPPY_TEST_ASAN)
@@ -179,32 +223,13 @@ TEST_F(CliTest, ADensityGridLargerThanTheMemoryIsRefusedBeforeItIsAllocated)
     // 4096 particles 3 apart, each with a sphere of 62 voxels across: about 6 GB of density
     // leaves. Under a 1.5 GB limit the run ended in "out of memory" (bug hunt); on a
     // smaller farm node, in the kernel's OOM killer.
-    std::string csv = "x,y,z\n";
-    for (int i = 0; i < 16 * 16 * 16; ++i) {
-        csv += std::to_string(3 * (i % 16)) + "," + std::to_string(3 * (i / 16 % 16)) + "," + std::to_string(3 * (i / 256))
-               + "\n";
-    }
-    const std::string input = in("sparse.csv");
-    writeText(input, csv);
-    const RunResult r = runWithAddressLimit(
-        1500000, "mesh " + quote(input) + " -o " + quote(out("s.ply")) + " --radius 1 --voxel-size 0.0325 --threshold 2"
-                     " --threads 2");
+    const std::string input = writeSparseParticles();
+    const RunResult r = runWithAddressLimit(1500000, meshSparseParticles(input));
     // What the process can still take is the limit less what it holds by then (libraries,
     // thread stacks, the particles and their index): below 1.54 GB. Two threads: each more
     // takes about 70 MB of address space (its stack and malloc arena), so the default count
     // on a machine of 12 cores would leave less than the 0.5 GB checked below.
-    const std::string head = "nonbloppy: " + input + ": the density grid (up to 5088448 leaves of 8^3 voxels) of "
-                             "these particles at --voxel-size 0.0325 and --radius 1 would take 5.57 GB to 11.1 GB, more "
-                             "than the ";
-    const std::string tail = " this process can still take: give a larger --voxel-size or a smaller --radius\n";
-    const std::string message = expectMemoryRefusal(r, head, tail, dir() + "/out");
-    ASSERT_EQ(message.rfind(head, 0), 0u);
-    ASSERT_GT(message.size(), head.size() + tail.size());
-    size_t digits = 0;
-    double headroom = std::stod(message.substr(head.size()), &digits);  // in GB, or MB below 1 GB
-    const std::string unit = message.substr(head.size() + digits, 3);
-    if (unit == " MB") headroom /= 1000.0;
-    else EXPECT_EQ(unit, " GB") << message;
+    const double headroom = expectSparseParticlesRefused(r, input);
     EXPECT_GT(headroom, 0.5);
     EXPECT_LT(headroom, 1.54);
 #endif
@@ -626,50 +651,70 @@ TEST_F(CliTest, VdbPrintReadsTheCache)
     EXPECT_NE(printed.find("effective_radius"), std::string::npos) << printed;
 }
 
-/// A child of this process's CPU cgroup limited to half a CPU, for as long as it lives; its
-/// directory empty where the machine does not let a test make one (not root, a read-only
-/// or delegated cgroup file system, no cpu controller there).
-class HalfCpuCgroup
+/// A cgroup a test makes below this process's own for @a controller, with the limit files
+/// @a v1Limits or @a v2Limits (as the hierarchy is v1 or v2) and, if @a child names one, a
+/// child without limits of its own, where commands then run. Both go when it does. Its
+/// directories are empty where the machine does not let a test make one (not root, a
+/// read-only or delegated cgroup file system, no such controller there).
+class ScratchCgroup
 {
 public:
-    HalfCpuCgroup()
+    using Files = std::vector<std::pair<std::string, std::string>>;  // {name, contents}
+
+    ScratchCgroup(nonbloppy::CgroupController controller, const Files& v1Limits, const Files& v2Limits,
+                  const std::string& child = "")
     {
-        // Where the tool looks for the limit (CpuLimit.h): a child of the suite's cgroup.
-        const std::optional<nonbloppy_tool::CpuCgroup> parent = nonbloppy_tool::cpuCgroup();
+        // Where the library looks for limits (CgroupLimits.h): below the suite's cgroup.
+        const std::optional<nonbloppy::CgroupLocation> parent = nonbloppy::findCgroup(controller);
         if (!parent) return;
-        const bool v1 = parent->v1;
-        const std::string dir = parent->directory() + "/nonbloppy_test_" + std::to_string(::getpid());
-        if (::mkdir(dir.c_str(), 0755) != 0) return;
+        if (!makeCgroup(parent->directory() + "/nonbloppy_test_" + std::to_string(::getpid()), mDir)) return;
+        for (const auto& [name, text] : parent->v1 ? v1Limits : v2Limits) {
+            if (!writeFile(mDir + "/" + name, text)) {
+                ::rmdir(mDir.c_str());
+                mDir.clear();
+                return;
+            }
+        }
+        if (!child.empty() && !makeCgroup(mDir + "/" + child, mChild)) {
+            ::rmdir(mDir.c_str());
+            mDir.clear();
+        }
+    }
+    ~ScratchCgroup()
+    {
+        // Empty again once the commands ended.
+        if (!mChild.empty()) ::rmdir(mChild.c_str());
+        if (!mDir.empty()) ::rmdir(mDir.c_str());
+    }
+    /// A shell prefix that moves the command after it into the cgroup (its child, if made);
+    /// empty where none could be made.
+    std::string enter() const
+    {
+        const std::string& where = mChild.empty() ? mDir : mChild;
+        return where.empty() ? std::string() : "echo $$ > " + quote(where + "/cgroup.procs") + " && exec ";
+    }
+
+private:
+    static bool makeCgroup(const std::string& dir, std::string& made)
+    {
+        if (::mkdir(dir.c_str(), 0755) != 0) return false;
         // A cgroup file system fills a new directory with its files; a plain one (a tmpfs
         // where the layout is another) does not, and the test would limit nothing.
         if (::access((dir + "/cgroup.procs").c_str(), F_OK) != 0) {
             std::error_code ec;
             std::filesystem::remove_all(dir, ec);
-            return;
+            return false;
         }
-        mDir = dir;
-        const bool limited = v1 ? writeFile(mDir + "/cpu.cfs_period_us", "100000") &&
-                                         writeFile(mDir + "/cpu.cfs_quota_us", "50000")
-                                   : writeFile(mDir + "/cpu.max", "50000 100000");
-        if (!limited) {
-            ::rmdir(mDir.c_str());
-            mDir.clear();
-        }
+        made = dir;
+        return true;
     }
-    ~HalfCpuCgroup()
-    {
-        if (!mDir.empty()) ::rmdir(mDir.c_str());  // empty again once the commands ended
-    }
-    const std::string& dir() const { return mDir; }
-
-private:
     static bool writeFile(const std::string& path, const std::string& text)
     {
         std::ofstream file(path);
         file << text << std::flush;
         return bool(file);
     }
-    std::string mDir;
+    std::string mDir, mChild;
 };
 
 TEST_F(CliTest, ThreadsDefaultToTheCpuLimitOfTheCgroup)
@@ -678,9 +723,11 @@ TEST_F(CliTest, ThreadsDefaultToTheCpuLimitOfTheCgroup)
     // core all the same, which the kernel then throttles. mesh and convert run as many as
     // the limit rounds up to unless --threads says otherwise; the output does not change.
     if (tbb::info::default_concurrency() < 2) GTEST_SKIP() << "one core: no limit to lower";
-    const HalfCpuCgroup cgroup;
-    if (cgroup.dir().empty()) GTEST_SKIP() << "cannot make a cgroup with a CPU limit here";
-    const std::string enter = "echo $$ > " + quote(cgroup.dir() + "/cgroup.procs") + " && exec ";
+    const ScratchCgroup halfCpu(nonbloppy::CgroupController::Cpu,
+                                {{"cpu.cfs_period_us", "100000"}, {"cpu.cfs_quota_us", "50000"}},
+                                {{"cpu.max", "50000 100000"}});
+    const std::string enter = halfCpu.enter();
+    if (enter.empty()) GTEST_SKIP() << "cannot make a cgroup with a CPU limit here";
     const RunResult limited = runAfter(enter, "mesh " + quote(kCube) + " -o " + quote(out("limited.obj")));
     ASSERT_EQ(limited.exitCode, 0) << limited.err;
     EXPECT_NE(limited.out.find("\n  threads              1              (the cgroup's CPU limit, 0.5 CPUs)\n"),
@@ -695,6 +742,24 @@ TEST_F(CliTest, ThreadsDefaultToTheCpuLimitOfTheCgroup)
     EXPECT_EQ(readText(out("given.obj")), readText(out("free.obj")));
     const RunResult converted = runAfter(enter, "convert " + quote(kCube) + " " + quote(out("cube.ply")));
     EXPECT_EQ(converted.exitCode, 0) << converted.err;
+}
+
+TEST_F(CliTest, AParentCgroupsMemoryLimitBinds)
+{
+    // Slurm limits a job's memory and runs its steps in cgroups below it; Kubernetes limits a
+    // pod above its containers; systemd a slice above its services. The memory checks read
+    // only the process's own cgroup and the root, so under such a parent's limit the 6 GB
+    // density grid was not refused: the kernel's OOM killer ended the run (exit 137).
+    const ScratchCgroup job(nonbloppy::CgroupController::Memory, {{"memory.limit_in_bytes", "1500M"}},
+                            {{"memory.max", "1500M"}}, "step");
+    const std::string enter = job.enter();
+    if (enter.empty()) GTEST_SKIP() << "cannot make a cgroup with a memory limit here";
+    const std::string input = writeSparseParticles();
+    const double headroom = expectSparseParticlesRefused(runAfter(enter, meshSparseParticles(input)), input);
+    // The job's 1.57 GB (1500 MiB) less what the process and the page cache charged to it
+    // hold by then.
+    EXPECT_GT(headroom, 1.0);
+    EXPECT_LE(headroom, 1.573);
 }
 
 TEST_F(CliTest, OutputDoesNotDependOnThreadCount)

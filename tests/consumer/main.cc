@@ -4,9 +4,12 @@
 // Exit status 0 on success; prints what failed otherwise.
 
 #include <nonbloppy/BuildSurface.h>
+#include <nonbloppy/CgroupLimits.h>
 #include <nonbloppy/Error.h>
 #include <nonbloppy/MeasureMesh.h>
 #include <nonbloppy/Version.h>
+
+#include <tbb/global_control.h>
 
 #include <cmath>
 #include <cstdio>
@@ -35,6 +38,11 @@ int main()
 {
     check(std::strcmp(nonbloppy::version(), NONBLOPPY_VERSION_STRING) == 0,
           "library version equals header version");
+
+    // Meshed with no more workers than a container's CPU limit grants, as a studio's tool would.
+    const nonbloppy::DefaultThreads threads = nonbloppy::defaultThreads();
+    check(threads.threads >= 1, "defaultThreads() gives at least one worker");
+    tbb::global_control workers(tbb::global_control::max_allowed_parallelism, size_t(threads.threads));
 
     // One particle: the density r_e/d − 1 equals r_0 at d = r_e/(1 + r_0), a sphere.
     const double re = 1.0, r0 = 1.0, h = 0.05;
