@@ -8,12 +8,15 @@
 /// Copy (i, j, k) is the input translated by (i·(Δx + gap), j·(Δy + gap), k·(Δz + gap)), where
 /// Δ is the extent of the input's bounding box and gap defaults to 0.05 (the spacing of the
 /// repository's dam-break frames), so copies never touch. Copies are written with i fastest,
-/// then j, then k, each in the input's particle order. The output is binary little-endian PLY
-/// with float x y z only; the same input and options give the same bytes on every machine.
-/// Written to a temporary file beside OUT and renamed, so OUT is never half-written.
+/// then j, then k, each in the input's particle order. The output is written by
+/// writeParticles(): binary little-endian PLY, float x y z and, with --attributes, each of the
+/// input's attributes in its type, every copy holding the input's values (ids repeat from copy
+/// to copy); the same input and options give the same bytes on every machine, and OUT is
+/// never half-written.
 
 #include <nonbloppy/Error.h>
 #include <nonbloppy/ReadParticles.h>
+#include <nonbloppy/WriteParticles.h>
 
 #include <algorithm>
 #include <cerrno>
@@ -21,21 +24,20 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
-#include <filesystem>
 #include <iostream>
 #include <string>
 #include <vector>
 
-#include <unistd.h>
 
 namespace {
 
 const char* const kUsage =
-    "usage: nonbloppy_tile IN OUT.ply [--copies N] [--gap G]\n"
+    "usage: nonbloppy_tile IN OUT.ply [--copies N] [--gap G] [--attributes]\n"
     "  IN        particle file (.vtk, .ply, .xyz)\n"
     "  OUT.ply   binary little-endian PLY with N*N*N translated copies of IN\n"
     "  --copies  copies per axis, >= 1 (default 2; 4 -> 64 copies, 8 -> 512 copies)\n"
-    "  --gap     distance between neighbouring copies' bounding boxes (default 0.05)\n";
+    "  --gap     distance between neighbouring copies' bounding boxes (default 0.05)\n"
+    "  --attributes  keep the input's attributes (each copy holds the input's values)\n";
 
 int fail(const std::string& message)
 {
@@ -43,23 +45,21 @@ int fail(const std::string& message)
     return 1;
 }
 
-void putFloatLE(unsigned char* out, float value)
-{
-    uint32_t bits;
-    std::memcpy(&bits, &value, 4);
-    for (int b = 0; b < 4; ++b) out[b] = static_cast<unsigned char>(bits >> (8 * b));
-}
-
 int run(int argc, char** argv)
 {
     std::vector<std::string> positional;
     long copies = 2;
     double gap = 0.05;
+    bool keepAttributes = false;
     for (int a = 1; a < argc; ++a) {
         const std::string arg = argv[a];
         if (arg == "-h" || arg == "--help") {
             std::cout << kUsage;
             return 0;
+        }
+        if (arg == "--attributes") {
+            keepAttributes = true;
+            continue;
         }
         if (arg == "--copies" || arg == "--gap") {
             if (a + 1 >= argc) return fail(arg + " needs a value");
@@ -106,42 +106,33 @@ int run(int argc, char** argv)
     double step[3];
     for (int axis = 0; axis < 3; ++axis) step[axis] = hi[axis] - lo[axis] + gap;
 
-    // Only the file name, so the bytes do not depend on where the input lies.
-    const std::string fileName = std::filesystem::path(inPath).filename().string();
-    const uint64_t total = uint64_t(count) * uint64_t(copies * copies * copies);
-    const std::string header = "ply\nformat binary_little_endian 1.0\n"
-                               "comment nonbloppy_tile " + std::to_string(copies) + "^3 copies of "
-                               + fileName + "\nelement vertex " + std::to_string(total)
-                               + "\nproperty float x\nproperty float y\nproperty float z\nend_header\n";
-
-    const std::string tempPath = outPath + ".tmp-" + std::to_string(::getpid());
-    std::FILE* file = std::fopen(tempPath.c_str(), "wb");
-    if (!file) return fail("cannot write " + outPath + ": " + std::strerror(errno));
-    bool ok = std::fwrite(header.data(), 1, header.size(), file) == header.size();
-
-    std::vector<unsigned char> buffer(count * 12);
-    for (long k = 0; k < copies && ok; ++k)
-        for (long j = 0; j < copies && ok; ++j)
-            for (long i = 0; i < copies && ok; ++i) {
+    const size_t copyCount = size_t(copies * copies * copies);
+    const uint64_t total = uint64_t(count) * copyCount;
+    nonbloppy::ParticleSet tiled;
+    tiled.positions.reserve(size_t(total));
+    for (long k = 0; k < copies; ++k)
+        for (long j = 0; j < copies; ++j)
+            for (long i = 0; i < copies; ++i) {
                 const double offset[3] = {i * step[0], j * step[1], k * step[2]};
-                for (size_t n = 0; n < count; ++n) {
-                    for (int axis = 0; axis < 3; ++axis) {
-                        const float value =
-                            static_cast<float>(double(particles.positions[n][axis]) + offset[axis]);
-                        putFloatLE(&buffer[12 * n + 4 * axis], value);
-                    }
+                for (const openvdb::Vec3f& p : particles.positions) {
+                    tiled.positions.emplace_back(float(double(p[0]) + offset[0]), float(double(p[1]) + offset[1]),
+                                                 float(double(p[2]) + offset[2]));
                 }
-                ok = std::fwrite(buffer.data(), 1, buffer.size(), file) == buffer.size();
             }
-    const int writeErrno = errno;
-    if (std::fclose(file) != 0) ok = false;
-    if (!ok || std::rename(tempPath.c_str(), outPath.c_str()) != 0) {
-        const int error = ok ? errno : writeErrno;
-        std::remove(tempPath.c_str());
-        return fail("cannot write " + outPath + ": " + std::strerror(error));
+    if (keepAttributes) {
+        for (const nonbloppy::ParticleAttribute& attribute : particles.attributes) {
+            nonbloppy::ParticleAttribute copy = attribute;
+            copy.bytes.clear();
+            copy.bytes.reserve(attribute.bytes.size() * copyCount);
+            for (size_t c = 0; c < copyCount; ++c) {
+                copy.bytes.insert(copy.bytes.end(), attribute.bytes.begin(), attribute.bytes.end());
+            }
+            tiled.attributes.push_back(std::move(copy));
+        }
     }
-    std::cout << outPath << ": " << total << " particles (" << copies * copies * copies
-              << " copies of " << count << ")" << std::endl;
+    nonbloppy::writeParticles(tiled, outPath);
+    std::cout << outPath << ": " << total << " particles (" << copyCount << " copies of " << count
+              << (keepAttributes ? ", with their attributes" : "") << ")" << std::endl;
     return 0;
 }
 

@@ -21,7 +21,9 @@
 # nonbloppy runs with voxel size 0.025, r_e = 0.1, c = 0.3, t = 2 and writes binary PLY too.
 # On the 64x input the script also scans t (0, 1, 2, 4) and the thread count (1, 2), runs the
 # faithful method's volume correction and smoothing (`--spacing`, with and without
-# `--no-smooth`), and meshes a six-frame sequence.
+# `--no-smooth`), meshes a six-frame sequence, and meshes the input tiled with the frame's id
+# and velocity: with `--attributes all`, read from VTK, VTU, CSV and OpenVDB points, and
+# written as OBJ.
 # Wall time, CPU time (user + system) and peak RSS come from GNU time. The report is markdown,
 # printed and written to DIR/benchmark.md.
 set -euo pipefail
@@ -191,10 +193,17 @@ say '```'
 # Scaling with t and with threads on the 64x input.
 scan_runs=$runs
 ((quick)) && scan_runs=1
-scan_once() {  # scan_once LABEL ARGS...: one timed run of nonbloppy with ARGS on the 64x input
-  local log="$out/scan_$1"; shift
-  rm -f "$out/scan.ply"
-  run_timed "$log" "$nonbloppy" mesh "$out/dam_break_x64.ply" -o "$out/scan.ply" "$@"
+# scan_file LABEL IN OUT ARGS...: one timed run of nonbloppy meshing IN into OUT with ARGS.
+scan_file() {
+  local log="$out/scan_$1" input="$2" output="$3"; shift 3
+  rm -f "$output"
+  run_timed "$log" "$nonbloppy" mesh "$input" -o "$output" "$@"
+}
+scan_once() { local label="$1"; shift; scan_file "$label" "$out/dam_break_x64.ply" "$out/scan.ply" "$@"; }
+# stage_seconds OUT STAGE: the wall seconds nonbloppy printed for STAGE ("read particles").
+stage_seconds() {
+  sed -n '/^timings/,$p' "$1" | awk -v name="$2" '{line = $0; sub(/^ +/, "", line)
+    if (index(line, name " ") == 1) for (i = 1; i <= NF; ++i) if ($i == "s") {print $(i - 1); exit}}'
 }
 # The settings take turns, run after run, so that a slow spell of the machine (seconds to
 # minutes here) hits them alike: when each setting ran its repetitions back to back, two runs
@@ -338,6 +347,57 @@ sequence_behind=$(per_frame "$out/seq_behind"); sequence_jobs2=$(per_frame "$out
 sequence_behind_rss=$(( $(median 3 "$out/seq_behind") / 1024 )); sequence_jobs2_rss=$(( $(median 3 "$out/seq_jobs2") / 1024 ))
 sequence_row "$seq_frames separate runs" "$(awk -v w="${nb_wall[64]}" -v n="$seq_frames" 'BEGIN {print w * n}')" "$(median 3 "$out/nb_64")"
 
+# Attributes and file formats (no targets): the 64x input tiled with the frame's id (uint32)
+# and velocity (3 x float32), as a simulation writes them; meshed without and with
+# `--attributes all`, read from each format `convert` writes that keeps them, and the mesh
+# written as OBJ against PLY. The runs take turns, as in the t scan.
+attr_input="$out/dam_break_x64_attributes.ply"
+[ -s "$attr_input" ] || "$tile" "$frame" "$attr_input" --copies 4 --attributes > /dev/null
+formats=(vtk vtu csv vdb)
+for format in "${formats[@]}"; do
+  [ -s "${attr_input%.ply}.$format" ] || "$nonbloppy" convert -q "$attr_input" "${attr_input%.ply}.$format"
+done
+labels=(attr_none attr_all obj read_ply "${formats[@]/#/read_}")
+for label in "${labels[@]}"; do rm -f "$out/scan_$label" "$out/scan_$label.stage"; done
+for ((r = 0; r < scan_runs; ++r)); do
+  scan_file attr_none "$attr_input" "$out/scan.ply" "${nb_args[@]}"
+  stage_seconds "$out/scan_attr_none.out" "write mesh" >> "$out/scan_attr_none.stage"
+  stage_seconds "$out/scan_attr_none.out" "read particles" >> "$out/scan_read_ply.stage"
+  ply_bytes=$(stat -c %s "$out/scan.ply")
+  scan_file attr_all "$attr_input" "$out/scan.ply" "${nb_args[@]}" --attributes all
+  stage_seconds "$out/scan_attr_all.out" "interpolate attributes" >> "$out/scan_attr_all.stage"
+  scan_file obj "$attr_input" "$out/scan.obj" "${nb_args[@]}"
+  stage_seconds "$out/scan_obj.out" "write mesh" >> "$out/scan_obj.stage"
+  obj_bytes=$(stat -c %s "$out/scan.obj")
+  for format in "${formats[@]}"; do
+    scan_file "read_$format" "${attr_input%.ply}.$format" "$out/scan.ply" "${nb_args[@]}"
+    stage_seconds "$out/scan_read_$format.out" "read particles" >> "$out/scan_read_$format.stage"
+  done
+done
+rm -f "$out/scan.obj"
+ply_read=$(median_of %.3f < "$out/scan_read_ply.stage")
+megabytes() { awk -v b="$1" 'BEGIN {printf "%.0f", b / 1e6}'; }
+attr_without=$(median 1 "$out/scan_attr_none"); attr_with=$(median 1 "$out/scan_attr_all")
+attr_interpolate=$(median_of %.3f < "$out/scan_attr_all.stage")
+write_ply=$(median_of %.3f < "$out/scan_attr_none.stage"); write_obj=$(median_of %.3f < "$out/scan_obj.stage")
+say ""
+say "Attributes and formats: the 64x input with the frame's \`id\` (uint32) and \`velocity\` (3 x float32), median of $scan_runs runs each, alternating:"
+say ""
+say "| 64x input with id and velocity | wall s | stage s |"
+say "| --- | --- | --- |"
+say "| binary PLY ($(megabytes "$(stat -c %s "$attr_input")") MB), the attributes not carried | $attr_without | read particles $ply_read; write mesh (PLY, $(megabytes "$ply_bytes") MB) $write_ply |"
+say "| \`--attributes all\` | $attr_with | interpolate attributes $attr_interpolate |"
+say "| \`-o mesh.obj\` | $(median 1 "$out/scan_obj") | write mesh (OBJ, $(megabytes "$obj_bytes") MB) $write_obj |"
+read_figures="binary PLY $ply_read s ($(megabytes "$(stat -c %s "$attr_input")") MB)"
+declare -A format_names=([vtk]="legacy VTK" [vtu]="VTU" [csv]="CSV" [vdb]="OpenVDB points")
+for format in "${formats[@]}"; do
+  bytes=$(stat -c %s "${attr_input%.ply}.$format")
+  seconds=$(median_of %.3f < "$out/scan_read_$format.stage")
+  say "| ${format_names[$format]} ($(megabytes "$bytes") MB) | $(median 1 "$out/scan_read_$format") | read particles $seconds |"
+  read_figures="$read_figures, ${format_names[$format]} $seconds s ($(megabytes "$bytes") MB)"
+done
+for label in "${labels[@]}"; do rm -f "$out/scan_$label.stage"; done
+
 # The paper's figure: 14,272 particles, t = 2, about 15 s on a 2008 desktop. Compute time of the
 # 1x frame (24,389 particles; stages without reading and writing) scaled to 14,272 particles.
 # A frame this small computes in under 0.1 s, where one run in three or four is 20-40% slower
@@ -380,6 +440,9 @@ summary="$out/summary.md"
   echo "and smoothing) $spacing_wall s and $spacing_rss MiB, $spacing_smooth s of it the smoothing, $nosmooth_wall s with"
   echo "\`--no-smooth\`; $seq_frames frames in one call, each written while the next is meshed, $sequence_behind of a"
   echo "single-frame run per frame at $sequence_behind_rss MiB, and $sequence_jobs2 with \`--frame-jobs 2\` at $sequence_jobs2_rss MiB."
+  echo "With the frame's \`id\` and \`velocity\` tiled along: $attr_with s with \`--attributes all\` against"
+  echo "$attr_without s without, $attr_interpolate s of it interpolating; the mesh written as OBJ ($(megabytes "$obj_bytes") MB) in $write_obj s"
+  echo "against PLY's ($(megabytes "$ply_bytes") MB) $write_ply s; the particles read as $read_figures."
 } > "$summary"
 say ""
 say "## Summary"
