@@ -8,15 +8,7 @@
 set -euo pipefail
 source_dir="$1"
 script="$source_dir/tests/bench/update_readme.sh"
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
-failures=0
-check() {  # check DESCRIPTION EXPECTED ACTUAL
-  if [ "$2" != "$3" ]; then
-    printf 'FAILED: %s\n--- expected\n%s\n--- actual\n%s\n' "$1" "$2" "$3" >&2
-    failures=$((failures + 1))
-  fi
-}
+source "$(dirname "$0")/check.sh"  # $work, check, finish
 
 begin='<!-- benchmark summary: begin -->'
 end='<!-- benchmark summary: end -->'
@@ -98,5 +90,4 @@ check "a missing figure is refused" "2 targets_table.sh: missing pairs64" "$stat
 readme_table=$(sed -n '/^| target | this run | |$/,/^| paper/p' "$source_dir/README.md")
 check "README targets table: a header, its rule and seven targets" 9 "$(wc -l <<<"$readme_table")"
 
-if ((failures)); then echo "$failures check(s) failed" >&2; exit 1; fi
-echo "test_bench_scripts.sh: all checks passed"
+finish test_bench_scripts.sh

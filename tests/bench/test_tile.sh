@@ -8,15 +8,7 @@ set -euo pipefail
 tile="$1"
 nonbloppy="$2"
 frame="$3/tests/data/dam_break_frame_23_24389_particles.vtk"
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
-failures=0
-check() {  # check DESCRIPTION EXPECTED ACTUAL
-  if [ "$2" != "$3" ]; then
-    printf 'FAILED: %s\n--- expected\n%s\n--- actual\n%s\n' "$1" "$2" "$3" >&2
-    failures=$((failures + 1))
-  fi
-}
+source "$(dirname "$0")/check.sh"  # $work, check, finish
 # json FILE: what `inspect --json` says of FILE.
 json() { "$nonbloppy" inspect --json "$1"; }
 
@@ -48,8 +40,4 @@ set -e
 check "bad --copies exit" 1 "$status"
 check "bad --copies message" "nonbloppy_tile: --copies must be an integer in [1,64], got '0'" "$(cat "$work/err")"
 check "bad --copies leaves no file" "" "$(ls "$work" | grep bad || true)"
-if ((failures)); then
-  echo "test_tile.sh: $failures check(s) failed" >&2
-  exit 1
-fi
-echo "test_tile.sh: all checks passed"
+finish test_tile.sh
