@@ -12,6 +12,7 @@
 #include "TestUtil.h"  // NONBLOPPY_TEST_ASAN
 
 #include <nonbloppy/CgroupLimits.h>
+#include <nonbloppy/CropParticles.h>
 #include <nonbloppy/EstimateParameters.h>
 #include <nonbloppy/ReadParticles.h>
 #include <nonbloppy/ReadVdb.h>
@@ -760,6 +761,52 @@ TEST_F(CliTest, AParentCgroupsMemoryLimitBinds)
     // hold by then.
     EXPECT_GT(headroom, 1.0);
     EXPECT_LE(headroom, 1.573);
+}
+
+TEST_F(CliTest, AParticleBoxMeshesOnlyTheParticlesInsideIt)
+{
+    // The dam-break frame cut at x = 0: the same mesh, attributes and all, as meshing a file
+    // holding only the particles with x <= 0 (cut here by the library, written as PLY).
+    const std::string frame = kData + "/dam_break_frame_23_24389_particles.vtk";
+    const openvdb::BBoxd box(openvdb::Vec3d(-10.0, -10.0, -10.0), openvdb::Vec3d(0.0, 10.0, 10.0));
+    const nonbloppy::ParticleSet half = nonbloppy::cropParticles(nonbloppy::readParticles(frame), box);
+    nonbloppy::writeParticles(half, in("half.ply"));
+    const RunResult cropped =
+        run("mesh " + quote(frame) + " -o " + quote(out("cropped.ply")) + " --attributes id --particle-box -10 -10 -10 0 10 10");
+    ASSERT_EQ(cropped.exitCode, 0) << cropped.err;
+    const RunResult written = run("mesh " + quote(in("half.ply")) + " -o " + quote(out("half.ply")) + " --attributes id");
+    ASSERT_EQ(written.exitCode, 0) << written.err;
+    EXPECT_EQ(readText(out("cropped.ply")), readText(out("half.ply")));
+    EXPECT_NE(cropped.out.find("\n  particles            " + std::to_string(half.size()) +
+                               "          (of 24389, inside --particle-box (-10, -10, -10) -> (0, 10, 10))\n"),
+              std::string::npos) << cropped.out;
+    EXPECT_NE(cropped.out.find("\n  crop particles "), std::string::npos) << cropped.out;  // its timing
+    EXPECT_GT(half.size(), 10000u);
+    EXPECT_LT(half.size(), 20000u);
+}
+
+TEST_F(CliTest, ABadParticleBoxIsRefused)
+{
+    const std::string frame = kData + "/dam_break_frame_23_24389_particles.vtk";
+    const auto refused = [&](const std::string& box) { return run("mesh " + quote(frame) + " -o " + quote(out("m.ply")) + " --particle-box " + box); };
+    const std::vector<std::pair<std::string, std::string>> cases = {
+        {"-1 -1 -1 1 -2 1", "nonbloppy: --particle-box: its minimum y -1 exceeds its maximum -2\n"},
+        {"-1 -1 -1 1 nan 1", "nonbloppy: --particle-box: its maximum y is nan, not a finite number\n"},
+        {"-1 -1 -1 1 1 1e400", "nonbloppy: --particle-box 1e400 lies outside double's range (it reads as infinity)\n"},
+        {"-1 -1 0x1 1 1 1", "nonbloppy: --particle-box needs a number, got '0x1'\n"},
+    };
+    for (const auto& [box, message] : cases) {
+        SCOPED_TRACE(box);
+        const RunResult r = refused(box);
+        EXPECT_EQ(r.exitCode, 2);
+        EXPECT_EQ(r.err, message);
+    }
+    // A box that holds none of the particles: said once the file is read, exit 1.
+    const RunResult empty = refused("10 10 10 11 11 11.5");
+    EXPECT_EQ(empty.exitCode, 1);
+    EXPECT_EQ(empty.err, "nonbloppy: none of the 24389 particles of " + frame +
+                             " lie inside --particle-box (10, 10, 10) -> (11, 11, 11.5)\n");
+    EXPECT_TRUE(listDir(dir() + "/out").empty());
 }
 
 TEST_F(CliTest, OutputDoesNotDependOnThreadCount)

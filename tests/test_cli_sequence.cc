@@ -97,6 +97,24 @@ TEST_F(CliSequenceTest, MeshesEveryFrameFoundWithOneLinePerFrame)
     EXPECT_NE(quads.out.find(" vertices, " + std::to_string(polygons) + " faces, "), std::string::npos) << quads.out;
 }
 
+TEST_F(CliSequenceTest, AParticleBoxCropsEveryFrame)
+{
+    // Each frame is cropped as a single file's run is: the same mesh, and the frame's line
+    // counts the particles meshed. The cube's lower half (y <= 0.35: 7 of its 14 layers).
+    makeFrames({kCube, kCube});
+    const std::string box = " --particle-box 0 0 0 2 0.35 2 --radius 0.1 --voxel-size 0.025";
+    const RunResult sequence = run("mesh " + quote(in("fluid_{}.vtk")) + " -o " + quote(out("mesh_{}.ply")) + box);
+    ASSERT_EQ(sequence.exitCode, 0) << sequence.err;
+    const RunResult single = run("mesh " + quote(kCube) + " -o " + quote(out("single.ply")) + box);
+    ASSERT_EQ(single.exitCode, 0) << single.err;
+    EXPECT_EQ(readText(out("mesh_0001.ply")), readText(out("single.ply")));
+    EXPECT_EQ(readText(out("mesh_0002.ply")), readText(out("single.ply")));
+    EXPECT_NE(sequence.out.find(" -> " + out("mesh_0002.ply") + ": 1183 particles, "), std::string::npos)
+        << sequence.out;
+    EXPECT_NE(single.out.find("(of 2366, inside --particle-box (0, 0, 0) -> (2, 0.35, 2))"), std::string::npos)
+        << single.out;
+}
+
 TEST_F(CliSequenceTest, HashAndPrintfPatterns)
 {
     makeFrames({kFree, kFree}, 9);

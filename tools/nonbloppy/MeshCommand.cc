@@ -15,6 +15,7 @@
 #include "OutputCleanup.h"
 
 #include <nonbloppy/BuildSurface.h>
+#include <nonbloppy/CropParticles.h>
 #include <nonbloppy/Error.h>
 #include <nonbloppy/ReadParticles.h>
 #include <nonbloppy/Timing.h>
@@ -219,6 +220,8 @@ struct MeshOptions
     bool quads = false, quiet = false, verbose = false;
     bool noDirectIo = false;  ///< --no-direct-io: write the mesh through the page cache
     MeshOutputOptions outputs;  ///< --attributes, --vdb-surface, --vdb-points (MeshOutputs.h)
+    std::vector<double> particleBox;  ///< --particle-box X0 Y0 Z0 X1 Y1 Z1, or empty
+    CLI::Option* particleBoxOpt = nullptr;
     // Frame sequences (FrameSequence.h, BatchRun.h).
     std::string frames, logPath;
     int frameJobs = 1;
@@ -232,6 +235,30 @@ struct MeshOptions
                 *adaptivityOpt = nullptr, *threadsOpt = nullptr, *vdbOpt = nullptr,
                 *regionLeavesOpt = nullptr, *maxStepOpt = nullptr, *noSmoothOpt = nullptr;
 };
+
+/// @a box as the summary and errors give it: "(x0, y0, z0) -> (x1, y1, z1)", each number in
+/// the shortest text that reads back as it (the values as given, not rounded to six digits).
+std::string formatBox(const openvdb::BBoxd& box)
+{
+    std::string text;
+    for (const openvdb::Vec3d& corner : {box.min(), box.max()}) {
+        text += text.empty() ? "(" : " -> (";
+        for (int axis = 0; axis < 3; ++axis) {
+            char digits[32];
+            const auto end = std::to_chars(digits, digits + sizeof(digits), corner[axis]).ptr;
+            text += std::string(digits, end) + (axis < 2 ? ", " : ")");
+        }
+    }
+    return text;
+}
+
+/// --particle-box as a box (its six values, minimum first); the whole of space without it.
+openvdb::BBoxd particleBox(const MeshOptions& o)
+{
+    if (o.particleBox.size() != 6) return openvdb::BBoxd(openvdb::Vec3d(-HUGE_VAL), openvdb::Vec3d(HUGE_VAL));
+    const std::vector<double>& b = o.particleBox;
+    return openvdb::BBoxd(openvdb::Vec3d(b[0], b[1], b[2]), openvdb::Vec3d(b[3], b[4], b[5]));
+}
 
 std::optional<double> ifGiven(const CLI::Option* option, double value)
 {
@@ -353,7 +380,7 @@ void validateParameters(const MeshOptions& o)
                                                             o.frameJobsOpt};
     for (const CLI::Option* option : {o.spacingOpt, o.radiusOpt, o.thresholdOpt, o.voxelSizeOpt, o.blendOpt,
                                       o.iterationsOpt, o.adaptivityOpt, o.regionLeavesOpt, o.threadsOpt,
-                                      o.frameJobsOpt, o.maxStepOpt}) {
+                                      o.frameJobsOpt, o.maxStepOpt, o.particleBoxOpt}) {
         if (!option) continue;
         const bool real = std::find(integerOptions.begin(), integerOptions.end(), option) == integerOptions.end();
         for (const std::string& value : option->results()) {
@@ -380,6 +407,15 @@ void validateParameters(const MeshOptions& o)
     }
     if (o.regionLeaves < 0) {
         throw UsageError("--region-leaves must be >= 0, got " + std::to_string(o.regionLeaves));
+    }
+    if (o.particleBoxOpt->count() > 0) {
+        try {
+            nonbloppy::checkParticleBox(particleBox(o));
+        } catch (const nonbloppy::ParameterError& e) {
+            // "particle box: its minimum y 2 exceeds its maximum 1", named as the option.
+            const std::string message = e.what();
+            throw UsageError("--particle-box" + message.substr(message.find(':')));
+        }
     }
     // The paper's method has no step cap and no smoothing: these would be ignored.
     if (o.method == "paper") {
@@ -441,7 +477,8 @@ void validate(const MeshOptions& o)
 std::string origin(bool given, const char* otherwise) { return given ? "(given)" : otherwise; }
 
 void printSummary(const MeshOptions& o, const nonbloppy::SurfaceResult& result,
-                  const nonbloppy::StageTimings& timings, int threads, const std::string& threadsOrigin)
+                  const nonbloppy::StageTimings& timings, int threads, const std::string& threadsOrigin,
+                  size_t particlesRead)
 {
     const nonbloppy::ResolvedParameters& p = result.parameters;
     const nonbloppy::SurfaceMesh& mesh = result.mesh;
@@ -457,7 +494,10 @@ void printSummary(const MeshOptions& o, const nonbloppy::SurfaceResult& result,
 
     out << "input\n";
     row("file", o.input, "");
-    row("particles", std::to_string(result.particleCount), "");
+    row("particles", std::to_string(result.particleCount),
+        o.particleBoxOpt->count() > 0
+            ? "(of " + std::to_string(particlesRead) + ", inside --particle-box " + formatBox(particleBox(o)) + ")"
+            : "");
     out << "parameters\n";
     // The spacing is only estimated when something was derived from it.
     const bool spacingUsed = p.spacingGiven || !p.effectiveRadiusGiven || !p.thresholdGiven
@@ -552,6 +592,7 @@ struct FrameOutcome
     nonbloppy::SurfaceResult result;
     nonbloppy::StageTimings timings;
     std::string faces;  ///< a mesh input's faces not read ("element 'face'"), or ""
+    size_t particlesRead = 0;  ///< in the file, before --particle-box kept result.particleCount
 };
 
 /// A frame read and meshed, its outputs not yet written (see writeFrame()).
@@ -562,6 +603,7 @@ struct MeshedFrame
     nonbloppy::StageTimings before;    ///< "read particles"
     nonbloppy::StageTimings after;     ///< "interpolate attributes", then the writes
     std::string faces;                 ///< what made the input a mesh, or "" (FrameOutcome)
+    size_t particlesRead = 0;          ///< in the file (FrameOutcome)
 };
 
 /// Read o.input and build the surface (with its attributes); writes nothing.
@@ -575,6 +617,18 @@ MeshedFrame meshFrameSurface(const MeshOptions& o, ProgressInterrupter& interrup
     }
     if (frame.particles.size() == 0) {
         throw nonbloppy::FileError("no particles in " + o.input);
+    }
+    frame.particlesRead = frame.particles.size();
+    if (o.particleBoxOpt->count() > 0) {
+        {
+            StageScope stage(interrupter, frame.before, "crop particles");
+            frame.particles = nonbloppy::cropParticles(frame.particles, particleBox(o));
+        }
+        if (frame.particles.size() == 0) {
+            const openvdb::BBoxd box = particleBox(o);
+            throw nonbloppy::ParameterError("none of the " + std::to_string(frame.particlesRead) + " particles of " +
+                                            o.input + " lie inside --particle-box " + formatBox(box));
+        }
     }
     for (const std::string& skipped : frame.particles.skipped) {
         // A mesh's faces, not read: its vertices are meshed (said by warnIfMeshInput()).
@@ -667,6 +721,7 @@ FrameOutcome writeFrame(const MeshOptions& o, MeshedFrame& frame, ProgressInterr
 
     FrameOutcome outcome;
     outcome.faces = frame.faces;
+    outcome.particlesRead = frame.particlesRead;
     outcome.timings = frame.before;
     outcome.timings.add(result.timings);
     outcome.timings.add(frame.after);
@@ -1210,7 +1265,7 @@ int runMesh(const MeshOptions& o)
             sampler->stop();
             std::cerr << sampler->report(outcome.timings, outcome.result.particleCount);
         }
-        if (!o.quiet) printSummary(o, outcome.result, outcome.timings, threads, threadsOrigin);
+        if (!o.quiet) printSummary(o, outcome.result, outcome.timings, threads, threadsOrigin, outcome.particlesRead);
         return 0;
     } catch (const nonbloppy::CancelledError&) {
         // meshFrame() has removed what was written; the library leaves nothing behind.
@@ -1249,6 +1304,11 @@ Command setupMeshCommand(CLI::App& parent)
         ->required()->group(kGroupInputOutput);
     cmd->add_flag("--quads", o.quads, "Keep quads instead of splitting them into triangles")
         ->group(kGroupInputOutput);
+    o.particleBoxOpt = cmd->add_option("--particle-box", o.particleBox,
+        "Mesh only the particles inside the box X0 Y0 Z0 X1 Y1 Z1 (minimum, then maximum corner), its faces "
+        "included, in world units (a tank's walls and floor left out, say); --attributes and --vdb-points take "
+        "those particles too")
+        ->expected(6)->type_name("FLOAT")->group(kGroupInputOutput);
     cmd->add_flag("--no-direct-io", o.noDirectIo,
         "Write the mesh through the page cache (by default meshes of 1 MiB or more bypass it on "
         "local ext4, XFS and Btrfs disks; the bytes are the same)")
@@ -1322,7 +1382,7 @@ Command setupMeshCommand(CLI::App& parent)
         readDecimalOnly(option, /*integer=*/true);
     }
     for (CLI::Option* option : {o.spacingOpt, o.radiusOpt, o.thresholdOpt, o.voxelSizeOpt, o.blendOpt,
-                                o.adaptivityOpt, o.maxStepOpt}) {
+                                o.adaptivityOpt, o.maxStepOpt, o.particleBoxOpt}) {
         readDecimalOnly(option, /*integer=*/false);
     }
 
