@@ -809,6 +809,35 @@ TEST_F(CliTest, ABadParticleBoxIsRefused)
     EXPECT_TRUE(listDir(dir() + "/out").empty());
 }
 
+TEST_F(CliTest, ConvertWithAParticleBoxWritesOnlyTheParticlesInsideIt)
+{
+    const std::string frame = kData + "/dam_break_frame_23_24389_particles.vtk";
+    const nonbloppy::ParticleSet half = nonbloppy::cropParticles(
+        nonbloppy::readParticles(frame), openvdb::BBoxd(openvdb::Vec3d(-10.0), openvdb::Vec3d(0.0, 10.0, 10.0)));
+    const RunResult r = run("convert " + quote(frame) + " " + quote(out("half.ply")) + " --particle-box -10 -10 -10 0 10 10");
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_EQ(r.out, "converted " + std::to_string(half.size()) +
+                         " particles (of 24389, inside --particle-box (-10, -10, -10) -> (0, 10, 10)) with 2 attributes: " +
+                         frame + " -> " + out("half.ply") + "\n");
+    const nonbloppy::ParticleSet written = nonbloppy::readParticles(out("half.ply"));
+    EXPECT_EQ(written.positions, half.positions);
+    ASSERT_EQ(written.attributes.size(), 2u);
+    EXPECT_EQ(written.attributes[0].bytes, half.attributes[0].bytes);  // id
+    EXPECT_EQ(written.attributes[1].bytes, half.attributes[1].bytes);  // velocity
+    // None inside: the (empty) file is written, as any file of no particles is, and said.
+    const RunResult none = run("convert -q " + quote(frame) + " " + quote(out("none.csv")) + " --particle-box 10 10 10 11 11 11");
+    EXPECT_EQ(none.exitCode, 0);
+    EXPECT_EQ(none.err, "nonbloppy: warning: none of the 24389 particles of " + frame +
+                            " lie inside --particle-box (10, 10, 10) -> (11, 11, 11): " + out("none.csv") +
+                            " holds no particles\n");
+    EXPECT_EQ(nonbloppy::readParticles(out("none.csv")).size(), 0u);
+    // A bad box: exit 2, nothing read or written.
+    const RunResult bad = run("convert " + quote(frame) + " " + quote(out("bad.csv")) + " --particle-box 0 0 0 1 1 -1");
+    EXPECT_EQ(bad.exitCode, 2);
+    EXPECT_EQ(bad.err, "nonbloppy: --particle-box: its minimum z 0 exceeds its maximum -1\n");
+    EXPECT_EQ(listDir(dir() + "/out"), (std::vector<std::string>{"half.ply", "none.csv"}));
+}
+
 TEST_F(CliTest, OutputDoesNotDependOnThreadCount)
 {
     const RunResult one = meshCube("t1", "--threads 1");

@@ -2,15 +2,17 @@
 /// @file ConvertCommand.cc
 /// @brief `nonbloppy convert IN OUT`: a particle file in any format readParticles() reads,
 ///        written as PLY, VTK, VTU, XYZ, CSV or VDB points, with every attribute the output
-///        format can carry.
+///        format can carry; with --particle-box, only the particles inside a box.
 
 #include "Commands.h"
 
 #include "BackgroundRemover.h"
 #include "CpuLimit.h"
 #include "Interrupts.h"
+#include "NumberOptions.h"
 #include "OutputCleanup.h"
 
+#include <nonbloppy/CropParticles.h>
 #include <nonbloppy/Error.h>
 #include <nonbloppy/ReadParticles.h>
 #include <nonbloppy/WriteParticles.h>
@@ -20,6 +22,7 @@
 #include <filesystem>
 #include <iostream>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -32,6 +35,7 @@ struct ConvertOptions
     std::string input, output;
     bool quiet = false;
     bool noDirectIo = false;  ///< --no-direct-io: write through the page cache
+    ParticleBoxOption particleBox;  ///< --particle-box: only the particles inside it
 };
 
 int runConvert(const ConvertOptions& o)
@@ -46,6 +50,7 @@ int runConvert(const ConvertOptions& o)
     if (o.input == o.output || std::filesystem::equivalent(o.input, o.output, ec)) {
         throw UsageError("cannot write " + o.output + ": it is the input file");
     }
+    const std::optional<openvdb::BBoxd> box = o.particleBox.box();
 
     // A stop signal ends the conversion with exit 130 and OUT as it was: it is acted on once
     // IN is read, before anything is written, or once OUT is written, which is then undone.
@@ -55,11 +60,21 @@ int runConvert(const ConvertOptions& o)
     // job grants (CpuLimit.h).
     const std::unique_ptr<tbb::global_control> threadLimit = limitWorkers(0);
     const WarningPrinter printer;
-    const nonbloppy::ParticleSet particles = [&] {
+    nonbloppy::ParticleSet particles = [&] {
         const InputReadScope reading;  // may block (a FIFO): see kStuckReadSeconds
         return nonbloppy::readParticles(o.input);
     }();
     throwIfInterrupted();
+    const size_t particlesRead = particles.size();
+    if (box) {
+        particles = nonbloppy::cropParticles(particles, *box);
+        // Written all the same, as a file of no particles is: said, as it is likely a slip.
+        if (particles.size() == 0 && particlesRead > 0) {
+            WarningLine(printer) << "none of the " << particlesRead << " particles of " << o.input
+                                 << " lie inside --particle-box " << formatBox(*box) << ": " << o.output
+                                 << " holds no particles";
+        }
+    }
     if (!particles.skipped.empty()) {
         WarningLine(printer) << "not read from " << o.input << ", so not converted: " << joinedSkipped(particles);
     }
@@ -86,9 +101,11 @@ int runConvert(const ConvertOptions& o)
     cleanup.keep(remover);
     if (!o.quiet) {
         // As written: .xyz keeps none of them (the warning above names those dropped).
-        std::cout << "converted " << counted(particles.size(), "particle") << " with "
-                  << counted(positionsOnly ? 0 : particles.attributes.size(), "attribute") << ": " << o.input << " -> "
-                  << o.output << std::endl;
+        std::cout << "converted " << counted(particles.size(), "particle")
+                  << (box ? " (of " + std::to_string(particlesRead) + ", inside --particle-box " + formatBox(*box) + ")"
+                          : std::string())
+                  << " with " << counted(positionsOnly ? 0 : particles.attributes.size(), "attribute") << ": "
+                  << o.input << " -> " << o.output << std::endl;
     }
     return 0;
 }
@@ -109,6 +126,7 @@ Command setupConvertCommand(CLI::App& parent)
         "Write through the page cache (by default files of 1 MiB or more bypass it on local ext4, "
         "XFS and Btrfs disks; the bytes are the same)")
         ->group(kGroupInputOutput);
+    options->particleBox.add(cmd, "written with their attributes");
     cmd->add_flag("-q,--quiet", options->quiet, "Print only warnings and errors (stderr)")->group(kGroupDebug);
     return {cmd, [options]() { return runConvert(*options); }};
 }

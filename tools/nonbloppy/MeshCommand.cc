@@ -12,6 +12,7 @@
 #include "FrameSequence.h"
 #include "Interrupts.h"
 #include "Json.h"
+#include "NumberOptions.h"
 #include "OutputCleanup.h"
 
 #include <nonbloppy/BuildSurface.h>
@@ -220,8 +221,7 @@ struct MeshOptions
     bool quads = false, quiet = false, verbose = false;
     bool noDirectIo = false;  ///< --no-direct-io: write the mesh through the page cache
     MeshOutputOptions outputs;  ///< --attributes, --vdb-surface, --vdb-points (MeshOutputs.h)
-    std::vector<double> particleBox;  ///< --particle-box X0 Y0 Z0 X1 Y1 Z1, or empty
-    CLI::Option* particleBoxOpt = nullptr;
+    ParticleBoxOption particleBox;  ///< --particle-box X0 Y0 Z0 X1 Y1 Z1
     // Frame sequences (FrameSequence.h, BatchRun.h).
     std::string frames, logPath;
     int frameJobs = 1;
@@ -235,30 +235,6 @@ struct MeshOptions
                 *adaptivityOpt = nullptr, *threadsOpt = nullptr, *vdbOpt = nullptr,
                 *regionLeavesOpt = nullptr, *maxStepOpt = nullptr, *noSmoothOpt = nullptr;
 };
-
-/// @a box as the summary and errors give it: "(x0, y0, z0) -> (x1, y1, z1)", each number in
-/// the shortest text that reads back as it (the values as given, not rounded to six digits).
-std::string formatBox(const openvdb::BBoxd& box)
-{
-    std::string text;
-    for (const openvdb::Vec3d& corner : {box.min(), box.max()}) {
-        text += text.empty() ? "(" : " -> (";
-        for (int axis = 0; axis < 3; ++axis) {
-            char digits[32];
-            const auto end = std::to_chars(digits, digits + sizeof(digits), corner[axis]).ptr;
-            text += std::string(digits, end) + (axis < 2 ? ", " : ")");
-        }
-    }
-    return text;
-}
-
-/// --particle-box as a box (its six values, minimum first); the whole of space without it.
-openvdb::BBoxd particleBox(const MeshOptions& o)
-{
-    if (o.particleBox.size() != 6) return openvdb::BBoxd(openvdb::Vec3d(-HUGE_VAL), openvdb::Vec3d(HUGE_VAL));
-    const std::vector<double>& b = o.particleBox;
-    return openvdb::BBoxd(openvdb::Vec3d(b[0], b[1], b[2]), openvdb::Vec3d(b[3], b[4], b[5]));
-}
 
 std::optional<double> ifGiven(const CLI::Option* option, double value)
 {
@@ -324,48 +300,6 @@ void requireWritableDirectory(const std::string& path)
     }
 }
 
-/// Read @a option's values as decimal numbers only (integers if @a integer), before CLI11
-/// converts them: CLI11 reads integers with strtoll in base 0, so "-t 010" ran 8 iterations
-/// (octal), "-t 08" was "out of range" and "-t 0x10" 16, and reals with strtold, which takes
-/// hexadecimal ("--spacing 0x1p-4") and leading blanks too (hostile-input audit). An integer
-/// loses its leading zeros ("010" is 10); a real may also be inf or nan (refused or taken by
-/// the range checks, with their own messages); an empty value is left to validateParameters().
-/// @throw UsageError("-t needs an integer, got '0x10'"), "--spacing needs a number, got ' 1'".
-void readDecimalOnly(CLI::Option* option, bool integer)
-{
-    option->transform(
-        [name = option->get_name(), integer](const std::string& given) {
-            std::string value = given;
-            if (value.empty()) return value;
-            const size_t unsignedStart = (value[0] == '+' || value[0] == '-') ? 1 : 0;
-            bool decimal = false;
-            if (integer) {
-                decimal = value.size() > unsignedStart
-                          && value.find_first_not_of("0123456789", unsignedStart) == std::string::npos;
-                if (decimal) {
-                    // Leading zeros off, one digit kept: strtoll must not see an octal number.
-                    const size_t keep = std::min(value.find_first_not_of('0', unsignedStart), value.size() - 1);
-                    value.erase(unsignedStart, keep - unsignedStart);
-                }
-            } else {
-                // std::from_chars reads strtod's decimal forms, inf and nan, and no hexadecimal,
-                // no blanks and no '+' (skipped here, once); nor nan's "(chars)", refused as before.
-                const char* first = value.data() + (value[0] == '+' ? 1 : 0);
-                const char* last = value.data() + value.size();
-                double parsed = 0.0;
-                const auto [end, error] = std::from_chars(first, last, parsed);
-                decimal = end == last && (error == std::errc() || error == std::errc::result_out_of_range)
-                          && !(value[0] == '+' && first < last && *first == '-')  // "+-1"
-                          && value.find('(') == std::string::npos;
-            }
-            if (!decimal) {
-                throw UsageError(name + " needs " + (integer ? "an integer" : "a number") + ", got '" + value + "'");
-            }
-            return value;
-        },
-        "", "");
-}
-
 /// Check everything that can be checked without reading the input, so a mistake costs
 /// nothing and leaves no file behind. The library checks the same ranges again.
 /// validateParameters() checks the numbers, validatePaths() the files of one frame.
@@ -380,23 +314,11 @@ void validateParameters(const MeshOptions& o)
                                                             o.frameJobsOpt};
     for (const CLI::Option* option : {o.spacingOpt, o.radiusOpt, o.thresholdOpt, o.voxelSizeOpt, o.blendOpt,
                                       o.iterationsOpt, o.adaptivityOpt, o.regionLeavesOpt, o.threadsOpt,
-                                      o.frameJobsOpt, o.maxStepOpt, o.particleBoxOpt}) {
+                                      o.frameJobsOpt, o.maxStepOpt}) {
         if (!option) continue;
         const bool real = std::find(integerOptions.begin(), integerOptions.end(), option) == integerOptions.end();
-        for (const std::string& value : option->results()) {
-            if (value.find_first_not_of(" \t") == std::string::npos) {
-                throw UsageError(option->get_name() + " needs a number, got ''");
-            }
-            if (!real) continue;
-            errno = 0;
-            const double parsed = std::strtod(value.c_str(), nullptr);
-            // --max-step 1e400 is +inf, which means no cap, as "inf" does.
-            if (option == o.maxStepOpt && parsed > 0.0) continue;
-            if (errno == ERANGE && (parsed == 0.0 || std::isinf(parsed))) {
-                throw UsageError(option->get_name() + " " + value + " lies outside double's range (it reads as " +
-                                 (parsed == 0.0 ? "0" : parsed > 0.0 ? "infinity" : "-infinity") + ")");
-            }
-        }
+        // --max-step 1e400 is +inf, which means no cap, as "inf" does.
+        requireNumberText(option, real, /*infinityAllowed=*/option == o.maxStepOpt);
     }
     // Every range, and the limits between given lengths (--voxel-size 0.001 with --radius 1),
     // in the library's words: exit 2 before the input is read, not 1 after.
@@ -408,15 +330,7 @@ void validateParameters(const MeshOptions& o)
     if (o.regionLeaves < 0) {
         throw UsageError("--region-leaves must be >= 0, got " + std::to_string(o.regionLeaves));
     }
-    if (o.particleBoxOpt->count() > 0) {
-        try {
-            nonbloppy::checkParticleBox(particleBox(o));
-        } catch (const nonbloppy::ParameterError& e) {
-            // "particle box: its minimum y 2 exceeds its maximum 1", named as the option.
-            const std::string message = e.what();
-            throw UsageError("--particle-box" + message.substr(message.find(':')));
-        }
-    }
+    o.particleBox.box();  // throws for a bad box
     // The paper's method has no step cap and no smoothing: these would be ignored.
     if (o.method == "paper") {
         for (const CLI::Option* option : {o.maxStepOpt, o.noSmoothOpt}) {
@@ -494,10 +408,9 @@ void printSummary(const MeshOptions& o, const nonbloppy::SurfaceResult& result,
 
     out << "input\n";
     row("file", o.input, "");
+    const std::optional<openvdb::BBoxd> box = o.particleBox.box();
     row("particles", std::to_string(result.particleCount),
-        o.particleBoxOpt->count() > 0
-            ? "(of " + std::to_string(particlesRead) + ", inside --particle-box " + formatBox(particleBox(o)) + ")"
-            : "");
+        box ? "(of " + std::to_string(particlesRead) + ", inside --particle-box " + formatBox(*box) + ")" : "");
     out << "parameters\n";
     // The spacing is only estimated when something was derived from it.
     const bool spacingUsed = p.spacingGiven || !p.effectiveRadiusGiven || !p.thresholdGiven
@@ -619,15 +532,14 @@ MeshedFrame meshFrameSurface(const MeshOptions& o, ProgressInterrupter& interrup
         throw nonbloppy::FileError("no particles in " + o.input);
     }
     frame.particlesRead = frame.particles.size();
-    if (o.particleBoxOpt->count() > 0) {
+    if (const std::optional<openvdb::BBoxd> box = o.particleBox.box()) {
         {
             StageScope stage(interrupter, frame.before, "crop particles");
-            frame.particles = nonbloppy::cropParticles(frame.particles, particleBox(o));
+            frame.particles = nonbloppy::cropParticles(frame.particles, *box);
         }
         if (frame.particles.size() == 0) {
-            const openvdb::BBoxd box = particleBox(o);
             throw nonbloppy::ParameterError("none of the " + std::to_string(frame.particlesRead) + " particles of " +
-                                            o.input + " lie inside --particle-box " + formatBox(box));
+                                            o.input + " lie inside --particle-box " + formatBox(*box));
         }
     }
     for (const std::string& skipped : frame.particles.skipped) {
@@ -1304,11 +1216,7 @@ Command setupMeshCommand(CLI::App& parent)
         ->required()->group(kGroupInputOutput);
     cmd->add_flag("--quads", o.quads, "Keep quads instead of splitting them into triangles")
         ->group(kGroupInputOutput);
-    o.particleBoxOpt = cmd->add_option("--particle-box", o.particleBox,
-        "Mesh only the particles inside the box X0 Y0 Z0 X1 Y1 Z1 (minimum, then maximum corner), its faces "
-        "included, in world units (a tank's walls and floor left out, say); --attributes and --vdb-points take "
-        "those particles too")
-        ->expected(6)->type_name("FLOAT")->group(kGroupInputOutput);
+    o.particleBox.add(cmd, "meshed, and taken by --attributes and --vdb-points");
     cmd->add_flag("--no-direct-io", o.noDirectIo,
         "Write the mesh through the page cache (by default meshes of 1 MiB or more bypass it on "
         "local ext4, XFS and Btrfs disks; the bytes are the same)")
@@ -1382,7 +1290,7 @@ Command setupMeshCommand(CLI::App& parent)
         readDecimalOnly(option, /*integer=*/true);
     }
     for (CLI::Option* option : {o.spacingOpt, o.radiusOpt, o.thresholdOpt, o.voxelSizeOpt, o.blendOpt,
-                                o.adaptivityOpt, o.maxStepOpt, o.particleBoxOpt}) {
+                                o.adaptivityOpt, o.maxStepOpt}) {
         readDecimalOnly(option, /*integer=*/false);
     }
 
