@@ -103,7 +103,8 @@ TEST_F(CliSequenceTest, AParticleBoxCropsEveryFrame)
     // counts the particles meshed. The cube's lower half (y <= 0.35: 7 of its 14 layers).
     makeFrames({kCube, kCube});
     const std::string box = " --particle-box 0 0 0 2 0.35 2 --radius 0.1 --voxel-size 0.025";
-    const RunResult sequence = run("mesh " + quote(in("fluid_{}.vtk")) + " -o " + quote(out("mesh_{}.ply")) + box);
+    const RunResult sequence =
+        run("mesh " + quote(in("fluid_{}.vtk")) + " -o " + quote(out("mesh_{}.ply")) + box + " --log " + quote(out("run.jsonl")));
     ASSERT_EQ(sequence.exitCode, 0) << sequence.err;
     const RunResult single = run("mesh " + quote(kCube) + " -o " + quote(out("single.ply")) + box);
     ASSERT_EQ(single.exitCode, 0) << single.err;
@@ -113,6 +114,12 @@ TEST_F(CliSequenceTest, AParticleBoxCropsEveryFrame)
         << sequence.out;
     EXPECT_NE(single.out.find("(of 2366, inside --particle-box (0, 0, 0) -> (2, 0.35, 2))"), std::string::npos)
         << single.out;
+    // The log counts both: the particles meshed and those the frame's file holds.
+    const std::vector<std::string> log = lines(readText(out("run.jsonl")));
+    ASSERT_EQ(log.size(), 3u);  // two frames and the summary
+    for (size_t frame = 0; frame < 2; ++frame) {
+        EXPECT_NE(log[frame].find("\"particles\": 1183, \"particles_read\": 2366, "), std::string::npos) << log[frame];
+    }
 }
 
 TEST_F(CliSequenceTest, HashAndPrintfPatterns)

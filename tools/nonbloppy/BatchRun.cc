@@ -105,6 +105,7 @@ public:
             line += (i ? ", " : "") + jsonString(job.outputs[i]);
         }
         line += "], \"particles\": " + std::to_string(report.particles)
+            + ", \"particles_read\": " + std::to_string(report.particlesRead)
             + ", \"vertices\": " + std::to_string(report.vertices)
             + ", \"faces\": " + std::to_string(report.faces) + ", \"seconds\": {";
         for (size_t i = 0; i < report.timings.entries.size(); ++i) {

@@ -42,7 +42,8 @@ struct BatchJob
 /// What one frame produced, for the progress line and the log.
 struct FrameReport
 {
-    size_t particles = 0, vertices = 0, faces = 0;
+    size_t particles = 0, vertices = 0, faces = 0;  ///< particles meshed (after --particle-box)
+    size_t particlesRead = 0;                         ///< particles in the file
     nonbloppy::StageTimings timings;                         ///< seconds per stage, in order
     std::vector<std::pair<std::string, double>> parameters;  ///< resolved values, by name
 };

@@ -1086,6 +1086,7 @@ int runSequence(const MeshOptions& o)
         const nonbloppy::SurfaceResult& result = outcome.result;
         const nonbloppy::ResolvedParameters& p = result.parameters;
         report.particles = result.particleCount;
+        report.particlesRead = outcome.particlesRead;
         report.vertices = result.mesh.points.size();
         // As written: quads are split into two triangles unless --quads keeps them.
         report.faces = f.quads ? result.mesh.polygonCount() : result.mesh.triangleCount();
