@@ -14,6 +14,7 @@
 #include <nonbloppy/CgroupLimits.h>
 #include <nonbloppy/CropParticles.h>
 #include <nonbloppy/EstimateParameters.h>
+#include <nonbloppy/ReadMesh.h>
 #include <nonbloppy/ReadParticles.h>
 #include <nonbloppy/ReadVdb.h>
 #include <nonbloppy/WriteParticles.h>
@@ -781,6 +782,14 @@ TEST_F(CliTest, AParticleBoxMeshesOnlyTheParticlesInsideIt)
                                "          (of 24389, inside --particle-box (-10, -10, -10) -> (0, 10, 10))\n"),
               std::string::npos) << cropped.out;
     EXPECT_NE(cropped.out.find("\n  crop particles "), std::string::npos) << cropped.out;  // its timing
+    // The surface closes around the kept particles, at most r_e past the box's face x = 0.
+    const size_t radiusAt = cropped.out.find("\n  radius r_e ");
+    ASSERT_NE(radiusAt, std::string::npos) << cropped.out;
+    const double radius = std::stod(cropped.out.substr(radiusAt + 14));
+    float farthest = -1e30f;
+    for (const openvdb::Vec3s& p : nonbloppy::readMesh(out("cropped.ply")).points) farthest = std::max(farthest, p.x());
+    EXPECT_GT(farthest, 0.0f);
+    EXPECT_LT(farthest, radius);
     EXPECT_GT(half.size(), 10000u);
     EXPECT_LT(half.size(), 20000u);
 }

@@ -6,8 +6,8 @@
 /// Simulations leave particles where the surface is not wanted: the domain's walls and
 /// floor (a tank's boundary particles, an emitter), or a region outside the shot. Cropping
 /// before meshing also makes the spacing estimate and the density grid see only what is kept.
-/// The surface near the box's faces is that of the kept particles: it closes just inside the
-/// box (within r_e/(1 + r_0) of the outermost kept particle), it is not cut open.
+/// The surface near the box's faces is that of the kept particles: it closes around them, not
+/// cut open along the faces, and reaches at most r_e (the kernel's reach) past the box.
 
 #ifndef NONBLOPPY_CROP_PARTICLES_H
 #define NONBLOPPY_CROP_PARTICLES_H

@@ -31,7 +31,6 @@
 #include <algorithm>
 #include <atomic>
 #include <cerrno>
-#include <charconv>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -513,7 +512,7 @@ struct MeshedFrame
 {
     nonbloppy::ParticleSet particles;  ///< kept only for --attributes and --vdb-points
     nonbloppy::SurfaceResult result;
-    nonbloppy::StageTimings before;    ///< "read particles"
+    nonbloppy::StageTimings before;    ///< "read particles", and "crop particles" with --particle-box
     nonbloppy::StageTimings after;     ///< "interpolate attributes", then the writes
     std::string faces;                 ///< what made the input a mesh, or "" (FrameOutcome)
     size_t particlesRead = 0;          ///< in the file (FrameOutcome)
