@@ -4,9 +4,12 @@
 //   usage: example_mesh_particle_array [out.obj]
 
 #include <nonbloppy/BuildSurface.h>
+#include <nonbloppy/CgroupLimits.h>
 #include <nonbloppy/Error.h>
 #include <nonbloppy/MeasureMesh.h>
 #include <nonbloppy/WriteMesh.h>
+
+#include <tbb/global_control.h>
 
 #include <cstdio>
 #include <vector>
@@ -32,6 +35,11 @@ int main(int argc, char** argv)
                 if (i * i + j * j + k * k < 100) {
                     particles.xyz.insert(particles.xyz.end(), {0.1f * i, 0.1f * j, 0.1f * k});
                 }
+
+    // In a container or batch job, no more workers than its CPU limit grants (TBB alone
+    // counts the node's cores); held for as long as the program meshes.
+    const nonbloppy::DefaultThreads threads = nonbloppy::defaultThreads();
+    const tbb::global_control workers(tbb::global_control::max_allowed_parallelism, size_t(threads.threads));
 
     try {
         nonbloppy::SurfaceParameters params;  // unset lengths derive from the spacing
