@@ -32,21 +32,21 @@ std::vector<std::string> wordsOfFirstLine(const std::string& path)
     return words;
 }
 
-/// A number spelled by the whole of @a word, at least @a least and finite; else nullopt
-/// ("max", "-1", "").
-std::optional<double> numberFrom(const std::string& word, double least)
+/// A finite number >= 0 spelled by the whole of @a word; else nullopt ("max", "-1", "").
+std::optional<double> numberFrom(const std::string& word)
 {
     if (word.empty()) return std::nullopt;
     char* end = nullptr;
     const double value = std::strtod(word.c_str(), &end);
-    if (end != word.c_str() + word.size() || !(value >= least) || !std::isfinite(value)) return std::nullopt;
+    if (end != word.c_str() + word.size() || !(value >= 0.0) || !std::isfinite(value)) return std::nullopt;
     return value;
 }
 
-std::optional<double> firstNumberIn(const std::string& path, double least)
+/// numberFrom() the first word of the file @a path.
+std::optional<double> firstNumberIn(const std::string& path)
 {
     const std::vector<std::string> words = wordsOfFirstLine(path);
-    return words.empty() ? std::nullopt : numberFrom(words[0], least);
+    return words.empty() ? std::nullopt : numberFrom(words[0]);
 }
 
 /// The value of @a key in a memory.stat file ("inactive_file 123" lines), or 0.
@@ -66,13 +66,13 @@ std::optional<double> cpuLimitIn(const std::string& dir, bool v1)
 {
     std::optional<double> quota, period;
     if (v1) {
-        quota = firstNumberIn(dir + "/cpu.cfs_quota_us", 0.0);
-        period = firstNumberIn(dir + "/cpu.cfs_period_us", 0.0);
+        quota = firstNumberIn(dir + "/cpu.cfs_quota_us");
+        period = firstNumberIn(dir + "/cpu.cfs_period_us");
     } else {
         const std::vector<std::string> max = wordsOfFirstLine(dir + "/cpu.max");  // "QUOTA PERIOD"
         if (max.size() >= 2) {
-            quota = numberFrom(max[0], 0.0);
-            period = numberFrom(max[1], 0.0);
+            quota = numberFrom(max[0]);
+            period = numberFrom(max[1]);
         }
     }
     if (!quota || !period || !(*quota > 0.0) || !(*period > 0.0)) return std::nullopt;
@@ -82,8 +82,8 @@ std::optional<double> cpuLimitIn(const std::string& dir, bool v1)
 /// What one cgroup directory's memory limit leaves, in bytes; nullopt without a limit.
 std::optional<double> memoryHeadroomIn(const std::string& dir, bool v1)
 {
-    const std::optional<double> limit = firstNumberIn(dir + (v1 ? "/memory.limit_in_bytes" : "/memory.max"), 0.0);
-    const std::optional<double> usage = firstNumberIn(dir + (v1 ? "/memory.usage_in_bytes" : "/memory.current"), 0.0);
+    const std::optional<double> limit = firstNumberIn(dir + (v1 ? "/memory.limit_in_bytes" : "/memory.max"));
+    const std::optional<double> usage = firstNumberIn(dir + (v1 ? "/memory.usage_in_bytes" : "/memory.current"));
     // v2 writes no limit as "max", v1 as 2^63 rounded down to a page.
     if (!limit || *limit > 1e18 || !usage) return std::nullopt;
     const double inactive = statValue(dir + "/memory.stat", v1 ? "total_inactive_file" : "inactive_file");

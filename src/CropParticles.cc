@@ -3,6 +3,7 @@
 
 #include <nonbloppy/Error.h>
 
+#include "FileFormats.h"
 #include "NumberText.h"
 
 #include <tbb/blocked_range.h>
@@ -53,13 +54,11 @@ void checkParticleBox(const openvdb::BBoxd& box)
 ParticleSet cropParticles(const ParticleSet& particles, const openvdb::BBoxd& box)
 {
     checkParticleBox(box);
+    io_internal::requireOneValuePerParticle(particles);
     const size_t count = particles.size();
-    for (const ParticleAttribute& attribute : particles.attributes) {
-        if (attribute.size() != count) {
-            throw ParameterError("attribute '" + attribute.name + "' holds " + std::to_string(attribute.size()) +
-                                 " values for " + std::to_string(count) + " particles");
-        }
-    }
+    // Bytes per particle of each attribute.
+    std::vector<size_t> valueBytes;
+    for (const ParticleAttribute& a : particles.attributes) valueBytes.push_back(scalarSize(a.type) * size_t(a.components));
     // Pass 1: how many each block keeps; then where each block's particles go.
     const size_t blocks = (count + kBlockParticles - 1) / kBlockParticles;
     std::vector<size_t> firstKept(blocks + 1, 0);
@@ -83,7 +82,7 @@ ParticleSet cropParticles(const ParticleSet& particles, const openvdb::BBoxd& bo
         to.name = from.name;
         to.type = from.type;
         to.components = from.components;
-        to.bytes.resize(firstKept[blocks] * scalarSize(from.type) * size_t(from.components));
+        to.bytes.resize(firstKept[blocks] * valueBytes[a]);
     }
     // Pass 2: each block copies what it keeps into its own range.
     tbb::parallel_for(tbb::blocked_range<size_t>(0, blocks), [&](const tbb::blocked_range<size_t>& range) {
@@ -93,10 +92,9 @@ ParticleSet cropParticles(const ParticleSet& particles, const openvdb::BBoxd& bo
             for (size_t n = block * kBlockParticles; n < end; ++n) {
                 if (!inside(particles.positions[n], box)) continue;
                 cropped.positions[to] = particles.positions[n];
-                for (size_t a = 0; a < particles.attributes.size(); ++a) {
-                    const ParticleAttribute& from = particles.attributes[a];
-                    const size_t bytes = scalarSize(from.type) * size_t(from.components);
-                    std::memcpy(cropped.attributes[a].bytes.data() + to * bytes, from.bytes.data() + n * bytes, bytes);
+                for (size_t a = 0; a < valueBytes.size(); ++a) {
+                    std::memcpy(cropped.attributes[a].bytes.data() + to * valueBytes[a],
+                                particles.attributes[a].bytes.data() + n * valueBytes[a], valueBytes[a]);
                 }
                 ++to;
             }

@@ -493,6 +493,18 @@ requireCountableValues(const ParticleAttribute& attribute, const std::string& su
 }
 
 void
+requireOneValuePerParticle(const ParticleSet& particles, const std::string& suffix)
+{
+    for (const ParticleAttribute& a : particles.attributes) {
+        requireCountableValues(a, suffix);
+        if (a.size() != particles.size()
+            || a.bytes.size() != particles.size() * size_t(a.components) * scalarSize(a.type)) {
+            throw ParameterError("attribute '" + a.name + "' does not hold one value per particle" + suffix);
+        }
+    }
+}
+
+void
 requireInt64Values(const ParticleAttribute& attribute, const char* holder)
 {
     if (attribute.type != ScalarType::UInt64) return;

@@ -228,6 +228,12 @@ void requireFileComponents(const std::string& name, int components, const std::s
 ///        cannot be counted; a caller's struct gave "has 0 values for 2000 particles".
 void requireCountableValues(const ParticleAttribute& attribute, const std::string& suffix = "");
 
+/// @throw ParameterError("attribute 'id' does not hold one value per particle", then
+///        @a suffix) for the first attribute of @a particles whose bytes are not exactly one
+///        value (of its components and type) per particle, after requireCountableValues().
+///        What writeParticles() and cropParticles() require of a caller's set.
+void requireOneValuePerParticle(const ParticleSet& particles, const std::string& suffix = "");
+
 /// @throw ParameterError("attribute 'h' holds 18446744073709551615, above
 ///        9223372036854775807, the largest integer @a holder") if @a attribute is UInt64
 ///        and holds a value no int64 can (@a holder: "a .vdb stores", "a mesh attribute holds").

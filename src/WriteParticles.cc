@@ -116,20 +116,6 @@ namesForExtension(const ParticleSet& particles, const std::string& ext)
     return std::vector<std::string>(particles.attributes.size());
 }
 
-/// @throw ParameterError naming the first attribute that does not hold one value of at
-///        least one component per particle, followed by @a suffix (" (path)" or "").
-void
-requireSizes(const ParticleSet& particles, const std::string& suffix)
-{
-    for (const ParticleAttribute& a : particles.attributes) {
-        io_internal::requireCountableValues(a, suffix);
-        if (a.size() != particles.size()
-            || a.bytes.size() != particles.size() * size_t(a.components) * scalarSize(a.type)) {
-            throw ParameterError("attribute '" + a.name + "' does not hold one value per particle" + suffix);
-        }
-    }
-}
-
 /// Bytes of @a count values of @a width in the requested byte order.
 void
 appendSwapped(std::string& out, const unsigned char* data, size_t count, size_t width, bool bigEndian)
@@ -567,7 +553,7 @@ pointDataGridOfFinitePositions(const ParticleSet& particles, double voxelSize, d
 openvdb::GridBase::Ptr
 makePointDataGrid(const ParticleSet& particles, double voxelSize)
 {
-    requireSizes(particles, "");
+    io_internal::requireOneValuePerParticle(particles);
     const double largest = requirePlaceablePositions(particles, "");
     return pointDataGridOfFinitePositions(particles, voxelSize, largest);
 }
@@ -576,7 +562,7 @@ void
 writeParticles(const ParticleSet& particles, const std::string& path, const ParticleWriteSettings& settings)
 {
     const std::string ext = requireParticleOutput(path);
-    requireSizes(particles, " (" + path + ")");
+    io_internal::requireOneValuePerParticle(particles, " (" + path + ")");
     if (ext != ".xyz") {  // .xyz drops the attributes
         for (const ParticleAttribute& a : particles.attributes) io_internal::requireFileComponents(a.name, a.components, " (" + path + ")");
     }

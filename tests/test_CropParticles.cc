@@ -121,16 +121,28 @@ TEST(CropParticles, BadBoxesAreRefusedNamingTheBound)
     EXPECT_EQ(errorOf(BBoxd(Vec3d(0.0), Vec3d(1.0, INFINITY, 1.0))),
               "particle box: its maximum y is inf, not a finite number");
     EXPECT_EQ(errorOf(BBoxd(Vec3d(0.0), Vec3d(1.0))), "");
-    // An attribute that does not hold one value per particle.
+    // An attribute that does not hold one value per particle, as writeParticles() refuses it:
+    // too few values, a stray byte past the last value, no components.
     nonbloppy::ParticleSet particles;
     particles.positions = {{0, 0, 0}, {1, 1, 1}};
-    particles.attributes.push_back(nonbloppy::ParticleAttribute::of("id", 1, std::vector<int32_t>{7}));
-    try {
-        cropParticles(particles, BBoxd(Vec3d(0.0), Vec3d(1.0)));
-        ADD_FAILURE() << "no error";
-    } catch (const nonbloppy::ParameterError& e) {
-        EXPECT_STREQ(e.what(), "attribute 'id' holds 1 values for 2 particles");
-    }
+    const auto cropError = [&](const nonbloppy::ParticleAttribute& attribute) {
+        particles.attributes = {attribute};
+        try {
+            cropParticles(particles, BBoxd(Vec3d(0.0), Vec3d(1.0)));
+        } catch (const nonbloppy::ParameterError& e) {
+            return std::string(e.what());
+        }
+        return std::string();
+    };
+    EXPECT_EQ(cropError(nonbloppy::ParticleAttribute::of("id", 1, std::vector<int32_t>{7})),
+              "attribute 'id' does not hold one value per particle");
+    nonbloppy::ParticleAttribute stray = nonbloppy::ParticleAttribute::of("id", 1, std::vector<int32_t>{7, 8});
+    stray.bytes.push_back(0);
+    EXPECT_EQ(cropError(stray), "attribute 'id' does not hold one value per particle");
+    nonbloppy::ParticleAttribute none = nonbloppy::ParticleAttribute::of("id", 1, std::vector<int32_t>{7, 8});
+    none.components = 0;
+    EXPECT_EQ(cropError(none), "attribute 'id' has 0 components, at least 1 needed");
+    EXPECT_EQ(cropError(nonbloppy::ParticleAttribute::of("id", 1, std::vector<int32_t>{7, 8})), "");
 }
 
 } // namespace

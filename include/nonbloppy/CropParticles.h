@@ -27,8 +27,9 @@ namespace nonbloppy {
 /// @throw ParameterError("particle box: its minimum x 2 exceeds its maximum 1") where a
 ///        minimum exceeds its maximum, "particle box: its minimum y is nan, not a finite
 ///        number" for a NaN or infinite bound (an unbounded side takes a huge finite one),
-///        and ParameterError("attribute 'id' holds 3 values for 4 particles") for an
-///        attribute that does not hold one value per particle.
+///        and, as writeParticles(), ParameterError("attribute 'id' does not hold one value
+///        per particle") for an attribute whose bytes are not one value per particle (or
+///        "attribute 'id' has 0 components, at least 1 needed").
 NONBLOPPY_API ParticleSet cropParticles(const ParticleSet& particles, const openvdb::BBoxd& box);
 
 /// Throw the ParameterError cropParticles() would for @a box, and nothing else: the check
