@@ -17,6 +17,7 @@
 #include <CLI/CLI.hpp>
 
 #include <cctype>
+#include <charconv>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -175,6 +176,24 @@ inline std::string formatNumber(double value)
     std::ostringstream out;
     out << value;
     return out.str();
+}
+
+/// The value @a v as the shortest text that reads back to it: "24388", "-0.125", "3.4e+38".
+template<typename T>
+std::string shortestText(T v)
+{
+    char digits[48];
+    return std::string(digits, std::to_chars(digits, digits + sizeof(digits), v).ptr);
+}
+
+/// A point's coordinates as T, each as the shortest text that reads back as it:
+/// "(1000000.7, 0.25, -3)". T is float for particle positions (what the files hold) and double
+/// for numbers a user gave. formatNumber()'s six digits dropped a box's width far from the
+/// origin ("(1e+06, ...) -> (1e+06, ...)" for a cube 0.7 wide at x = 1e6; hostile-input audit).
+template<typename T>
+std::string formatPoint(const openvdb::Vec3d& p)
+{
+    return "(" + shortestText(T(p[0])) + ", " + shortestText(T(p[1])) + ", " + shortestText(T(p[2])) + ")";
 }
 
 /// A count with a K/M/G suffix, as vdb_print prints voxel counts ("24.4K", "1.21M").

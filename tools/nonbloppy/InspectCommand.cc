@@ -26,7 +26,6 @@
 
 #include <algorithm>
 #include <cerrno>
-#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -123,20 +122,6 @@ std::string formatVec3(double x, double y, double z)
     return "(" + formatNumber(x) + ", " + formatNumber(y) + ", " + formatNumber(z) + ")";
 }
 
-/// A position's coordinates (floats), each as the shortest text that reads back as it:
-/// "(1000000.7, 0.25, -3)". formatVec3()'s six digits dropped a box's width far from the
-/// origin ("(1e+06, ...) -> (1e+06, ...)" for a cube 0.7 wide at x = 1e6; hostile-input audit).
-std::string formatPosition(const openvdb::Vec3d& p)
-{
-    std::string text = "(";
-    for (int axis = 0; axis < 3; ++axis) {
-        char digits[32];
-        text.append(digits, std::to_chars(digits, digits + sizeof(digits), float(p[axis])).ptr);
-        text += axis < 2 ? ", " : ")";
-    }
-    return text;
-}
-
 std::string formatCoord(const openvdb::Coord& c)
 {
     return "(" + std::to_string(c.x()) + "," + std::to_string(c.y()) + "," + std::to_string(c.z())
@@ -181,14 +166,6 @@ struct AttributeSummary
     std::vector<std::string> low, high;
     size_t nonFinite = 0;
 };
-
-/// The value @a v as the shortest text that reads back to it: "24388", "-0.125", "3.4e+38".
-template<typename T>
-std::string shortestText(T v)
-{
-    char digits[48];
-    return std::string(digits, std::to_chars(digits, digits + sizeof(digits), v).ptr);
-}
 
 /// Whether @a a orders before @a b, -0 before +0: std::min of the two equal zeros keeps
 /// whichever came first, and the parallel reduction's order depends on the threads.
@@ -376,7 +353,7 @@ int inspectParticles(const std::string& path, const nonbloppy::ParticleSet& part
     std::cout << path << ": particle file\n";
     printRow("particles", std::to_string(particles.size()));
     if (bbox) {
-        printRow("bounding box", formatPosition(bbox->first) + " -> " + formatPosition(bbox->second));
+        printRow("bounding box", formatPoint<float>(bbox->first) + " -> " + formatPoint<float>(bbox->second));
     }
     // estimateSpacing() does not say which of its two measures it gave: name both.
     printRow("spacing", spacing ? formatNumber(*spacing) + " (estimated: volume per particle inside the fluid, "
@@ -493,7 +470,7 @@ int inspectMesh(const std::string& path, const nonbloppy::SurfaceMesh& mesh, boo
     printRow("area", formatNumber(m.area));
     printRow("volume", formatNumber(m.volume) + (m.closed ? "" : " (not closed: not meaningful)"));
     if (bbox) {
-        printRow("bounding box", formatPosition(bbox->first) + " -> " + formatPosition(bbox->second));
+        printRow("bounding box", formatPoint<float>(bbox->first) + " -> " + formatPoint<float>(bbox->second));
     }
     if (attributes) printAttributes(*attributes);
     else printRow("attributes", "- (the particle readers refuse this file)");

@@ -92,16 +92,7 @@ std::optional<openvdb::BBoxd> ParticleBoxOption::box() const
 
 std::string formatBox(const openvdb::BBoxd& box)
 {
-    std::string text;
-    for (const openvdb::Vec3d& corner : {box.min(), box.max()}) {
-        text += text.empty() ? "(" : " -> (";
-        for (int axis = 0; axis < 3; ++axis) {
-            char digits[32];
-            const auto end = std::to_chars(digits, digits + sizeof(digits), corner[axis]).ptr;
-            text += std::string(digits, end) + (axis < 2 ? ", " : ")");
-        }
-    }
-    return text;
+    return formatPoint<double>(box.min()) + " -> " + formatPoint<double>(box.max());
 }
 
 } // namespace nonbloppy_tool
