@@ -44,6 +44,7 @@ using namespace nonbloppy_test;
 
 const std::string kData = NONBLOPPY_TEST_DATA_DIR;
 const std::string kCube = kData + "/cube_2366_particles.vtk";
+const std::string kDamBreak = kData + "/dam_break_frame_23_24389_particles.vtk";
 
 /// Wait (at most 30 s) until process @a pid catches @a signal, as its /proc status tells
 /// (SigCgt: the caught signals as a hex mask, signal n at bit n - 1): its handler is installed.
@@ -500,7 +501,7 @@ TEST_F(CliTest, InspectParticleFile)
         EXPECT_EQ(document["bbox"]["max"][axis].get<float>(), high[axis]) << axis;
     }
 
-    const RunResult text = run("inspect " + quote(kData + "/dam_break_frame_23_24389_particles.vtk"));
+    const RunResult text = run("inspect " + quote(kDamBreak));
     ASSERT_EQ(text.exitCode, 0) << text.err;
     // Whole rows: the file's name holds "24389" too.
     EXPECT_NE(text.out.find("\n  particles        24389\n"), std::string::npos) << text.out;
@@ -510,11 +511,11 @@ TEST_F(CliTest, InspectParticleFile)
               std::string::npos)
         << text.out;
     // Those ranges are the file's own, to the float (the JSON report's, against the reader).
-    const nonbloppy::ParticleSet dam = nonbloppy::readParticles(kData + "/dam_break_frame_23_24389_particles.vtk");
+    const nonbloppy::ParticleSet dam = nonbloppy::readParticles(kDamBreak);
     const nonbloppy::ParticleAttribute* velocity = dam.findAttribute("velocity");
     ASSERT_NE(velocity, nullptr);
     const nlohmann::json damJson =
-        nlohmann::json::parse(run("inspect --json " + quote(kData + "/dam_break_frame_23_24389_particles.vtk")).out);
+        nlohmann::json::parse(run("inspect --json " + quote(kDamBreak)).out);
     ASSERT_EQ(damJson["attributes"][1]["name"], "velocity");
     for (int c = 0; c < 3; ++c) {
         double low = velocity->asDouble(0, c), high = low;
@@ -615,7 +616,7 @@ TEST_F(CliTest, MeshWarnsOfVerticesWhoseCarriedAttributeIsNotFinite)
                          + " vertices of " + out("hot.ply") + " have a NaN or infinite 'temp': particles of "
                          + in("hot.csv") + " near them hold such values (nonbloppy inspect counts them)\n");
     // Finite values everywhere: no word.
-    const RunResult fine = run("mesh -q " + quote(kData + "/dam_break_frame_23_24389_particles.vtk") + " -o "
+    const RunResult fine = run("mesh -q " + quote(kDamBreak) + " -o "
                                + quote(out("dam.ply")) + " --attributes all");
     ASSERT_EQ(fine.exitCode, 0) << fine.err;
     EXPECT_EQ(fine.err, "");
@@ -768,12 +769,11 @@ TEST_F(CliTest, AParticleBoxMeshesOnlyTheParticlesInsideIt)
 {
     // The dam-break frame cut at x = 0: the same mesh, attributes and all, as meshing a file
     // holding only the particles with x <= 0 (cut here by the library, written as PLY).
-    const std::string frame = kData + "/dam_break_frame_23_24389_particles.vtk";
     const openvdb::BBoxd box(openvdb::Vec3d(-10.0, -10.0, -10.0), openvdb::Vec3d(0.0, 10.0, 10.0));
-    const nonbloppy::ParticleSet half = nonbloppy::cropParticles(nonbloppy::readParticles(frame), box);
+    const nonbloppy::ParticleSet half = nonbloppy::cropParticles(nonbloppy::readParticles(kDamBreak), box);
     nonbloppy::writeParticles(half, in("half.ply"));
     const RunResult cropped =
-        run("mesh " + quote(frame) + " -o " + quote(out("cropped.ply")) + " --attributes id --particle-box -10 -10 -10 0 10 10");
+        run("mesh " + quote(kDamBreak) + " -o " + quote(out("cropped.ply")) + " --attributes id --particle-box -10 -10 -10 0 10 10");
     ASSERT_EQ(cropped.exitCode, 0) << cropped.err;
     const RunResult written = run("mesh " + quote(in("half.ply")) + " -o " + quote(out("half.ply")) + " --attributes id");
     ASSERT_EQ(written.exitCode, 0) << written.err;
@@ -796,8 +796,7 @@ TEST_F(CliTest, AParticleBoxMeshesOnlyTheParticlesInsideIt)
 
 TEST_F(CliTest, ABadParticleBoxIsRefused)
 {
-    const std::string frame = kData + "/dam_break_frame_23_24389_particles.vtk";
-    const auto refused = [&](const std::string& box) { return run("mesh " + quote(frame) + " -o " + quote(out("m.ply")) + " --particle-box " + box); };
+    const auto refused = [&](const std::string& box) { return run("mesh " + quote(kDamBreak) + " -o " + quote(out("m.ply")) + " --particle-box " + box); };
     const std::vector<std::pair<std::string, std::string>> cases = {
         {"-1 -1 -1 1 -2 1", "nonbloppy: --particle-box: its minimum y -1 exceeds its maximum -2\n"},
         {"-1 -1 -1 1 nan 1", "nonbloppy: --particle-box: its maximum y is nan, not a finite number\n"},
@@ -813,35 +812,34 @@ TEST_F(CliTest, ABadParticleBoxIsRefused)
     // A box that holds none of the particles: said once the file is read, exit 1.
     const RunResult empty = refused("10 10 10 11 11 11.5");
     EXPECT_EQ(empty.exitCode, 1);
-    EXPECT_EQ(empty.err, "nonbloppy: none of the 24389 particles of " + frame +
+    EXPECT_EQ(empty.err, "nonbloppy: none of the 24389 particles of " + kDamBreak +
                              " lie inside --particle-box (10, 10, 10) -> (11, 11, 11.5)\n");
     EXPECT_TRUE(listDir(dir() + "/out").empty());
 }
 
 TEST_F(CliTest, ConvertWithAParticleBoxWritesOnlyTheParticlesInsideIt)
 {
-    const std::string frame = kData + "/dam_break_frame_23_24389_particles.vtk";
     const nonbloppy::ParticleSet half = nonbloppy::cropParticles(
-        nonbloppy::readParticles(frame), openvdb::BBoxd(openvdb::Vec3d(-10.0), openvdb::Vec3d(0.0, 10.0, 10.0)));
-    const RunResult r = run("convert " + quote(frame) + " " + quote(out("half.ply")) + " --particle-box -10 -10 -10 0 10 10");
+        nonbloppy::readParticles(kDamBreak), openvdb::BBoxd(openvdb::Vec3d(-10.0), openvdb::Vec3d(0.0, 10.0, 10.0)));
+    const RunResult r = run("convert " + quote(kDamBreak) + " " + quote(out("half.ply")) + " --particle-box -10 -10 -10 0 10 10");
     ASSERT_EQ(r.exitCode, 0) << r.err;
     EXPECT_EQ(r.out, "converted " + std::to_string(half.size()) +
                          " particles (of 24389, inside --particle-box (-10, -10, -10) -> (0, 10, 10)) with 2 attributes: " +
-                         frame + " -> " + out("half.ply") + "\n");
+                         kDamBreak + " -> " + out("half.ply") + "\n");
     const nonbloppy::ParticleSet written = nonbloppy::readParticles(out("half.ply"));
     EXPECT_EQ(written.positions, half.positions);
     ASSERT_EQ(written.attributes.size(), 2u);
     EXPECT_EQ(written.attributes[0].bytes, half.attributes[0].bytes);  // id
     EXPECT_EQ(written.attributes[1].bytes, half.attributes[1].bytes);  // velocity
     // None inside: the (empty) file is written, as any file of no particles is, and said.
-    const RunResult none = run("convert -q " + quote(frame) + " " + quote(out("none.csv")) + " --particle-box 10 10 10 11 11 11");
+    const RunResult none = run("convert -q " + quote(kDamBreak) + " " + quote(out("none.csv")) + " --particle-box 10 10 10 11 11 11");
     EXPECT_EQ(none.exitCode, 0);
-    EXPECT_EQ(none.err, "nonbloppy: warning: none of the 24389 particles of " + frame +
+    EXPECT_EQ(none.err, "nonbloppy: warning: none of the 24389 particles of " + kDamBreak +
                             " lie inside --particle-box (10, 10, 10) -> (11, 11, 11): " + out("none.csv") +
                             " holds no particles\n");
     EXPECT_EQ(nonbloppy::readParticles(out("none.csv")).size(), 0u);
     // A bad box: exit 2, nothing read or written.
-    const RunResult bad = run("convert " + quote(frame) + " " + quote(out("bad.csv")) + " --particle-box 0 0 0 1 1 -1");
+    const RunResult bad = run("convert " + quote(kDamBreak) + " " + quote(out("bad.csv")) + " --particle-box 0 0 0 1 1 -1");
     EXPECT_EQ(bad.exitCode, 2);
     EXPECT_EQ(bad.err, "nonbloppy: --particle-box: its minimum z 0 exceeds its maximum -1\n");
     EXPECT_EQ(listDir(dir() + "/out"), (std::vector<std::string>{"half.ply", "none.csv"}));
@@ -860,7 +858,7 @@ TEST_F(CliTest, OutputDoesNotDependOnThreadCount)
     // Smoothing sums over neighbouring vertices and attributes over neighbouring particles:
     // the paths where the order of a parallel sum would show. The dam break carries id and
     // velocity; the cube carries nothing.
-    const std::string dam = kData + "/dam_break_frame_23_24389_particles.vtk";
+    const std::string dam = kDamBreak;
     for (const char* threads : {"1", "2"}) {
         const std::string name = std::string("dam") + threads;
         const RunResult r = run("mesh " + quote(dam) + " -o " + quote(out(name + ".ply")) + " --vdb "
@@ -880,7 +878,7 @@ TEST_F(CliTest, NoDirectIoWritesTheSameMesh)
     // The dam-break frame's PLY (2.7 MB) is over the 1 MiB from which meshes bypass the page
     // cache; --no-direct-io writes it through the cache, with the same bytes.
     if (!nonbloppy::directIoSuitable(dir())) GTEST_SKIP() << "no direct I/O on " << dir();
-    const std::string frame = quote(kData + "/dam_break_frame_23_24389_particles.vtk");
+    const std::string frame = quote(kDamBreak);
     ASSERT_EQ(run("mesh " + frame + " -o " + quote(out("direct.ply")) + " -q").exitCode, 0);
     ASSERT_EQ(run("mesh " + frame + " -o " + quote(out("cached.ply")) + " -q --no-direct-io").exitCode, 0);
     const std::string direct = readText(out("direct.ply"));
@@ -1323,7 +1321,7 @@ TEST_F(CliTest, ASuccessfulRunOverEarlierOutputsLeavesOnlyTheNewOnes)
     // The replaced files lose their last link on a thread of their own (BackgroundRemover):
     // by the time the process exits they must be gone, and the new files in their place.
     auto meshTo = [&](const std::string& name, const char* blend) {
-        return run("mesh " + quote(kData + "/dam_break_frame_23_24389_particles.vtk") + " -q -c " + blend +
+        return run("mesh " + quote(kDamBreak) + " -q -c " + blend +
                    " -o " + quote(out(name + ".ply")) + " --vdb " + quote(out(name + ".vdb")));
     };
     ASSERT_EQ(meshTo("dam", "0.1").exitCode, 0);
@@ -1400,7 +1398,7 @@ TEST_F(CliTest, SigintSigtermAndSighupCancelWithoutLeavingFiles)
     for (const int signal : {SIGINT, SIGTERM, SIGHUP}) {
         SCOPED_TRACE(signal);
         const RunResult r = interruptWhen(
-            {"mesh", kData + "/dam_break_frame_23_24389_particles.vtk", "-o", out("dam.obj"), "--vdb",
+            {"mesh", kDamBreak, "-o", out("dam.obj"), "--vdb",
              out("dam.vdb"), "--voxel-size", "0.005", "-v"},
             [](const std::string& err) { return err.find("[progress] rasterize density") != std::string::npos; },
             signal);
@@ -1421,7 +1419,7 @@ TEST_F(CliTest, RepeatedSignalsWithinASecondAreOneRequest)
     writeText(out("dam.obj"), "old mesh\n");
     writeText(out("dam.vdb"), "old grid\n");
     const RunResult r = interruptWhen(
-        {"mesh", kData + "/dam_break_frame_23_24389_particles.vtk", "-o", out("dam.obj"), "--vdb",
+        {"mesh", kDamBreak, "-o", out("dam.obj"), "--vdb",
          out("dam.vdb"), "--voxel-size", "0.005", "-v"},
         [](const std::string& err) { return err.find("[progress] rasterize density") != std::string::npos; },
         SIGINT, 2);
