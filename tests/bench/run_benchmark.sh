@@ -297,7 +297,7 @@ spacing=$(awk '$1 == "spacing" {print $3}' "$out/nb_64.out")
 rm -f "$out/scan_spacing" "$out/scan_nosmooth" "$out/scan_spacing.smooth"
 for ((r = 0; r < scan_runs; ++r)); do
   scan_once spacing "${nb_args[@]}" --spacing "$spacing"
-  awk '$1 == "smooth" {print $3}' "$out/scan_spacing.out" >> "$out/scan_spacing.smooth"
+  stage_seconds "$out/scan_spacing.out" "smooth surface" >> "$out/scan_spacing.smooth"
   scan_once nosmooth "${nb_args[@]}" --spacing "$spacing" --no-smooth
 done
 say ""
@@ -353,6 +353,8 @@ sequence_row "$seq_frames separate runs" "$(awk -v w="${nb_wall[64]}" -v n="$seq
 # written as OBJ against PLY. The runs take turns, as in the t scan.
 attr_input="$out/dam_break_x64_attributes.ply"
 [ -s "$attr_input" ] || "$tile" "$frame" "$attr_input" --copies 4 --attributes > /dev/null
+megabytes() { awk -v b="$1" 'BEGIN {printf "%.0f", b / 1e6}'; }
+attr_input_mb=$(megabytes "$(stat -c %s "$attr_input")")
 formats=(vtk vtu csv vdb)
 for format in "${formats[@]}"; do
   [ -s "${attr_input%.ply}.$format" ] || "$nonbloppy" convert -q "$attr_input" "${attr_input%.ply}.$format"
@@ -376,7 +378,6 @@ for ((r = 0; r < scan_runs; ++r)); do
 done
 rm -f "$out/scan.obj"
 ply_read=$(median_of %.3f < "$out/scan_read_ply.stage")
-megabytes() { awk -v b="$1" 'BEGIN {printf "%.0f", b / 1e6}'; }
 attr_without=$(median 1 "$out/scan_attr_none"); attr_with=$(median 1 "$out/scan_attr_all")
 attr_interpolate=$(median_of %.3f < "$out/scan_attr_all.stage")
 write_ply=$(median_of %.3f < "$out/scan_attr_none.stage"); write_obj=$(median_of %.3f < "$out/scan_obj.stage")
@@ -385,10 +386,10 @@ say "Attributes and formats: the 64x input with the frame's \`id\` (uint32) and 
 say ""
 say "| 64x input with id and velocity | wall s | stage s |"
 say "| --- | --- | --- |"
-say "| binary PLY ($(megabytes "$(stat -c %s "$attr_input")") MB), the attributes not carried | $attr_without | read particles $ply_read; write mesh (PLY, $(megabytes "$ply_bytes") MB) $write_ply |"
+say "| binary PLY ($attr_input_mb MB), the attributes not carried | $attr_without | read particles $ply_read; write mesh (PLY, $(megabytes "$ply_bytes") MB) $write_ply |"
 say "| \`--attributes all\` | $attr_with | interpolate attributes $attr_interpolate |"
 say "| \`-o mesh.obj\` | $(median 1 "$out/scan_obj") | write mesh (OBJ, $(megabytes "$obj_bytes") MB) $write_obj |"
-read_figures="binary PLY $ply_read s ($(megabytes "$(stat -c %s "$attr_input")") MB)"
+read_figures="binary PLY $ply_read s ($attr_input_mb MB)"
 declare -A format_names=([vtk]="legacy VTK" [vtu]="VTU" [csv]="CSV" [vdb]="OpenVDB points")
 for format in "${formats[@]}"; do
   bytes=$(stat -c %s "${attr_input%.ply}.$format")
