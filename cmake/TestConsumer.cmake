@@ -1,9 +1,11 @@
 # ctest driver for the installed-package test (run with cmake -P):
 #   install the built project into a fresh prefix, configure and build tests/consumer against
-#   it, run the shared and static consumers, then compile the same main.cc with pkg-config.
+#   it, run the shared and static consumers, then compile the same main.cc with pkg-config;
+#   import the installed Python module.
 # Inputs: -DBUILD_DIR=<nonbloppy build> -DSOURCE_DIR=<nonbloppy source> -DWORK_DIR=<scratch>
 #         -DCXX=<compiler> -DBUILD_TYPE=<Release|...> and the project's -DCXX_FLAGS and
-#         -DEXE_LINKER_FLAGS (e.g. sanitizers: the consumer must be built the same way)
+#         -DEXE_LINKER_FLAGS (e.g. sanitizers: the consumer must be built the same way), and
+#         -DPYTHON=<interpreter> where the build made the Python module (empty: none)
 cmake_minimum_required(VERSION 3.18)
 
 function(run)
@@ -47,3 +49,19 @@ separate_arguments(extra UNIX_COMMAND "${CXX_FLAGS} ${EXE_LINKER_FLAGS}")
 run(${CXX} -O1 ${extra} "${SOURCE_DIR}/tests/consumer/main.cc" -o "${WORK_DIR}/consumer_pkgconfig"
     ${flags} "-Wl,-rpath,${libdir}")
 run("${WORK_DIR}/consumer_pkgconfig")
+
+# The Python module, where the build made one: it imports from where it was installed and
+# meshes (as the suite's python_module test does from the build tree).
+if(PYTHON)
+  file(GLOB_RECURSE module "${prefix}/*/nonbloppy.cpython-*.so")
+  if(NOT module)
+    message(FATAL_ERROR "not installed: the Python module")
+  endif()
+  get_filename_component(moduledir "${module}" DIRECTORY)
+  set(ENV{PYTHONPATH} "${moduledir}")
+  # Statements on lines of their own: CMake would split the argument at a ';'.
+  run(${PYTHON} -c "import nonbloppy
+mesh = nonbloppy.build_surface([[0, 0, 0]], radius=1.0, threshold=1.0, voxel_size=0.1, method='paper', iterations=0)
+assert nonbloppy.__file__.startswith('${prefix}/'), nonbloppy.__file__
+assert len(mesh.vertices) > 100, mesh")
+endif()
