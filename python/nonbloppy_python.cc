@@ -370,6 +370,22 @@ py::dict meshParameters(const Mesh& mesh)
     return result;
 }
 
+/// The keywords that make build_surface() use @a mesh's lengths on another frame, so that a
+/// sequence is meshed alike (the lengths not given follow each frame's spacing estimate,
+/// which moves with the fluid: flicker). As `nonbloppy mesh` advises for sequences.
+py::dict pinnedParameters(const Mesh& mesh)
+{
+    const nonbloppy::ResolvedParameters& p = mesh.parameters;
+    py::dict result;
+    if (p.spacingGiven) result["spacing"] = p.spacing;
+    result["radius"] = p.effectiveRadius;
+    result["voxel_size"] = p.voxelSize;
+    result["threshold"] = p.threshold;
+    // The faithful step cap follows the estimate too (0: none).
+    if (p.method == nonbloppy::Method::Faithful) result["max_step"] = p.maxStep;
+    return result;
+}
+
 py::dict meshTimings(const Mesh& mesh)
 {
     py::dict result;
@@ -584,6 +600,11 @@ PYBIND11_MODULE(nonbloppy, m)
             "nearest particle's value)")
         .def_property_readonly("parameters", &meshParameters,
             "dict of every parameter as used: spacing, radius, threshold, voxel_size, blend, ...")
+        .def_property_readonly("pinned_parameters", &pinnedParameters,
+            "dict of the keywords that mesh another frame with this mesh's lengths (radius,\n"
+            "voxel_size, threshold, max_step; spacing where given): build_surface(frame,\n"
+            "**first.pinned_parameters). Unpinned, they follow each frame's spacing estimate, which\n"
+            "moves with the fluid, and the surface flickers in a rendered sequence.")
         .def_property_readonly("timings", &meshTimings, "dict: stage -> wall-clock seconds")
         .def_property_readonly("particle_count", [](const Mesh& mesh) { return mesh.particleCount; })
         .def("write", [](const Mesh& mesh, const std::string& path, bool quads, bool directIo) {

@@ -108,6 +108,26 @@ class SameAsTheCommandLine(unittest.TestCase):
             np.testing.assert_array_equal(mesh.normals, reference.normals)
 
 
+class Sequences(unittest.TestCase):
+    def test_pinned_parameters_mesh_other_frames_with_the_first_frames_lengths(self):
+        first = nonbloppy.build_surface(nonbloppy.read_particles(DAM_BREAK))
+        pinned = first.pinned_parameters
+        self.assertEqual(set(pinned), {"radius", "voxel_size", "threshold", "max_step"})
+        again = nonbloppy.build_surface(nonbloppy.read_particles(DAM_BREAK), **pinned)
+        np.testing.assert_array_equal(again.vertices, first.vertices)
+        other = nonbloppy.read_particles(os.path.join(DATA, "dam_break_frame_9_6859_particles.bgeo"))
+        alone = nonbloppy.build_surface(other).parameters
+        alike = nonbloppy.build_surface(other, **pinned).parameters
+        self.assertNotAlmostEqual(alone["radius"], pinned["radius"], places=4)  # the estimate moved
+        for name, value in pinned.items():
+            self.assertEqual(alike[name], value, name)
+
+    def test_a_given_spacing_is_pinned_too(self):
+        mesh = nonbloppy.build_surface(nonbloppy.read_particles(CUBE), spacing=0.1, iterations=1)
+        self.assertEqual(mesh.pinned_parameters["spacing"], 0.1)
+        self.assertTrue(mesh.parameters["preserve_volume"])
+
+
 class Arrays(unittest.TestCase):
     def test_read_particles_keeps_every_attribute_in_its_type(self):
         particles = nonbloppy.read_particles(DAM_BREAK)
