@@ -108,6 +108,14 @@ std::string pythonNames(std::string message)
     return message;
 }
 
+/// A file name from a str or any os.PathLike (pathlib.Path), as open() takes them.
+std::string pathOf(const py::object& path)
+{
+    const py::object name = py::module_::import("os").attr("fspath")(path);
+    if (!py::isinstance<py::str>(name)) throw py::type_error("a file name must be a str or an os.PathLike of str");
+    return name.cast<std::string>();
+}
+
 [[noreturn]] void throwParameterError(const std::string& message)
 {
     throw nonbloppy::ParameterError(message);
@@ -607,7 +615,8 @@ PYBIND11_MODULE(nonbloppy, m)
             "moves with the fluid, and the surface flickers in a rendered sequence.")
         .def_property_readonly("timings", &meshTimings, "dict: stage -> wall-clock seconds")
         .def_property_readonly("particle_count", [](const Mesh& mesh) { return mesh.particleCount; })
-        .def("write", [](const Mesh& mesh, const std::string& path, bool quads, bool directIo) {
+        .def("write", [](const Mesh& mesh, const py::object& file, bool quads, bool directIo) {
+                const std::string path = pathOf(file);
                 nonbloppy::requireMeshFile(path);
                 nonbloppy::MeshWriteSettings settings;
                 settings.keepQuads = quads;
@@ -619,7 +628,8 @@ PYBIND11_MODULE(nonbloppy, m)
             "file renamed into place (no partial file). quads=True keeps quads. Raises FileError.")
         .def("__repr__", &meshRepr);
 
-    m.def("read_particles", [](const std::string& path) {
+    m.def("read_particles", [](const py::object& file) {
+            const std::string path = pathOf(file);
             Particles particles;
             {
                 py::gil_scoped_release release;

@@ -6,6 +6,7 @@ NONBLOPPY_CLI_PATH (the command-line tool, whose output the module must match by
 
 import math
 import os
+import pathlib
 import signal
 import subprocess
 import tempfile
@@ -84,7 +85,7 @@ class SameAsTheCommandLine(unittest.TestCase):
 
     def test_defaults_give_the_tools_bytes(self):
         mesh = nonbloppy.build_surface(nonbloppy.read_particles(DAM_BREAK))
-        mesh.write(self.path("python.ply"))
+        mesh.write(pathlib.Path(self.path("python.ply")))
         self.assertEqual(read_bytes(self.path("python.ply")), self.cli_mesh("cli.ply"))
         self.assertEqual(mesh.particle_count, 24389)
 
@@ -139,6 +140,10 @@ class Arrays(unittest.TestCase):
         self.assertEqual(ids.shape, (24389,))
         self.assertEqual(np.sort(ids.astype(np.int64)).tolist(), list(range(ids.min(), ids.min() + 24389)))
         self.assertIn("24389 particles", repr(particles))
+        from_path = nonbloppy.read_particles(pathlib.Path(DAM_BREAK))  # any os.PathLike
+        np.testing.assert_array_equal(from_path.positions, particles.positions)
+        with self.assertRaises(TypeError):
+            nonbloppy.read_particles(DAM_BREAK.encode())
 
     def test_mesh_arrays_are_views_that_keep_the_mesh_alive(self):
         mesh = nonbloppy.build_surface(nonbloppy.read_particles(CUBE))
