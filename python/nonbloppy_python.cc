@@ -534,7 +534,7 @@ PYBIND11_MODULE(nonbloppy, m)
     types.parameterError = makeType("ParameterError", py::make_tuple(types.error, py::handle(PyExc_ValueError)),
                                     "A parameter or the input data is out of range.");
     types.cancelledError = makeType("CancelledError", types.error, "The work was stopped; nothing was produced.");
-    py::register_exception_translator([](std::exception_ptr p) {
+    py::register_local_exception_translator([](std::exception_ptr p) {
         try {
             if (p) std::rethrow_exception(p);
         } catch (const nonbloppy::FileError& e) {
