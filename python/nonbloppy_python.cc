@@ -35,11 +35,13 @@
 
 #include <nonbloppy/BuildSurface.h>
 #include <nonbloppy/CgroupLimits.h>
+#include <nonbloppy/CropParticles.h>
 #include <nonbloppy/Error.h>
 #include <nonbloppy/InterpolateAttributes.h>
 #include <nonbloppy/ReadParticles.h>
 #include <nonbloppy/Version.h>
 #include <nonbloppy/WriteMesh.h>
+#include <nonbloppy/WriteParticles.h>
 
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
@@ -48,12 +50,14 @@
 #include <tbb/task_arena.h>
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstring>
 #include <memory>
 #include <optional>
+#include <sstream>
 #include <string>
 #include <thread>
 #include <utility>
@@ -67,6 +71,7 @@ namespace {
 struct ExceptionTypes
 {
     py::object error, fileError, parameterError, cancelledError;
+    py::object surfaceWarning;  ///< a UserWarning: the mesh is made, but not as asked
 };
 
 ExceptionTypes& exceptionTypes()
@@ -476,6 +481,17 @@ Mesh buildSurface(const py::object& input, std::optional<double> spacing, std::o
         mesh.timings = std::move(result.timings);
         mesh.particleCount = result.particleCount;
     });
+    // As the tool warns: r_0 could not be calibrated for so strong a relaxation.
+    if (!mesh.parameters.thresholdReachesSurface) {
+        std::ostringstream message;
+        message << "blend=" << blend << ", iterations=" << iterations
+                << " relax too strongly for the threshold to be calibrated: flat faces end inside the "
+                   "particles; lower blend or iterations"
+                << (mesh.parameters.spacingGiven ? "" : ", or give spacing to correct the volume");
+        if (PyErr_WarnEx(exceptionTypes().surfaceWarning.ptr(), message.str().c_str(), 1) != 0) {
+            throw py::error_already_set();  // warnings turned into errors
+        }
+    }
     return mesh;
 }
 
@@ -507,7 +523,8 @@ progress    called as progress(stage, percent) on this thread at each stage's st
 Cost: about 1 s per million particles on two cores (extraction, rasterization and the
 relaxation dominate); memory: the density grid, 16 bytes per particle and the mesh.
 The GIL is released while it works.
-Raises ParameterError (bad parameters, non-finite or no positions), CancelledError.)";
+Raises ParameterError (bad parameters, non-finite or no positions), CancelledError; warns
+(SurfaceWarning) where blend and iterations relax too strongly for r_0's calibration.)";
 
 } // namespace
 
@@ -534,6 +551,9 @@ PYBIND11_MODULE(nonbloppy, m)
     types.parameterError = makeType("ParameterError", py::make_tuple(types.error, py::handle(PyExc_ValueError)),
                                     "A parameter or the input data is out of range.");
     types.cancelledError = makeType("CancelledError", types.error, "The work was stopped; nothing was produced.");
+    types.surfaceWarning = makeType("SurfaceWarning", PyExc_UserWarning,
+                                    "The mesh was made, but not as asked (e.g. a relaxation too strong for the "
+                                    "threshold's calibration).");
     py::register_local_exception_translator([](std::exception_ptr p) {
         try {
             if (p) std::rethrow_exception(p);
@@ -562,6 +582,26 @@ PYBIND11_MODULE(nonbloppy, m)
             "dict: name -> (N,) or (N, C) view of each attribute, in the type the file stored")
         .def_property_readonly("skipped", [](const Particles& p) { return p.set.skipped; },
             "what the file holds per particle that no attribute could take, e.g. \"group 'splash'\"")
+        .def("crop", [](const Particles& p, const std::array<double, 3>& lower, const std::array<double, 3>& upper) {
+                const openvdb::BBoxd box(openvdb::Vec3d(lower[0], lower[1], lower[2]),
+                                         openvdb::Vec3d(upper[0], upper[1], upper[2]));
+                Particles kept;
+                py::gil_scoped_release release;
+                kept.set = nonbloppy::cropParticles(p.set, box);
+                return kept;
+            }, py::arg("lower"), py::arg("upper"),
+            "The particles inside the box lower..upper (x, y, z each; its faces included), with their\n"
+            "attributes, in order: a tank's walls and floor left out before meshing, as the tool's\n"
+            "--particle-box. Raises ParameterError for a minimum above its maximum or a NaN bound.")
+        .def("write", [](const Particles& p, const py::object& file) {
+                const std::string path = pathOf(file);
+                nonbloppy::requireParticleOutputFile(path);
+                py::gil_scoped_release release;
+                nonbloppy::writeParticles(p.set, path);
+            }, py::arg("path"),
+            "Write the particles with their attributes as .ply, .vtk, .vtu, .csv, .xyz (positions\n"
+            "only) or .vdb (points), by the extension, through a temporary file renamed into place,\n"
+            "as `nonbloppy convert`. Raises FileError, ParameterError.")
         .def("__len__", [](const Particles& p) { return p.set.size(); })
         .def("__repr__", [](const Particles& p) {
             std::string text = "<nonbloppy.Particles: " + std::to_string(p.set.size()) + " particles";

@@ -90,12 +90,23 @@ class SameAsTheCommandLine(unittest.TestCase):
         self.assertEqual(mesh.particle_count, 24389)
 
     def test_parameters_and_attributes_give_the_tools_bytes(self):
-        mesh = nonbloppy.build_surface(nonbloppy.read_particles(DAM_BREAK), spacing=0.05, blend=0.4,
+        mesh = nonbloppy.build_surface(nonbloppy.read_particles(DAM_BREAK), spacing=0.05, blend=0.25,
                                        iterations=3, attributes="all")
         mesh.write(self.path("python.ply"), quads=True)
         self.assertEqual(read_bytes(self.path("python.ply")),
-                         self.cli_mesh("cli.ply", "--spacing", "0.05", "--blend", "0.4", "--iterations", "3",
+                         self.cli_mesh("cli.ply", "--spacing", "0.05", "--blend", "0.25", "--iterations", "3",
                                        "--attributes", "all", "--quads"))
+
+    def test_too_strong_a_relaxation_warns_as_the_tool_does(self):
+        particles = nonbloppy.read_particles(DAM_BREAK)
+        with self.assertWarns(nonbloppy.SurfaceWarning) as caught:
+            nonbloppy.build_surface(particles, blend=0.4, iterations=3)
+        self.assertEqual(str(caught.warning), "blend=0.4, iterations=3 relax too strongly for the threshold to be "
+                         "calibrated: flat faces end inside the particles; lower blend or iterations, or give "
+                         "spacing to correct the volume")
+        result = subprocess.run([CLI, "mesh", DAM_BREAK, "-o", self.path("cli.ply"), "--blend", "0.4",
+                                 "--iterations", "3"], check=True, capture_output=True, text=True)
+        self.assertIn("relax too strongly", result.stderr)
 
     def test_a_bare_array_and_one_thread_give_the_same_mesh(self):
         particles = nonbloppy.read_particles(CUBE)
@@ -177,6 +188,44 @@ class Arrays(unittest.TestCase):
         self.assertEqual(mesh.attributes["id"].dtype, np.int64)
         self.assertTrue(set(mesh.attributes["id"].tolist()) <= set(ids.tolist()))
         self.assertIn("interpolate attributes", mesh.timings)
+
+
+class ParticleFiles(unittest.TestCase):
+    def test_written_particles_read_back_with_their_attributes(self):
+        particles = nonbloppy.read_particles(DAM_BREAK)
+        with tempfile.TemporaryDirectory() as tmp:
+            for name in ("p.ply", "p.vtu", "p.csv", "p.vdb"):
+                with self.subTest(name):
+                    particles.write(pathlib.Path(tmp, name))
+                    back = nonbloppy.read_particles(os.path.join(tmp, name))
+                    if name == "p.vdb":  # a points grid holds them leaf by leaf, not in file order
+                        order = np.lexsort(particles.positions.T)
+                        back_order = np.lexsort(back.positions.T)
+                    else:
+                        order = back_order = slice(None)
+                    np.testing.assert_array_equal(back.positions[back_order], particles.positions[order])
+                    for attribute, values in particles.attributes.items():
+                        # CSV declares no types: its numbers read back as float64 and int64,
+                        # which hold the written values exactly.
+                        np.testing.assert_array_equal(back.attributes[attribute][back_order].astype(values.dtype),
+                                                      values[order])
+            with self.assertRaises(nonbloppy.FileError) as caught:
+                particles.write(os.path.join(tmp, "p.obj"))
+            self.assertEqual(str(caught.exception), "unknown particle output extension '.obj' (" +
+                             os.path.join(tmp, "p.obj") + "); expected .ply, .vtk, .vtu, .xyz, .csv or .vdb")
+
+    def test_crop_keeps_what_a_numpy_mask_keeps(self):
+        particles = nonbloppy.read_particles(DAM_BREAK)
+        lower, upper = (-10.0, -10.0, -10.0), (0.0, 10.0, 10.0)
+        kept = particles.crop(lower, upper)
+        inside = np.all((particles.positions >= lower) & (particles.positions <= upper), axis=1)
+        self.assertGreater(len(kept), 0)
+        self.assertLess(len(kept), len(particles))
+        np.testing.assert_array_equal(kept.positions, particles.positions[inside])
+        np.testing.assert_array_equal(kept.attributes["id"], particles.attributes["id"][inside])
+        with self.assertRaises(nonbloppy.ParameterError) as caught:
+            particles.crop((0, 0, 0), (1, -1, 1))
+        self.assertEqual(str(caught.exception), "particle box: its minimum y 0 exceeds its maximum -1")
 
 
 class Errors(unittest.TestCase):
