@@ -36,6 +36,7 @@
 #include <nonbloppy/BuildSurface.h>
 #include <nonbloppy/CgroupLimits.h>
 #include <nonbloppy/CropParticles.h>
+#include <nonbloppy/DiagnoseSurface.h>
 #include <nonbloppy/Error.h>
 #include <nonbloppy/InterpolateAttributes.h>
 #include <nonbloppy/ReadParticles.h>
@@ -341,21 +342,19 @@ void runReleased(int threads, PythonInterrupter& interrupter, WorkT&& work)
 
 //////////////////////////////////////// Mesh
 
-/// nonbloppy.Mesh: a SurfaceResult without its density grid.
+/// nonbloppy.Mesh: a SurfaceResult without its density grid (SurfaceParameters::keepDensity
+/// is false here).
 struct Mesh
 {
-    nonbloppy::SurfaceMesh mesh;
-    nonbloppy::ResolvedParameters parameters;
-    nonbloppy::StageTimings timings;
-    size_t particleCount = 0;
+    nonbloppy::SurfaceResult result;
 };
 
 py::dict meshAttributes(const py::object& self)
 {
     const Mesh& mesh = self.cast<const Mesh&>();
     py::dict result;
-    const size_t vertices = mesh.mesh.points.size();
-    for (const nonbloppy::MeshAttribute& attribute : mesh.mesh.attributes) {
+    const size_t vertices = mesh.result.mesh.points.size();
+    for (const nonbloppy::MeshAttribute& attribute : mesh.result.mesh.attributes) {
         const size_t columns = size_t(attribute.components);
         result[py::str(attribute.name)] = attribute.integer
             ? viewOf(attribute.integers.data(), vertices, columns, self, /*flat=*/true)
@@ -366,7 +365,7 @@ py::dict meshAttributes(const py::object& self)
 
 py::dict meshParameters(const Mesh& mesh)
 {
-    const nonbloppy::ResolvedParameters& p = mesh.parameters;
+    const nonbloppy::ResolvedParameters& p = mesh.result.parameters;
     py::dict result;
     result["spacing"] = p.spacing;
     result["radius"] = p.effectiveRadius;
@@ -388,7 +387,7 @@ py::dict meshParameters(const Mesh& mesh)
 /// which moves with the fluid: flicker). As `nonbloppy mesh` advises for sequences.
 py::dict pinnedParameters(const Mesh& mesh)
 {
-    const nonbloppy::ResolvedParameters& p = mesh.parameters;
+    const nonbloppy::ResolvedParameters& p = mesh.result.parameters;
     py::dict result;
     if (p.spacingGiven) result["spacing"] = p.spacing;
     result["radius"] = p.effectiveRadius;
@@ -402,16 +401,16 @@ py::dict pinnedParameters(const Mesh& mesh)
 py::dict meshTimings(const Mesh& mesh)
 {
     py::dict result;
-    for (const auto& entry : mesh.timings.entries) result[py::str(entry.stage)] = entry.seconds;
+    for (const auto& entry : mesh.result.timings.entries) result[py::str(entry.stage)] = entry.seconds;
     return result;
 }
 
 std::string meshRepr(const Mesh& mesh)
 {
-    std::string text = "<nonbloppy.Mesh: " + std::to_string(mesh.mesh.points.size()) + " vertices, " +
-                       std::to_string(mesh.mesh.triangles.size()) + " triangles, " +
-                       std::to_string(mesh.mesh.quads.size()) + " quads";
-    for (const auto& attribute : mesh.mesh.attributes) text += ", " + attribute.name;
+    std::string text = "<nonbloppy.Mesh: " + std::to_string(mesh.result.mesh.points.size()) + " vertices, " +
+                       std::to_string(mesh.result.mesh.triangles.size()) + " triangles, " +
+                       std::to_string(mesh.result.mesh.quads.size()) + " quads";
+    for (const auto& attribute : mesh.result.mesh.attributes) text += ", " + attribute.name;
     return text + ">";
 }
 
@@ -429,6 +428,56 @@ nonbloppy::Method methodOf(const std::string& method)
     if (method == "faithful") return nonbloppy::Method::Faithful;
     if (method == "paper") return nonbloppy::Method::Paper;
     throwParameterError("method must be 'faithful' or 'paper', not '" + method + "'");
+}
+
+/// Python's shortest text of @a value ("0.025", "1e+308"), as the user would type it.
+std::string number(double value)
+{
+    return py::repr(py::float_(value)).cast<std::string>();
+}
+
+/// Warn (nonbloppy.SurfaceWarning) of what diagnoseSurface() finds in @a mesh, in the tool's
+/// words but with build_surface()'s keywords. A warnings filter that turns them into errors
+/// raises here.
+void warnAbout(const Mesh& mesh, double blend, int iterations)
+{
+    const nonbloppy::SurfaceDiagnostics d = nonbloppy::diagnoseSurface(mesh.result);
+    const nonbloppy::ResolvedParameters& p = mesh.result.parameters;
+    const size_t vertices = mesh.result.mesh.points.size();
+    std::vector<std::string> messages;
+    if (d.facesEndInside) {
+        messages.push_back("blend=" + number(blend) + ", iterations=" + std::to_string(iterations) +
+                           " relax too strongly for the threshold to be calibrated: flat faces end inside the "
+                           "particles; lower blend or iterations" +
+                           (p.spacingGiven ? "" : ", or give spacing to correct the volume"));
+    }
+    if (d.coarseFloats()) {
+        messages.push_back("the particles reach " + number(d.farthestCoordinate) +
+                           " from the origin, where float positions step by " + number(d.floatStep) + ", more than " +
+                           (p.spacing > 0.0 ? "1/16 of the spacing " + number(p.spacing)
+                                            : "1/8 of the voxel size " + number(p.voxelSize)) +
+                           ": the surface is quantized there" + (d.dropletsMayVanish() ? ", and droplets may vanish" : "") +
+                           "; move the particles nearer the origin");
+    }
+    if (d.empty) {
+        messages.push_back("the mesh is empty: the density of the " + std::to_string(mesh.result.particleCount) +
+                           (mesh.result.particleCount == 1 ? " particle" : " particles") + ", sampled at voxel_size " +
+                           number(p.voxelSize) + ", nowhere reaches threshold " + number(p.threshold));
+    }
+    if (d.verticesWithoutNormal > 0) {
+        messages.push_back(std::to_string(d.verticesWithoutNormal) + " of the " + std::to_string(vertices) +
+                           " vertices have no normal (the faces around them have no area)" +
+                           (p.blend == 1.0 ? ": blend=1 collapses droplets onto their particles; lower blend" : ""));
+    }
+    for (const auto& [name, count] : d.nonFiniteAttributes) {
+        messages.push_back(std::to_string(count) + " of the " + std::to_string(vertices) +
+                           " vertices have a NaN or infinite '" + name + "': particles near them hold such values");
+    }
+    for (const std::string& message : messages) {
+        if (PyErr_WarnEx(exceptionTypes().surfaceWarning.ptr(), message.c_str(), 2) != 0) {
+            throw py::error_already_set();
+        }
+    }
 }
 
 Mesh buildSurface(const py::object& input, std::optional<double> spacing, std::optional<double> radius,
@@ -476,22 +525,9 @@ Mesh buildSurface(const py::object& input, std::optional<double> spacing, std::o
             nonbloppy::interpolateAttributes(result.mesh, particles->set, *names,
                                              result.parameters.effectiveRadius, &interrupter);
         }
-        mesh.mesh = std::move(result.mesh);
-        mesh.parameters = result.parameters;
-        mesh.timings = std::move(result.timings);
-        mesh.particleCount = result.particleCount;
+        mesh.result = std::move(result);
     });
-    // As the tool warns: r_0 could not be calibrated for so strong a relaxation.
-    if (!mesh.parameters.thresholdReachesSurface) {
-        std::ostringstream message;
-        message << "blend=" << blend << ", iterations=" << iterations
-                << " relax too strongly for the threshold to be calibrated: flat faces end inside the "
-                   "particles; lower blend or iterations"
-                << (mesh.parameters.spacingGiven ? "" : ", or give spacing to correct the volume");
-        if (PyErr_WarnEx(exceptionTypes().surfaceWarning.ptr(), message.str().c_str(), 1) != 0) {
-            throw py::error_already_set();  // warnings turned into errors
-        }
-    }
+    warnAbout(mesh, blend, iterations);
     return mesh;
 }
 
@@ -614,25 +650,25 @@ PYBIND11_MODULE(nonbloppy, m)
         // Views: changing one changes the mesh that write() writes.
         .def_property_readonly("vertices", [](const py::object& self) {
                 const Mesh& mesh = self.cast<const Mesh&>();
-                return viewOf(reinterpret_cast<const float*>(mesh.mesh.points.data()), mesh.mesh.points.size(), 3, self);
+                return viewOf(reinterpret_cast<const float*>(mesh.result.mesh.points.data()), mesh.result.mesh.points.size(), 3, self);
             }, "(V, 3) float32 vertex positions, world units")
         .def_property_readonly("normals", [](const py::object& self) {
                 const Mesh& mesh = self.cast<const Mesh&>();
-                return viewOf(reinterpret_cast<const float*>(mesh.mesh.normals.data()), mesh.mesh.normals.size(), 3, self);
+                return viewOf(reinterpret_cast<const float*>(mesh.result.mesh.normals.data()), mesh.result.mesh.normals.size(), 3, self);
             }, "(V, 3) float32 unit vertex normals (the normalized sum of the adjacent faces' normals)")
         .def_property_readonly("triangles", [](const py::object& self) {
                 const Mesh& mesh = self.cast<const Mesh&>();
-                return viewOf(reinterpret_cast<const uint32_t*>(mesh.mesh.triangles.data()), mesh.mesh.triangles.size(), 3, self);
+                return viewOf(reinterpret_cast<const uint32_t*>(mesh.result.mesh.triangles.data()), mesh.result.mesh.triangles.size(), 3, self);
             }, "(T, 3) uint32 vertex indices of the triangles, counter-clockwise seen from outside the\n"
                "fluid; with quads, the mesh's other polygons (faces has them all as triangles)")
         .def_property_readonly("quads", [](const py::object& self) {
                 const Mesh& mesh = self.cast<const Mesh&>();
-                return viewOf(reinterpret_cast<const uint32_t*>(mesh.mesh.quads.data()), mesh.mesh.quads.size(), 4, self);
+                return viewOf(reinterpret_cast<const uint32_t*>(mesh.result.mesh.quads.data()), mesh.result.mesh.quads.size(), 4, self);
             }, "(Q, 4) uint32 vertex indices, counter-clockwise seen from outside the fluid")
         .def_property_readonly("faces", [](const Mesh& mesh) {
                 // As the writers split quads: triangles first, then (q0,q1,q2), (q0,q2,q3).
-                const auto& triangles = mesh.mesh.triangles;
-                const auto& quads = mesh.mesh.quads;
+                const auto& triangles = mesh.result.mesh.triangles;
+                const auto& quads = mesh.result.mesh.quads;
                 py::array_t<uint32_t> faces({triangles.size() + 2 * quads.size(), size_t(3)});
                 uint32_t* out = faces.mutable_data();
                 for (const openvdb::Vec3I& t : triangles) out = std::copy(t.asPointer(), t.asPointer() + 3, out);
@@ -654,7 +690,7 @@ PYBIND11_MODULE(nonbloppy, m)
             "**first.pinned_parameters). Unpinned, they follow each frame's spacing estimate, which\n"
             "moves with the fluid, and the surface flickers in a rendered sequence.")
         .def_property_readonly("timings", &meshTimings, "dict: stage -> wall-clock seconds")
-        .def_property_readonly("particle_count", [](const Mesh& mesh) { return mesh.particleCount; })
+        .def_property_readonly("particle_count", [](const Mesh& mesh) { return mesh.result.particleCount; })
         .def("write", [](const Mesh& mesh, const py::object& file, bool quads, bool directIo) {
                 const std::string path = pathOf(file);
                 nonbloppy::requireMeshFile(path);
@@ -662,7 +698,7 @@ PYBIND11_MODULE(nonbloppy, m)
                 settings.keepQuads = quads;
                 settings.directIo = directIo;
                 py::gil_scoped_release release;
-                nonbloppy::writeMesh(mesh.mesh, path, settings);
+                nonbloppy::writeMesh(mesh.result.mesh, path, settings);
             }, py::arg("path"), py::kw_only(), py::arg("quads") = false, py::arg("direct_io") = true,
             "Write the mesh as .obj, .ply (binary) or .vtk, by the extension, through a temporary\n"
             "file renamed into place (no partial file). quads=True keeps quads. Raises FileError.")

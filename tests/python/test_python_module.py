@@ -12,6 +12,7 @@ import subprocess
 import tempfile
 import threading
 import unittest
+import warnings
 
 import numpy as np
 
@@ -188,6 +189,60 @@ class Arrays(unittest.TestCase):
         self.assertEqual(mesh.attributes["id"].dtype, np.int64)
         self.assertTrue(set(mesh.attributes["id"].tolist()) <= set(ids.tolist()))
         self.assertIn("interpolate attributes", mesh.timings)
+
+
+class Warnings(unittest.TestCase):
+    """What diagnoseSurface() finds comes out as nonbloppy.SurfaceWarning, in the tool's words."""
+
+    def warnings_of(self, *args, **parameters):
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            nonbloppy.build_surface(*args, **parameters)
+        self.assertTrue(all(w.category is nonbloppy.SurfaceWarning for w in caught))
+        self.assertTrue(all(w.filename == __file__ for w in caught))  # the caller's line
+        return [str(w.message) for w in caught]
+
+    def test_a_mesh_as_asked_warns_of_nothing(self):
+        self.assertEqual(self.warnings_of(nonbloppy.read_particles(CUBE)), [])
+
+    def test_an_empty_mesh(self):
+        self.assertEqual(self.warnings_of([CENTRE], radius=1.0, threshold=1e30, voxel_size=0.05, method="paper"),
+                         ["the mesh is empty: the density of the 1 particle, sampled at voxel_size 0.05, nowhere "
+                          "reaches threshold 1e+30"])
+
+    def test_particles_far_from_the_origin(self):
+        messages = self.warnings_of([[2.0 ** 20, 0, 0]], radius=1.0, threshold=1.0, voxel_size=0.05,
+                                    method="paper", iterations=0)
+        self.assertEqual(messages[0], "the particles reach 1048576.0 from the origin, where float positions step by "
+                         "0.125, more than 1/8 of the voxel size 0.05: the surface is quantized there, and droplets "
+                         "may vanish; move the particles nearer the origin")
+        # Vertices snapped to a step of 2.5 voxels: faces with no area.
+        self.assertEqual(len(messages), 2)
+        self.assertRegex(messages[1], r"^\d+ of the \d+ vertices have no normal \(the faces around them have no "
+                                      r"area\)$")
+
+    def test_vertices_without_normals(self):
+        messages = self.warnings_of([CENTRE], radius=1.0, threshold=1.0, voxel_size=0.05, method="paper",
+                                    blend=1.0, iterations=1)
+        self.assertEqual(len(messages), 1)
+        self.assertRegex(messages[0], r"^\d+ of the \d+ vertices have no normal \(the faces around them have no "
+                                      r"area\): blend=1 collapses droplets onto their particles; lower blend$")
+
+    def test_a_nan_attribute(self):
+        cube = nonbloppy.read_particles(CUBE)
+        temperature = np.full(len(cube), 300.0, dtype=np.float32)
+        temperature[7] = math.nan
+        particles = nonbloppy.Particles(cube.positions, attributes={"temperature": temperature})
+        messages = self.warnings_of(particles, attributes="all")
+        self.assertEqual(len(messages), 1)
+        self.assertRegex(messages[0], r"^\d+ of the \d+ vertices have a NaN or infinite 'temperature': particles "
+                                      r"near them hold such values$")
+
+    def test_warnings_made_errors_raise(self):
+        with warnings.catch_warnings():
+            warnings.simplefilter("error", nonbloppy.SurfaceWarning)
+            with self.assertRaises(nonbloppy.SurfaceWarning):
+                nonbloppy.build_surface([CENTRE], radius=1.0, threshold=1e30, voxel_size=0.05, method="paper")
 
 
 class ParticleFiles(unittest.TestCase):

@@ -17,6 +17,7 @@
 
 #include <nonbloppy/BuildSurface.h>
 #include <nonbloppy/CropParticles.h>
+#include <nonbloppy/DiagnoseSurface.h>
 #include <nonbloppy/Error.h>
 #include <nonbloppy/ReadParticles.h>
 #include <nonbloppy/Timing.h>
@@ -704,41 +705,32 @@ void warnIfLengthsMoved(bool maxStepGiven, OnceWarnings& once)
 }
 
 /// Once per run: relaxation too strong for the calibrated r_0 shrinks every flat face.
-void warnIfFacesEndInside(const MeshOptions& o, const nonbloppy::ResolvedParameters& p, OnceWarnings& once)
+void warnIfFacesEndInside(const MeshOptions& o, const nonbloppy::SurfaceDiagnostics& d, bool spacingGiven,
+                          OnceWarnings& once)
 {
-    if (p.thresholdReachesSurface || once.facesEndInside.exchange(true)) return;
+    if (!d.facesEndInside || once.facesEndInside.exchange(true)) return;
     warning(once) << "--blend " << formatNumber(o.blend) << " --iterations " << o.iterations
                   << " relax too strongly for --threshold to be calibrated: flat faces end inside the "
                      "particles; lower --blend or --iterations"
-                  << (p.spacingGiven ? "" : ", or give --spacing to correct the volume");
+                  << (spacingGiven ? "" : ", or give --spacing to correct the volume");
 }
 
 /// Once per run: positions are floats, whose step grows with the distance from the origin;
 /// a scene placed far out (georeferenced, say) meshes to a surface quantized to that step,
 /// and nothing else tells why it looks rough; where the step nears the spacing, droplets
 /// collapse to points and vanish from the mesh. Warned when the step at the particles'
-/// farthest coordinate exceeds 1/16 of the spacing (from 8192 units out for s = 0.01). The
-/// particles, not the mesh: a part of the fluid that is lost leaves no vertex to tell.
-/// Without a spacing (r_e, r_0 and h all given) the voxel size stands for s/2, its default.
-void warnIfCoarseFloats(const nonbloppy::SurfaceResult& result, OnceWarnings& once)
+/// farthest coordinate exceeds 1/16 of the spacing (from 8192 units out for s = 0.01;
+/// SurfaceDiagnostics::floatStepLimit). The particles, not the mesh: a part of the fluid
+/// that is lost leaves no vertex to tell.
+void warnIfCoarseFloats(const nonbloppy::SurfaceDiagnostics& d, const nonbloppy::ResolvedParameters& p,
+                        OnceWarnings& once)
 {
-    // Not BBoxd::empty(), which is true for particles in one plane (min == max on an axis):
-    // a flat sheet or a single particle went unwarned (bug hunt).
-    const openvdb::BBoxd& bounds = result.particleBounds;
-    if (result.particleCount == 0 || once.coarseFloats.load()) return;
-    double farthest = 0.0;
-    for (int k = 0; k < 3; ++k) farthest = std::max({farthest, std::abs(bounds.min()[k]), std::abs(bounds.max()[k])});
-    const float atFarthest = float(farthest);  // exact: the bounds are float positions
-    const double step = double(std::nextafter(atFarthest, std::numeric_limits<float>::infinity())) - farthest;
-    const double spacing = result.parameters.spacing, voxelSize = result.parameters.voxelSize;
-    const bool bySpacing = spacing > 0.0;
-    const double limit = bySpacing ? spacing / 16.0 : voxelSize / 8.0;
-    if (!(limit > 0.0) || !(step > limit) || once.coarseFloats.exchange(true)) return;
-    warning(once) << "the particles reach " << formatNumber(farthest)
-                  << " from the origin, where float positions step by " << formatNumber(step) << ", more than "
-                  << (bySpacing ? "1/16 of the spacing " + formatNumber(spacing)
-                                : "1/8 of the voxel size " + formatNumber(voxelSize))
-                  << ": the surface is quantized there" << (step >= 8.0 * limit ? ", and droplets may vanish" : "")
+    if (!d.coarseFloats() || once.coarseFloats.exchange(true)) return;
+    warning(once) << "the particles reach " << formatNumber(d.farthestCoordinate)
+                  << " from the origin, where float positions step by " << formatNumber(d.floatStep) << ", more than "
+                  << (p.spacing > 0.0 ? "1/16 of the spacing " + formatNumber(p.spacing)
+                                      : "1/8 of the voxel size " + formatNumber(p.voxelSize))
+                  << ": the surface is quantized there" << (d.dropletsMayVanish() ? ", and droplets may vanish" : "")
                   << "; move the particles nearer the origin";
 }
 
@@ -746,9 +738,10 @@ void warnIfCoarseFloats(const nonbloppy::SurfaceResult& result, OnceWarnings& on
 /// out-of-scale --threshold (1e308) gave 0 vertices and exit 0 without a word. The density
 /// is named as sampled: it reaches any threshold at a particle's centre, but a lone particle
 /// between voxel centres can leave every sample below it (bug hunt).
-void warnIfEmpty(const nonbloppy::SurfaceResult& result, const std::string& output, const OnceWarnings& once)
+void warnIfEmpty(const nonbloppy::SurfaceDiagnostics& d, const nonbloppy::SurfaceResult& result,
+                 const std::string& output, const OnceWarnings& once)
 {
-    if (result.particleCount == 0 || !result.mesh.points.empty()) return;
+    if (!d.empty) return;
     warning(once) << output << " is empty: the density of the " << result.particleCount
                   << (result.particleCount == 1 ? " particle" : " particles") << ", sampled at --voxel-size "
                   << formatNumber(result.parameters.voxelSize) << ", nowhere reaches --threshold "
@@ -769,21 +762,11 @@ void warnIfMeshInput(const std::string& input, const std::string& faces, OnceWar
 /// all, and nothing said why: -c 1 moves every vertex onto its particles' weighted mean,
 /// which collapses a droplet to a point (bug hunt: 32 of the 1,032 vertices of the bundled
 /// free-particle frame with --method paper).
-void warnIfNormalsMissing(const nonbloppy::SurfaceResult& result, const std::string& output, OnceWarnings& once)
+void warnIfNormalsMissing(const nonbloppy::SurfaceDiagnostics& d, const nonbloppy::SurfaceResult& result,
+                          const std::string& output, OnceWarnings& once)
 {
-    if (once.normalsMissing.load()) return;  // said: no pass over the next frames' normals
-    const std::vector<openvdb::Vec3s>& normals = result.mesh.normals;
-    // In parallel: it runs after the write, when nothing else is left, and a 64x benchmark
-    // frame has 2.4M normals (4 ms alone).
-    const size_t missing = tbb::parallel_reduce(
-        tbb::blocked_range<size_t>(0, normals.size(), 65536), size_t(0),
-        [&](const tbb::blocked_range<size_t>& range, size_t count) {
-            return count + size_t(std::count(normals.begin() + range.begin(), normals.begin() + range.end(),
-                                             openvdb::Vec3s(0.0f)));
-        },
-        std::plus<size_t>());
-    if (missing == 0 || once.normalsMissing.exchange(true)) return;
-    warning(once) << missing << " of the " << normals.size() << " vertices of " << output
+    if (d.verticesWithoutNormal == 0 || once.normalsMissing.exchange(true)) return;
+    warning(once) << d.verticesWithoutNormal << " of the " << result.mesh.normals.size() << " vertices of " << output
                   << " have no normal (the faces around them have no area)"
                   << (result.parameters.blend == 1.0 ? ": -c 1 collapses droplets onto their particles; lower --blend"
                                                      : "");
@@ -792,44 +775,30 @@ void warnIfNormalsMissing(const nonbloppy::SurfaceResult& result, const std::str
 /// Once per run: vertices whose carried attribute (--attributes) is NaN or infinite. The
 /// particles' values are averaged as they are, so one NaN velocity in a cache from a
 /// simulation that blew up makes every vertex within r_e of it NaN, which a renderer's motion
-/// blur does not survive; `nonbloppy inspect IN` counts such values per attribute.
-void warnIfAttributesNotFinite(const nonbloppy::SurfaceResult& result, const std::string& input,
-                               const std::string& output, OnceWarnings& once)
+/// blur does not survive; `nonbloppy inspect IN` counts such values per attribute. The first
+/// such attribute is named.
+void warnIfAttributesNotFinite(const nonbloppy::SurfaceDiagnostics& d, const nonbloppy::SurfaceResult& result,
+                               const std::string& input, const std::string& output, OnceWarnings& once)
 {
-    if (once.attributesNotFinite.load()) return;
-    const nonbloppy::SurfaceMesh& mesh = result.mesh;
-    for (const nonbloppy::MeshAttribute& a : mesh.attributes) {
-        if (a.integer || a.components < 1) continue;
-        const size_t components = size_t(a.components);
-        const size_t vertices = tbb::parallel_reduce(
-            tbb::blocked_range<size_t>(0, a.values.size() / components, 65536), size_t(0),
-            [&](const tbb::blocked_range<size_t>& range, size_t count) {
-                for (size_t v = range.begin(); v < range.end(); ++v) {
-                    const float* value = a.values.data() + v * components;
-                    count += std::any_of(value, value + components, [](float x) { return !std::isfinite(x); });
-                }
-                return count;
-            },
-            std::plus<size_t>());
-        if (vertices == 0) continue;
-        if (once.attributesNotFinite.exchange(true)) return;  // another frame said it meanwhile
-        warning(once) << vertices << " of the " << mesh.points.size() << " vertices of " << output << " have a NaN or "
-                      << "infinite '" << a.name << "': particles of " << input
-                      << " near them hold such values (nonbloppy inspect counts them)";
-        return;
-    }
+    if (d.nonFiniteAttributes.empty() || once.attributesNotFinite.exchange(true)) return;
+    const auto& [name, vertices] = d.nonFiniteAttributes.front();
+    warning(once) << vertices << " of the " << result.mesh.points.size() << " vertices of " << output
+                  << " have a NaN or infinite '" << name << "': particles of " << input
+                  << " near them hold such values (nonbloppy inspect counts them)";
 }
 
 /// The warnings about one meshed frame (@a f: its options, paths included), each printed
 /// once per run.
 void warnAboutFrame(const MeshOptions& f, const FrameOutcome& outcome, OnceWarnings& once)
 {
-    warnIfFacesEndInside(f, outcome.result.parameters, once);
-    warnIfCoarseFloats(outcome.result, once);
-    warnIfEmpty(outcome.result, f.output, once);
-    warnIfNormalsMissing(outcome.result, f.output, once);
+    const nonbloppy::SurfaceResult& result = outcome.result;
+    const nonbloppy::SurfaceDiagnostics d = nonbloppy::diagnoseSurface(result);
+    warnIfFacesEndInside(f, d, result.parameters.spacingGiven, once);
+    warnIfCoarseFloats(d, result.parameters, once);
+    warnIfEmpty(d, result, f.output, once);
+    warnIfNormalsMissing(d, result, f.output, once);
     warnIfMeshInput(f.input, outcome.faces, once);
-    warnIfAttributesNotFinite(outcome.result, f.input, f.output, once);
+    warnIfAttributesNotFinite(d, result, f.input, f.output, once);
 }
 
 // ---------------------------------------------------------------------------------------
