@@ -23,7 +23,7 @@
 # faithful method's volume correction and smoothing (`--spacing`, with and without
 # `--no-smooth`), meshes a six-frame sequence, and meshes the input tiled with the frame's id
 # and velocity: with `--attributes all`, read from VTK, VTU, CSV and OpenVDB points, and
-# written as OBJ.
+# written as OBJ; and it meshes the input from Python through the module, where it was built.
 # Wall time, CPU time (user + system) and peak RSS come from GNU time. The report is markdown,
 # printed and written to DIR/benchmark.md.
 set -euo pipefail
@@ -399,6 +399,27 @@ for format in "${formats[@]}"; do
 done
 for label in "${labels[@]}"; do rm -f "$out/scan_$label.stage"; done
 
+# From Python (no target): the same mesh made by a script through the module (read_particles,
+# build_surface, Mesh.write), alternating with the tool; the two meshes must be the same bytes.
+python_module=$(ls build/python/nonbloppy.*.so 2>/dev/null | head -1)
+python_figures=""
+if [ -n "$python_module" ] && [ -x /usr/bin/python3 ]; then
+  rm -f "$out/scan_py_tool" "$out/scan_py"
+  for ((r = 0; r < scan_runs; ++r)); do
+    scan_once py_tool "${nb_args[@]}"
+    rm -f "$out/py.ply"
+    PYTHONPATH="$PWD/build/python" run_timed "$out/scan_py" /usr/bin/python3 tests/bench/mesh_from_python.py \
+      "$out/dam_break_x64.ply" "$out/py.ply"
+  done
+  cmp -s "$out/scan.ply" "$out/py.ply" && same="the same bytes" || same="**different bytes**"
+  rm -f "$out/py.ply"
+  py_wall=$(median 1 "$out/scan_py"); py_tool_wall=$(median 1 "$out/scan_py_tool")
+  py_rss=$(( $(median 3 "$out/scan_py") / 1024 )); py_tool_rss=$(( $(median 3 "$out/scan_py_tool") / 1024 ))
+  say ""
+  say "From Python (\`tests/bench/mesh_from_python.py\`: read_particles, build_surface with the same parameters, Mesh.write), the 64x input, median of $scan_runs runs each, alternating with the tool: $py_wall s and $py_rss MiB against $py_tool_wall s and $py_tool_rss MiB, $same."
+  python_figures="From Python (the module, \`tests/bench/mesh_from_python.py\`): $py_wall s and $py_rss MiB against the tool's $py_tool_wall s and $py_tool_rss MiB in the same turns, $same."
+fi
+
 # The paper's figure: 14,272 particles, t = 2, about 15 s on a 2008 desktop. Compute time of the
 # 1x frame (24,389 particles; stages without reading and writing) scaled to 14,272 particles.
 # A frame this small computes in under 0.1 s, where one run in three or four is 20-40% slower
@@ -444,6 +465,7 @@ summary="$out/summary.md"
   echo "With the frame's \`id\` and \`velocity\` tiled along: $attr_with s with \`--attributes all\` against"
   echo "$attr_without s without, $attr_interpolate s of it interpolating; the mesh written as OBJ ($(megabytes "$obj_bytes") MB) in $write_obj s"
   echo "against PLY's ($(megabytes "$ply_bytes") MB) $write_ply s; the particles read as $read_figures."
+  [ -z "$python_figures" ] || echo "$python_figures"
 } > "$summary"
 say ""
 say "## Summary"
