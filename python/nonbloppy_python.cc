@@ -39,6 +39,7 @@
 #include <nonbloppy/DiagnoseSurface.h>
 #include <nonbloppy/Error.h>
 #include <nonbloppy/InterpolateAttributes.h>
+#include <nonbloppy/MeasureMesh.h>
 #include <nonbloppy/ReadParticles.h>
 #include <nonbloppy/Version.h>
 #include <nonbloppy/WriteMesh.h>
@@ -690,6 +691,31 @@ PYBIND11_MODULE(nonbloppy, m)
             "**first.pinned_parameters). Unpinned, they follow each frame's spacing estimate, which\n"
             "moves with the fluid, and the surface flickers in a rendered sequence.")
         .def_property_readonly("timings", &meshTimings, "dict: stage -> wall-clock seconds")
+        .def("measure", [](const Mesh& mesh) {
+                nonbloppy::MeshMeasures m;
+                {
+                    py::gil_scoped_release release;
+                    m = nonbloppy::measureMesh(mesh.result.mesh);
+                }
+                py::dict result;
+                result["vertices"] = m.vertices;
+                result["polygons"] = m.polygons;
+                result["closed"] = m.closed;
+                result["manifold"] = m.manifold;
+                result["area"] = m.area;
+                result["volume"] = m.volume;
+                result["boundary_edges"] = m.boundaryEdges;
+                result["non_manifold_edges"] = m.nonManifoldEdges;
+                result["inconsistent_edges"] = m.inconsistentEdges;
+                result["zero_area_polygons"] = m.zeroAreaPolygons;
+                result["unused_vertices"] = m.unusedVertices;
+                return result;
+            },
+            "dict of the mesh's measures, as `nonbloppy inspect` prints them: closed, manifold (every edge\n"
+            "shared by two consistently oriented polygons), area (world units^2), volume (signed,\n"
+            "positive facing outwards), and the counts of boundary, non-manifold and inconsistent\n"
+            "edges, zero-area polygons and unused vertices. Cost: O(polygons), about 1 s for 4.7M\n"
+            "triangles on two cores.")
         .def_property_readonly("particle_count", [](const Mesh& mesh) { return mesh.result.particleCount; })
         .def("write", [](const Mesh& mesh, const py::object& file, bool quads, bool directIo) {
                 const std::string path = pathOf(file);

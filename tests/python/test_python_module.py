@@ -60,6 +60,15 @@ class OneParticle(unittest.TestCase):
         np.testing.assert_allclose(np.linalg.norm(mesh.normals, axis=1), 1.0, rtol=1e-5)
         self.assertGreater(np.min(np.sum(mesh.normals * outward, axis=1)), 0.99)
 
+    def test_measure_gives_the_spheres_area_and_volume(self):
+        measures = one_particle_mesh(iterations=0).measure()
+        self.assertTrue(measures["closed"])
+        self.assertTrue(measures["manifold"])
+        self.assertEqual((measures["boundary_edges"], measures["inconsistent_edges"]), (0, 0))
+        # Polygons inscribed in the sphere of radius 0.5, h = 0.05: within 1% of its measures.
+        self.assertAlmostEqual(measures["area"] / (4 * math.pi * 0.25), 1.0, delta=0.01)
+        self.assertAlmostEqual(measures["volume"] / (4 / 3 * math.pi * 0.125), 1.0, delta=0.01)
+
     def test_parameters_report_what_was_used(self):
         parameters = one_particle_mesh(iterations=3, blend=0.25).parameters
         self.assertEqual(parameters["radius"], 1.0)
