@@ -440,14 +440,14 @@ std::string number(double value)
 /// Warn (nonbloppy.SurfaceWarning) of what diagnoseSurface() finds in @a mesh, in the tool's
 /// words but with build_surface()'s keywords. A warnings filter that turns them into errors
 /// raises here.
-void warnAbout(const Mesh& mesh, double blend, int iterations)
+void warnAbout(const Mesh& mesh)
 {
     const nonbloppy::SurfaceDiagnostics d = nonbloppy::diagnoseSurface(mesh.result);
     const nonbloppy::ResolvedParameters& p = mesh.result.parameters;
     const size_t vertices = mesh.result.mesh.points.size();
     std::vector<std::string> messages;
     if (d.facesEndInside) {
-        messages.push_back("blend=" + number(blend) + ", iterations=" + std::to_string(iterations) +
+        messages.push_back("blend=" + number(p.blend) + ", iterations=" + std::to_string(p.iterations) +
                            " relax too strongly for the threshold to be calibrated: flat faces end inside the "
                            "particles; lower blend or iterations" +
                            (p.spacingGiven ? "" : ", or give spacing to correct the volume"));
@@ -528,7 +528,7 @@ Mesh buildSurface(const py::object& input, std::optional<double> spacing, std::o
         }
         mesh.result = std::move(result);
     });
-    warnAbout(mesh, blend, iterations);
+    warnAbout(mesh);
     return mesh;
 }
 
